@@ -1,0 +1,5 @@
+"""Allow ``python -m nfwserver``."""
+
+from nfwserver.cli import main
+
+raise SystemExit(main())

@@ -1,0 +1,85 @@
+"""Clocks: the only place the server learns what time it is.
+
+Every component that needs the time takes a :class:`Clock` argument; nothing reads the wall clock on
+its own.  :class:`SystemClock` follows real time; :class:`VirtualClock` only moves when told to (or
+when something sleeps on it), so tests and ``nfwserver simulate`` run whole passes at any speed.
+
+Times are timezone-aware :class:`datetime.datetime` objects in UTC.  ``monotonic()`` is in seconds
+and only meaningful as a difference.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from datetime import datetime, timedelta, timezone
+from typing import Protocol
+
+
+class Clock(Protocol):
+    """What the server needs from a clock."""
+
+    def now(self) -> datetime:
+        """The current instant, timezone-aware UTC."""
+        ...
+
+    def monotonic(self) -> float:
+        """Seconds on a clock that never goes backwards (only differences are meaningful)."""
+        ...
+
+    def sleep(self, seconds: float) -> None:
+        """Block (or, for a virtual clock, advance) for ``seconds``; non-positive returns at once."""
+        ...
+
+
+class SystemClock:
+    """Real time: UTC from the operating system, ``time.monotonic`` and ``time.sleep``."""
+
+    def now(self) -> datetime:
+        return datetime.now(timezone.utc)
+
+    def monotonic(self) -> float:
+        return time.monotonic()
+
+    def sleep(self, seconds: float) -> None:
+        if seconds > 0:
+            time.sleep(seconds)
+
+
+class VirtualClock:
+    """A clock that stands still until advanced; ``sleep`` advances it instantly.
+
+    Thread-safe.  ``start`` must be timezone-aware (naive datetimes are taken as UTC).
+    """
+
+    def __init__(self, start: datetime) -> None:
+        if start.tzinfo is None:
+            start = start.replace(tzinfo=timezone.utc)
+        self._start = start.astimezone(timezone.utc)
+        self._elapsed = 0.0
+        self._lock = threading.Lock()
+
+    def now(self) -> datetime:
+        with self._lock:
+            return self._start + timedelta(seconds=self._elapsed)
+
+    def monotonic(self) -> float:
+        with self._lock:
+            return self._elapsed
+
+    def advance(self, seconds: float) -> None:
+        """Move time forward by ``seconds`` (negative values are refused)."""
+        if seconds < 0:
+            raise ValueError("a virtual clock cannot go backwards")
+        with self._lock:
+            self._elapsed += seconds
+
+    def set(self, when: datetime) -> None:
+        """Jump to ``when`` (must not be earlier than now)."""
+        if when.tzinfo is None:
+            when = when.replace(tzinfo=timezone.utc)
+        self.advance((when - self.now()).total_seconds())
+
+    def sleep(self, seconds: float) -> None:
+        if seconds > 0:
+            self.advance(seconds)

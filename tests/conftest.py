@@ -1,0 +1,34 @@
+"""Shared test configuration: deterministic hypothesis, paths to shared data, Hamlib daemons."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, settings
+
+from tests.hamlib_daemons import HamlibDaemon
+
+settings.register_profile(
+    "nfwserver", derandomize=True, deadline=None, suppress_health_check=[HealthCheck.too_slow]
+)
+settings.load_profile("nfwserver")
+
+ROOT = Path(__file__).resolve().parent.parent
+#: Element sets shipped with the tests (copied from ../shared/data, a fact-only CelesTrak snapshot).
+DATA = ROOT / "tests" / "data"
+
+
+@pytest.fixture
+def rotctld() -> Iterator[HamlibDaemon]:
+    """A running ``rotctld -m 1`` (dummy rotor) on a free loopback port."""
+    with HamlibDaemon("rotctld") as daemon:
+        yield daemon
+
+
+@pytest.fixture
+def rigctld() -> Iterator[HamlibDaemon]:
+    """A running ``rigctld -m 1`` (dummy rig) on a free loopback port."""
+    with HamlibDaemon("rigctld") as daemon:
+        yield daemon

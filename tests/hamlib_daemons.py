@@ -1,0 +1,100 @@
+"""Real Hamlib daemons (rotctld, rigctld) for tests, on free 127.0.0.1 ports.
+
+Tests talk to the real programs from Debian's ``libhamlib-utils`` with the dummy models
+(``-m 1``), never to a mock.  A daemon can be killed and restarted on the same port to test
+reconnection.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import socket
+import subprocess
+import time
+
+import pytest
+
+
+def free_port() -> int:
+    """A TCP port on 127.0.0.1 that nothing listens on right now."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+def require_program(name: str) -> str:
+    """Path of ``name``; skip the test if it is missing, except under CI where it must be there."""
+    path = shutil.which(name)
+    if path is None:
+        if os.environ.get("CI"):
+            pytest.fail(f"{name} is not installed (CI must install libhamlib-utils)")
+        pytest.skip(f"{name} not installed (apt-get install libhamlib-utils)")
+    return path
+
+
+class HamlibDaemon:
+    """One rotctld/rigctld process listening on 127.0.0.1:``port``.
+
+    ``program`` is ``"rotctld"`` or ``"rigctld"``; ``extra`` are further command-line arguments
+    (for example ``["--set-conf=min_az=0,max_az=450"]``).
+    """
+
+    def __init__(self, program: str, model: int = 1, extra: list[str] | None = None) -> None:
+        self.program = require_program(program)
+        self.model = model
+        self.extra = list(extra or [])
+        self.host = "127.0.0.1"
+        self.port = free_port()
+        self.proc: subprocess.Popen[bytes] | None = None
+
+    def start(self, timeout: float = 10.0) -> HamlibDaemon:
+        """Start the daemon and wait until it accepts connections."""
+        cmd = [self.program, "-m", str(self.model), "-T", self.host, "-t", str(self.port), *self.extra]
+        self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if self.proc.poll() is not None:
+                raise RuntimeError(f"{cmd[0]} exited with {self.proc.returncode}: {' '.join(cmd)}")
+            try:
+                with socket.create_connection((self.host, self.port), timeout=0.2):
+                    return self
+            except OSError:
+                time.sleep(0.02)
+        raise RuntimeError(f"{' '.join(cmd)} did not listen within {timeout} s")
+
+    def kill(self) -> None:
+        """Kill the daemon (SIGKILL) and wait for it to be gone."""
+        if self.proc is not None and self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait(timeout=5)
+        self.proc = None
+
+    def restart(self) -> HamlibDaemon:
+        """Kill and start again on the same port."""
+        self.kill()
+        return self.start()
+
+    def command(self, line: str, timeout: float = 3.0) -> str:
+        """Send one raw protocol line on a fresh connection and return the reply text (for checks)."""
+        with socket.create_connection((self.host, self.port), timeout=timeout) as sock:
+            sock.sendall(line.encode("ascii") + b"\n")
+            sock.settimeout(timeout)
+            chunks = []
+            deadline = time.monotonic() + timeout
+            while time.monotonic() < deadline:
+                try:
+                    chunk = sock.recv(4096)
+                except TimeoutError:
+                    break
+                if not chunk:
+                    break
+                chunks.append(chunk)
+                sock.settimeout(0.1)
+            return b"".join(chunks).decode("ascii", errors="replace")
+
+    def __enter__(self) -> HamlibDaemon:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.kill()
