@@ -19,7 +19,7 @@ ANSI_CODEPAGE = "cp1252"
 
 
 def format_name(fmt: int) -> str:
-    """A readable name for a clipboard format number (``"CF_TEXT"``, ``"CF_UNICODETEXT"``, ``"fmt 49161"``)."""
+    """A readable name for a clipboard format number, e.g. ``"CF_TEXT"`` or ``"fmt 49161"``."""
     return {CF_TEXT: "CF_TEXT", CF_UNICODETEXT: "CF_UNICODETEXT"}.get(fmt, f"fmt {fmt}")
 
 
