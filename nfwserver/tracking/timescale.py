@@ -1,0 +1,56 @@
+"""Time scales for SGP4: UTC datetimes to split Julian dates, UT1, and GMST (IAU 1982).
+
+SGP4 element epochs are UTC, so the propagator is fed the UTC Julian date, as the ``sgp4``
+package and skyfield do.  Rotating SGP4's TEME frame into the Earth-fixed frame needs the
+Greenwich mean sidereal angle at UT1 = UTC + (UT1 - UTC).  |UT1 - UTC| stays below 0.9 s by
+definition of UTC; leaving it at 0 rotates the Earth by up to 0.9 s x 15.04"/s = 0.0038 deg,
+which moves a LEO satellite's azimuth and elevation by about 0.002 deg and its range rate by
+up to about 0.2 m/s.  Pass ``ut1_utc`` (IERS Bulletin A, seconds) to remove that error.
+"""
+
+from __future__ import annotations
+
+import math
+from datetime import datetime, timedelta, timezone
+
+#: Julian date of 2000-01-01T00:00:00 UTC.
+_JD_2000 = 2451544.5
+_EPOCH_2000 = datetime(2000, 1, 1, tzinfo=timezone.utc)
+#: Julian date of the J2000.0 epoch (2000-01-01T12:00).
+JD_J2000 = 2451545.0
+SECONDS_PER_DAY = 86400.0
+_TAU = 2.0 * math.pi
+
+
+def julian_date(when: datetime) -> tuple[float, float]:
+    """Split Julian date ``(jd, fraction)`` of ``when`` (naive datetimes are taken as UTC).
+
+    ``jd`` ends in .5 (the preceding midnight) and ``fraction`` is the day fraction since then,
+    so that microsecond resolution survives in double precision.
+    """
+    if when.tzinfo is None:
+        when = when.replace(tzinfo=timezone.utc)
+    delta = when - _EPOCH_2000
+    return _JD_2000 + delta.days, (delta.seconds + delta.microseconds * 1e-6) / SECONDS_PER_DAY
+
+
+def datetime_from_julian(jd: float, fraction: float = 0.0) -> datetime:
+    """Aware UTC datetime of a (split) Julian date, rounded to the microsecond."""
+    days = (jd - _JD_2000) + fraction
+    whole = math.floor(days)
+    micros = round((days - whole) * SECONDS_PER_DAY * 1e6)
+    return _EPOCH_2000 + timedelta(days=whole, microseconds=micros)
+
+
+def gmst1982(jd_ut1: float, fraction_ut1: float = 0.0) -> tuple[float, float]:
+    """Greenwich mean sidereal angle (radians, 0..2pi) and its rate (radians per UT1 day).
+
+    The IAU 1982 expression that defines SGP4's TEME frame (AIAA 2006-6753 appendix C), in the
+    same arithmetic as skyfield's ``theta_GMST1982`` so both agree to the last bit.
+    """
+    t = (jd_ut1 - JD_J2000 + fraction_ut1) / 36525.0
+    g = 67310.54841 + (8640184.812866 + (0.093104 + (-6.2e-6) * t) * t) * t
+    dg = 8640184.812866 + (0.093104 * 2.0 + (-6.2e-6 * 3.0) * t) * t
+    theta = (jd_ut1 % 1.0 + fraction_ut1 + g / SECONDS_PER_DAY % 1.0) % 1.0 * _TAU
+    theta_dot = (1.0 + dg / (SECONDS_PER_DAY * 36525.0)) * _TAU
+    return theta, theta_dot
