@@ -1,0 +1,150 @@
+"""The satellite catalog: element sets keyed by catalog number, with update semantics and DDE names.
+
+:meth:`Catalog.update` follows InstantTrack's UPDATE: a set replaces the stored one only when
+its epoch is newer; new satellites are added.  Each satellite has a unique DDE name
+(:mod:`nfwserver.tracking.dde_names`); user overrides win.  Thread-safe for concurrent readers and
+one writer: updates build new objects and swap them in.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass, field
+from datetime import datetime
+
+from nfwserver.tracking.dde_names import assign_dde_names, validate_dde_name
+from nfwserver.tracking.elements import ElementSet
+
+#: WGS72 constants used by SGP4: Earth radius (km) and gravitational parameter (km^3/s^2).
+_WGS72_RADIUS_KM = 6378.135
+_WGS72_MU = 398600.8
+
+
+@dataclass(frozen=True)
+class Satellite:
+    """A catalog entry: the current element set and the satellite's DDE name."""
+
+    elements: ElementSet
+    dde_name: str
+
+    @property
+    def catalog_number(self) -> int:
+        return self.elements.catalog_number
+
+    @property
+    def name(self) -> str:
+        return self.elements.name
+
+    @property
+    def satrec(self):
+        return self.elements.satrec
+
+    def age_days(self, at: datetime) -> float:
+        """Element age at ``at``: days since the epoch (negative before it)."""
+        return (at - self.elements.epoch).total_seconds() / 86400.0
+
+    @property
+    def perigee_height_km(self) -> float:
+        """Perigee height above the equatorial radius (km), from the mean motion (WGS72)."""
+        n = self.elements.mean_motion_rev_per_day * 2.0 * math.pi / 86400.0
+        a = (_WGS72_MU / (n * n)) ** (1.0 / 3.0)
+        return a * (1.0 - self.elements.eccentricity) - _WGS72_RADIUS_KM
+
+    @property
+    def is_decayed(self) -> bool:
+        """True when the mean perigee lies below the Earth's surface."""
+        return self.perigee_height_km < 0.0
+
+
+@dataclass(frozen=True)
+class UpdateSummary:
+    """Catalog numbers added, replaced (newer epoch), and left alone (not newer)."""
+
+    added: list[int] = field(default_factory=list)
+    updated: list[int] = field(default_factory=list)
+    not_newer: list[int] = field(default_factory=list)
+
+
+class Catalog:
+    """Satellites by catalog number."""
+
+    def __init__(self, sets: Iterable[ElementSet] = (), dde_names: dict[int, str] | None = None) -> None:
+        self._lock = threading.Lock()
+        self._elements: dict[int, ElementSet] = {}
+        self._overrides: dict[int, str] = {}
+        self._satellites: dict[int, Satellite] = {}
+        for catnr, name in (dde_names or {}).items():
+            self._overrides[int(catnr)] = validate_dde_name(name)
+        self.update(sets)
+
+    def update(self, sets: Iterable[ElementSet]) -> UpdateSummary:
+        """Merge ``sets``: add unknown satellites, replace a set only by a newer epoch."""
+        summary = UpdateSummary()
+        with self._lock:
+            elements = dict(self._elements)
+            for es in sets:
+                old = elements.get(es.catalog_number)
+                if old is None:
+                    summary.added.append(es.catalog_number)
+                elif es.epoch > old.epoch:
+                    summary.updated.append(es.catalog_number)
+                else:
+                    summary.not_newer.append(es.catalog_number)
+                    continue
+                elements[es.catalog_number] = es
+            self._rebuild(elements)
+        return summary
+
+    def _rebuild(self, elements: dict[int, ElementSet]) -> None:
+        names = assign_dde_names(
+            {k: v.name for k, v in elements.items()},
+            {k: v for k, v in self._overrides.items() if k in elements},
+        )
+        self._elements = elements
+        self._satellites = {k: Satellite(elements[k], names[k]) for k in sorted(elements)}
+
+    def set_dde_name(self, catalog_number: int, name: str) -> None:
+        """Override the DDE name of a satellite (may be set before its elements arrive).
+
+        Raises :class:`ValueError` for an unusable name or one held by another override.
+        """
+        validate_dde_name(name)
+        with self._lock:
+            for other, held in self._overrides.items():
+                if other != catalog_number and held.upper() == name.upper():
+                    raise ValueError(f"DDE name {name!r} is already given to satellite {other}")
+            self._overrides[catalog_number] = name
+            self._rebuild(self._elements)
+
+    def get(self, catalog_number: int) -> Satellite | None:
+        return self._satellites.get(catalog_number)
+
+    def __contains__(self, catalog_number: object) -> bool:
+        return catalog_number in self._satellites
+
+    def __len__(self) -> int:
+        return len(self._satellites)
+
+    def __iter__(self) -> Iterator[Satellite]:
+        return iter(list(self._satellites.values()))
+
+    def satellites(self) -> list[Satellite]:
+        """All satellites, ascending catalog number."""
+        return list(self._satellites.values())
+
+    def find(self, text: str) -> Satellite | None:
+        """A satellite by catalog number, DDE name or element name (case-insensitive)."""
+        text = text.strip()
+        if text.isdigit():
+            return self.get(int(text))
+        key = text.upper()
+        sats = self._satellites.values()
+        for sat in sats:
+            if sat.dde_name.upper() == key:
+                return sat
+        for sat in sats:
+            if sat.name.upper() == key:
+                return sat
+        return None
