@@ -6,11 +6,12 @@ element name.  Candidates, best first:
 
 1. an amateur designator in parentheses: ``SAUDISAT 1C (SO-50)`` -> ``SO-50``,
    ``JAS-2 (FO-29)`` -> ``FO-29``;
-2. the name before any parentheses, blanks turned into ``-``: ``ISS (ZARYA)`` -> ``ISS``,
+2. an amateur designator opening the name: ``RS-44 & BREEZE-KM R/B`` -> ``RS-44``;
+3. the name before any parentheses, blanks turned into ``-``: ``ISS (ZARYA)`` -> ``ISS``,
    ``NOAA 19`` -> ``NOAA-19``;
-3. that name joined with the parenthesised part: ``ISS (UNITY)`` -> ``ISS-UNITY``;
-4. the shortened name with the catalog number: ``STARLINK-1008`` style collisions ->
-   ``STARLI-44714``; and the bare catalog number for a set without a name.
+4. that name joined with the parenthesised part: ``ISS (UNITY)`` -> ``ISS-UNITY``;
+5. the shortened name with the catalog number (``STARLI-44723``), or the bare catalog number for
+   a set without a name.
 
 Characters outside ``A-Z a-z 0-9 - _ . + /`` are dropped and every candidate is cut to 12
 characters.  Within a catalog, names are unique: satellites are taken in ascending catalog
@@ -30,10 +31,18 @@ _PAREN = re.compile(r"\(([^)]*)\)")
 
 
 def sanitize(text: str) -> str:
-    """``text`` with blanks as ``-``, other unusable characters dropped, cut to 12 characters."""
+    """``text`` with blanks as ``-``, other unusable characters dropped, at most 12 characters.
+
+    A long name that ends in a number keeps the number whole and shortens what precedes it
+    (``STARLINK-1008`` -> ``STARLIN-1008``); other long names are cut.
+    """
     text = re.sub(r"\s+", "-", text.strip())
     text = _ALLOWED.sub("", text)
     text = re.sub(r"-{2,}", "-", text).strip("-")
+    if len(text) > MAX_LENGTH:
+        head, sep, tail = text.rpartition("-")
+        if sep and head and any(c.isdigit() for c in tail) and len(tail) <= MAX_LENGTH - 4:
+            return head[: MAX_LENGTH - len(tail) - 1].rstrip("-") + "-" + tail
     return text[:MAX_LENGTH].rstrip("-")
 
 
@@ -57,6 +66,9 @@ def name_candidates(element_name: str, catalog_number: int) -> list[str]:
     for part in inner:
         if _AMATEUR.match(part.upper()):
             out.append(sanitize(part))
+    first_word = re.split(r"[\s&/]+", main, maxsplit=1)[0] if main else ""
+    if first_word != main and _AMATEUR.match(first_word.upper()):
+        out.append(sanitize(first_word))
     if main:
         out.append(sanitize(main))
         if inner:

@@ -234,8 +234,8 @@ def format_tle(f: TleFields) -> tuple[str, str]:
     day_text = f"{day:012.8f}"
     if day_text.startswith("367") or float(day_text) >= 367.0:
         raise TleError("epoch day does not fit the TLE field")
-    ndot = f"{f.mean_motion_dot:.8f}"
-    ndot = ("-" if f.mean_motion_dot < 0 else " ") + ndot.lstrip("-").lstrip("0")
+    ndot_value = round(f.mean_motion_dot, 8) + 0.0  # + 0.0 turns -0.0 into 0.0
+    ndot = ("-" if ndot_value < 0 else " ") + f"{abs(ndot_value):.8f}".lstrip("0")
     if len(ndot) > 10:
         raise TleError(f"first derivative of mean motion {f.mean_motion_dot} does not fit the TLE field")
     cat = encode_catalog_number(f.catalog_number)

@@ -1,0 +1,86 @@
+"""Catalog update semantics, element age, decay detection and DDE names."""
+
+from __future__ import annotations
+
+import dataclasses
+from datetime import datetime, timedelta, timezone
+
+import pytest
+
+from nfwserver.tracking.catalog import Catalog
+from nfwserver.tracking.elements import ElementSet, load_element_file, load_elements
+from nfwserver.tracking.tle import parse_tle
+from tests.conftest import DATA
+
+VISUAL = load_element_file(DATA / "visual.txt").sets
+
+
+def _shifted(es: ElementSet, days: float) -> ElementSet:
+    fields = parse_tle(es.line1, es.line2)
+    fields = dataclasses.replace(fields, epoch=fields.epoch + timedelta(days=days))
+    return ElementSet.from_fields(es.name, fields, "shifted")
+
+
+def test_update_replaces_only_with_newer_epochs() -> None:
+    cat = Catalog(VISUAL[:10])
+    first = VISUAL[0]
+    older, newer = _shifted(first, -1.0), _shifted(first, +0.5)
+    summary = cat.update([older, VISUAL[10]])
+    assert summary.added == [VISUAL[10].catalog_number]
+    assert summary.not_newer == [first.catalog_number]
+    assert cat.get(first.catalog_number).elements.epoch == first.epoch
+    summary = cat.update([newer, first])
+    assert summary.updated == [first.catalog_number]
+    assert summary.not_newer == [first.catalog_number]  # the same epoch again is not newer
+    assert cat.get(first.catalog_number).elements.epoch == newer.epoch
+    assert len(cat) == 11 and first.catalog_number in cat
+
+
+def test_age_and_decay() -> None:
+    cat = Catalog(VISUAL)
+    sat = cat.get(VISUAL[0].catalog_number)
+    assert sat.age_days(sat.elements.epoch + timedelta(days=3, hours=6)) == pytest.approx(3.25)
+    assert not any(s.is_decayed for s in cat)
+    decayed_line2 = "2 99999  51.6000 100.0000 0300000 100.0000 100.0000 16.90000000    10"
+    from nfwserver.tracking.tle import tle_checksum
+
+    line1 = "1 99999U 26001A   26127.50000000  .00000000  00000+0  00000+0 0  999"
+    text = f"{line1}{tle_checksum(line1)}\n{decayed_line2[:68]}{tle_checksum(decayed_line2)}\n"
+    (es,) = load_elements(text).sets
+    low = Catalog([es]).get(99999)
+    assert low.perigee_height_km < 0 and low.is_decayed
+
+
+def test_dde_names_are_unique_valid_and_overridable() -> None:
+    cat = Catalog(load_element_file(DATA / "active.txt").sets)
+    names = [s.dde_name for s in cat]
+    assert len({n.upper() for n in names}) == len(names) == 15347
+    assert all(0 < len(n) <= 12 and " " not in n and n.isascii() and n.isprintable() for n in names)
+    assert cat.get(25544).dde_name == "ISS"
+    assert cat.find("so-50").name == "SAUDISAT 1C (SO-50)"
+    assert cat.find("25544").dde_name == "ISS"
+    assert cat.find("iss (zarya)").catalog_number == 25544
+    assert cat.find("no such satellite") is None
+    cat.set_dde_name(25544, "ISS-ARISS")
+    assert cat.get(25544).dde_name == "ISS-ARISS"
+    assert cat.find("ISS-ARISS").catalog_number == 25544
+    with pytest.raises(ValueError):
+        cat.set_dde_name(25544, "TWO WORDS")
+    with pytest.raises(ValueError):
+        cat.set_dde_name(27607, "ISS-ARISS")  # held by another override
+    with pytest.raises(ValueError):
+        cat.set_dde_name(27607, "THIRTEEN-CHAR")
+
+
+def test_names_do_not_depend_on_load_order() -> None:
+    sets = load_element_file(DATA / "active.txt").sets[:3000]
+    a = {s.catalog_number: s.dde_name for s in Catalog(sets)}
+    b = {s.catalog_number: s.dde_name for s in Catalog(list(reversed(sets)))}
+    half = Catalog(sets[:1500])
+    half.update(sets[1500:])
+    assert a == b == {s.catalog_number: s.dde_name for s in half}
+
+
+def test_epoch_is_utc() -> None:
+    assert all(s.epoch.tzinfo == timezone.utc for s in VISUAL)
+    assert min(s.epoch for s in VISUAL) > datetime(2026, 4, 1, tzinfo=timezone.utc)
