@@ -78,6 +78,16 @@ class HorizonTable:
             return np.full_like(az, self._el[0])
         return np.interp(az % 360.0, self._np_az, self._np_el, period=360.0)
 
+    def slope_array(self, azimuth_deg: np.ndarray) -> np.ndarray:
+        """d(minimum elevation)/d(azimuth) (deg/deg) at each azimuth; 0 for a flat table."""
+        az = np.asarray(azimuth_deg, dtype=float)
+        if len(self._az) < 2:
+            return np.zeros_like(az)
+        ext_az = np.array(self._ext_az)
+        slopes = np.diff(self._ext_el) / np.diff(ext_az)
+        idx = np.clip(np.searchsorted(ext_az, az % 360.0, side="right") - 1, 0, len(slopes) - 1)
+        return slopes[idx]
+
     def is_above(self, azimuth_deg: float, elevation_deg: float) -> bool:
         """True when ``elevation_deg`` is above the table's minimum at ``azimuth_deg``."""
         return elevation_deg > self.min_elevation(azimuth_deg)

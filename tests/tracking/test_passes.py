@@ -1,0 +1,133 @@
+"""Pass prediction against skyfield's find_events and against a dense brute-force search."""
+
+from __future__ import annotations
+
+from datetime import datetime, timedelta, timezone
+
+import numpy as np
+import pytest
+
+from nfwserver.tracking.elements import load_element_file
+from nfwserver.tracking.horizon import HorizonTable
+from nfwserver.tracking.look_angles import LookAngleCalculator, look_angles_array
+from nfwserver.tracking.observer import Observer
+from nfwserver.tracking.passes import find_passes
+from nfwserver.tracking.timescale import julian_date
+from tests.conftest import DATA
+from tests.tracking.skyfield_oracle import TS, skyfield_satellite, skyfield_topos
+
+START = datetime(2026, 5, 8, tzinfo=timezone.utc)
+END = START + timedelta(hours=24)
+VISUAL = load_element_file(DATA / "visual.txt").sets
+ACTIVE = {s.catalog_number: s for s in load_element_file(DATA / "active.txt").sets}
+OBSERVERS = [Observer(52.2, 0.12, 20.0), Observer(-33.87, 151.21, 40.0), Observer(78.22, 15.63, 10.0)]
+
+
+def _our_events(passes, catnr):
+    events = []
+    for p in passes:
+        if p.catalog_number != catnr:
+            continue
+        if p.aos is not None and START <= p.aos <= END:
+            events.append((0, p.aos))
+        if START <= p.tca <= END:
+            events.append((1, p.tca))
+        if p.los is not None and START <= p.los <= END:
+            events.append((2, p.los))
+    return events
+
+
+@pytest.mark.parametrize("observer", OBSERVERS, ids=["north", "south", "polar"])
+def test_same_events_as_skyfield_with_a_flat_horizon(observer: Observer) -> None:
+    sats = VISUAL[:25] + [ACTIVE[25544], ACTIVE[27607]]
+    passes = find_passes(sats, observer, START, END)
+    topos = skyfield_topos(observer)
+    total = 0
+    for es in sats:
+        t, kinds = skyfield_satellite(es).find_events(topos, TS.from_datetime(START), TS.from_datetime(END), 0.0)
+        ref = [(int(k), x.utc_datetime()) for k, x in zip(kinds, t)]
+        ours = _our_events(passes, es.catalog_number)
+        assert [k for k, _ in ours] == [k for k, _ in ref], es.name
+        for (_, a), (_, b) in zip(ours, ref):
+            assert abs((a - b).total_seconds()) < 0.5, es.name
+        total += len(ref)
+    assert total > 300
+
+
+def test_in_progress_pass_gets_its_true_aos_before_the_window() -> None:
+    observer = OBSERVERS[0]
+    iss = ACTIVE[25544]
+    full = find_passes([iss], observer, START, END)
+    p = full[3]
+    mid = p.aos + (p.los - p.aos) / 2
+    cut = find_passes([iss], observer, mid, mid + timedelta(hours=1))
+    first = cut[0]
+    assert first.aos_before_start and not first.los_after_end
+    assert abs((first.aos - p.aos).total_seconds()) < 0.01
+    assert abs((first.los - p.los).total_seconds()) < 0.01
+    tail = find_passes([iss], observer, mid - timedelta(hours=1), mid)
+    assert tail[-1].los_after_end and abs((tail[-1].los - p.los).total_seconds()) < 0.01
+
+
+def test_geostationary_objects_give_no_bogus_events() -> None:
+    geo = [s for s in ACTIVE.values() if abs(s.mean_motion_rev_per_day - 1.0027) < 0.0005 and s.eccentricity < 5e-4]
+    observer = OBSERVERS[0]
+    calc = LookAngleCalculator(observer)
+    passes = find_passes(geo[:40], observer, START, END)
+    for p in passes:  # whatever is reported must be a real crossing
+        for when in (p.aos, p.los):
+            if when is not None:
+                before = calc.compute(ACTIVE[p.catalog_number].satrec, when - timedelta(seconds=1)).elevation_deg
+                after = calc.compute(ACTIVE[p.catalog_number].satrec, when + timedelta(seconds=1)).elevation_deg
+                assert before * after < 0
+    up = [s for s in geo[:40] if calc.compute(s.satrec, START).elevation_deg > 1.0]
+    assert up and not any(p.catalog_number == up[0].catalog_number for p in passes)
+
+
+def _brute_force(es, observer, horizon, step_s=0.5):
+    t = np.arange(0.0, (END - START).total_seconds() + step_s, step_s)
+    jd, fr = julian_date(START)
+    la = look_angles_array([es.satrec], observer, np.full(t.shape, jd), fr + t / 86400.0)
+    f = la.elevation_deg[0] - horizon.min_elevation_array(la.azimuth_deg[0])
+    up = f > 0
+    idx = np.flatnonzero(up[1:] != up[:-1])
+    # Linear interpolation between the dense samples.
+    times = t[idx] + f[idx] / (f[idx] - f[idx + 1]) * step_s
+    return [(bool(up[i + 1]), START + timedelta(seconds=float(x))) for i, x in zip(idx, times)]
+
+
+def test_non_flat_horizon_matches_a_dense_brute_force_search() -> None:
+    horizon = HorizonTable([(0, 5), (45, 12), (90, 2), (135, 20), (180, 8), (225, 0), (270, 15), (315, 3)])
+    observer = OBSERVERS[0]
+    sats = VISUAL[:30] + [ACTIVE[25544]]
+    passes = find_passes(sats, observer, START, END, horizon=horizon)
+    checked = 0
+    for es in sats:
+        ref = _brute_force(es, observer, horizon)
+        ours = []
+        for p in (q for q in passes if q.catalog_number == es.catalog_number):
+            if p.aos is not None and START < p.aos < END:
+                ours.append((True, p.aos))
+            if p.los is not None and START < p.los < END:
+                ours.append((False, p.los))
+        assert [k for k, _ in ours] == [k for k, _ in ref], es.name
+        for (_, a), (_, b) in zip(ours, ref):
+            assert abs((a - b).total_seconds()) < 0.1, es.name
+        checked += len(ref)
+    assert checked > 100
+    for p in passes:
+        assert p.max_elevation_deg > horizon.minimum
+
+
+def test_short_pass_between_grid_points_is_found() -> None:
+    # Choose the lowest ISS pass of the day and place a flat horizon just under its maximum, so
+    # the remaining pass lasts only seconds.
+    observer = OBSERVERS[0]
+    iss = ACTIVE[25544]
+    low = min(find_passes([iss], observer, START, END), key=lambda p: p.max_elevation_deg)
+    horizon = HorizonTable([(0, low.max_elevation_deg - 0.01)])
+    short = [p for p in find_passes([iss], observer, START, END, horizon=horizon)
+             if abs((p.tca - low.tca).total_seconds()) < 60]
+    assert len(short) == 1
+    assert 0 < short[0].duration_s < 30
+    assert short[0].aos < short[0].tca < short[0].los
