@@ -311,7 +311,7 @@ def find_passes(
     end: datetime,
     horizon: HorizonTable | None = None,
     ut1_utc: float = 0.0,
-    fine_step_s: float = 30.0,
+    fine_step_s: float = 60.0,
 ) -> list[Pass]:
     """Passes of ``satellites`` (``sgp4`` Satrecs, or objects with a ``.satrec``) between ``start`` and ``end``.
 
