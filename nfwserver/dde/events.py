@@ -1,0 +1,86 @@
+"""The event stream: every string that goes in or out of the server, with time and conversation.
+
+Nova showed incoming (F3) and outgoing (F1) strings for diagnosis; the console shows these events.
+The log is bounded (a ring of ``capacity`` events) and fans each event out to subscribers;
+a subscriber that raises is logged and dropped from that one delivery, never breaking the server.
+Texts are stored as received; :func:`nfwserver.dde.protocol.escape_for_log` renders them safely.
+"""
+
+from __future__ import annotations
+
+import enum
+import itertools
+import logging
+import threading
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from datetime import datetime
+
+log = logging.getLogger(__name__)
+
+
+class Direction(enum.Enum):
+    IN = "in"  #: from a client (poke, execute, request, advise start/stop, connect)
+    OUT = "out"  #: to clients (published string, request reply)
+    INFO = "info"  #: server-side notes (satellite changed, errors)
+
+
+@dataclass(frozen=True)
+class Event:
+    """One line of the diagnostic stream."""
+
+    seq: int
+    time: datetime  #: aware UTC, from the server's clock
+    direction: Direction
+    kind: str  #: "poke", "request", "advise", "publish", "connect", "disconnect", "execute", "note"
+    text: str  #: the string itself (untrusted for IN events)
+    conversation: int | None = None
+    client: str = ""  #: who: "conv 3 on NFW32/NFW_DATA", "console", ...
+    accepted: bool | None = None  #: for pokes/executes: acknowledged or refused
+    detail: str = ""  #: e.g. the refusal reason, or the number of advise loops served
+
+
+class EventLog:
+    """Bounded, thread-safe event stream with subscribers."""
+
+    def __init__(self, capacity: int = 5000) -> None:
+        self._events: deque[Event] = deque(maxlen=capacity)
+        self._subscribers: list[Callable[[Event], None]] = []
+        self._lock = threading.Lock()
+        self._seq = itertools.count(1)
+
+    def add(self, time: datetime, direction: Direction, kind: str, text: str, **fields: object) -> Event:
+        event = Event(next(self._seq), time, direction, kind, text, **fields)  # type: ignore[arg-type]
+        with self._lock:
+            self._events.append(event)
+            subscribers = list(self._subscribers)
+        for callback in subscribers:
+            try:
+                callback(event)
+            except Exception:  # a broken subscriber must not break the server
+                log.exception("event subscriber %r failed", callback)
+        return event
+
+    def subscribe(self, callback: Callable[[Event], None]) -> Callable[[], None]:
+        """Call ``callback(event)`` for every new event; returns a function that unsubscribes."""
+        with self._lock:
+            self._subscribers.append(callback)
+
+        def unsubscribe() -> None:
+            with self._lock:
+                if callback in self._subscribers:
+                    self._subscribers.remove(callback)
+
+        return unsubscribe
+
+    def recent(self, count: int | None = None, direction: Direction | None = None) -> list[Event]:
+        """The latest events, oldest first (optionally only one direction)."""
+        with self._lock:
+            events = list(self._events)
+        if direction is not None:
+            events = [e for e in events if e.direction is direction]
+        return events if count is None else events[-count:]
+
+    def __len__(self) -> int:
+        return len(self._events)
