@@ -8,6 +8,7 @@ computed for.  Pokes can be scheduled: ``--poke 120:SAT=25544`` is sent by that 
 from __future__ import annotations
 
 import argparse
+import logging
 import sys
 
 from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs, parse_time
@@ -63,6 +64,8 @@ def run(args: argparse.Namespace) -> int:
     elif not server.select_satellite(args.sat, source="simulate"):
         print(f"nfwserver: satellite {args.sat} is not in the element files; nothing is published",
               file=sys.stderr)
+    # Refusals are reported below with their time; keep the server's own warning out of the way.
+    logging.getLogger("nfwserver.dde.server").setLevel(logging.ERROR)
     system = FakeDdeSystem(received_capacity=16)
     server.attach(system.server_transport())
     client = system.connect("NFW32", "NFW_DATA", client_name="simulate")
@@ -88,7 +91,10 @@ def run(args: argparse.Namespace) -> int:
             try:
                 client.poke("NFW_SERVER", command)
             except DdeError:
-                pass  # the server logs the refusal and its reason
+                refusal = server.events.recent(1)
+                reason = refusal[0].detail if refusal else "refused"
+                print(f"nfwserver: poke {command!r} at {format_time(clock.now())} refused: {reason}",
+                      file=sys.stderr)
 
     try:
         run_virtual(server, clock, args.duration, before_tick=before_tick)

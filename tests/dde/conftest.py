@@ -1,0 +1,51 @@
+"""A Nova server on the fake DDE transport under a virtual clock, near a real ISS pass."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from datetime import datetime, timedelta, timezone
+
+import pytest
+
+from nfwserver.clock import VirtualClock
+from nfwserver.dde.publisher import run_virtual
+from nfwserver.dde.server import NovaServer
+from nfwserver.fake_dde import FakeDdeSystem
+from nfwserver.tracking.catalog import Catalog
+from nfwserver.tracking.elements import load_element_file
+from nfwserver.tracking.horizon import HorizonTable
+from nfwserver.tracking.observer import Observer
+from nfwserver.tracking.passes import find_passes
+from tests.conftest import DATA
+
+ISS = 25544
+OBSERVER = Observer(52.2053, 0.1218, 20.0)
+CATALOG = Catalog(load_element_file(DATA / "visual.txt").sets)
+DAY = datetime(2026, 5, 8, tzinfo=timezone.utc)
+ISS_PASS = max(find_passes([CATALOG.get(ISS)], OBSERVER, DAY, DAY + timedelta(days=1)),
+               key=lambda p: p.max_elevation_deg)
+
+
+@dataclass
+class Station:
+    server: NovaServer
+    system: FakeDdeSystem
+    clock: VirtualClock
+
+    def run(self, seconds: float, before_tick=None) -> int:
+        return run_virtual(self.server, self.clock, seconds, before_tick)
+
+
+def make_station(start: datetime | None = None, rate_hz: float = 5.0, horizon: HorizonTable | None = None,
+                 satellite: int | None = ISS, ut1_utc: float = 0.0) -> Station:
+    clock = VirtualClock(start or ISS_PASS.aos - timedelta(seconds=60))
+    server = NovaServer(CATALOG, OBSERVER, clock, horizon=horizon, rate_hz=rate_hz, satellite=satellite,
+                        ut1_utc=ut1_utc)
+    system = FakeDdeSystem()
+    server.attach(system.server_transport())
+    return Station(server, system, clock)
+
+
+@pytest.fixture
+def station() -> Station:
+    return make_station()

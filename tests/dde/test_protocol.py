@@ -1,0 +1,94 @@
+"""Formatting of the Nova string and the poke grammar."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from nfwserver.dde.protocol import (
+    Poke,
+    PokeError,
+    PokeKind,
+    escape_for_log,
+    format_azimuth,
+    format_elevation,
+    format_nova,
+    format_range_rate,
+    parse_poke,
+)
+
+NOVA = re.compile(r"^\S{1,12} AZ:\d{1,3}\.\d EL:-?\d{1,2}\.\d RR:-?\d+\.\d{10} AH:[YN]$")
+
+
+def test_the_spec_sample() -> None:
+    assert format_nova("Mir", 116.4, -21.0, -1.4396996895, False) == "Mir AZ:116.4 EL:-21.0 RR:-1.4396996895 AH:N"
+
+
+@pytest.mark.parametrize(
+    ("az", "text"),
+    [(0.0, "0.0"), (359.94, "359.9"), (359.96, "0.0"), (359.999, "0.0"), (360.0, "0.0"), (12.35, "12.3")],
+)
+def test_azimuth_wraps_and_never_prints_360(az: float, text: str) -> None:
+    assert format_azimuth(az) == text
+
+
+def test_no_negative_zero() -> None:
+    assert format_elevation(-0.04) == "0.0"
+    assert format_elevation(-0.05001) == "-0.1"
+    assert format_range_rate(-1e-12) == "0.0000000000"
+    assert format_range_rate(-1e-10) == "-0.0000000001"
+
+
+def test_names_are_cut_and_blank_free() -> None:
+    assert format_nova("A VERY LONG NAME INDEED", 1, 2, 3, True).split()[0] == "AVERYLONGNAM"
+
+
+@given(st.text(max_size=20), st.floats(0, 360), st.floats(-90, 90), st.floats(-12, 12), st.booleans())
+def test_every_string_matches_the_grammar(name, az, el, rr, ah) -> None:
+    assert NOVA.match(format_nova(name, az, el, rr, ah))
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ("TUNE ON", [Poke(PokeKind.TUNE, True)]),
+        ("TUNE OFF\x00", [Poke(PokeKind.TUNE, False)]),
+        ("track on\r\n", [Poke(PokeKind.TRACK, True)]),
+        ("  TRACK   OFF  ", [Poke(PokeKind.TRACK, False)]),
+        ("SAT=25544", [Poke(PokeKind.SAT, 25544)]),
+        ("SAT = 7530\x00\x00", [Poke(PokeKind.SAT, 7530)]),
+        ("ANTAZ=123.45", [Poke(PokeKind.ANTAZ, 123.45)]),
+        ("ANTEL=-0", [Poke(PokeKind.ANTEL, 0.0)]),
+        ("TUNE ON\r\nSAT=25544\r\n", [Poke(PokeKind.TUNE, True), Poke(PokeKind.SAT, 25544)]),
+    ],
+)
+def test_pokes(text: str, expected: list[Poke]) -> None:
+    assert parse_poke(text) == expected
+
+
+@pytest.mark.parametrize(
+    "text",
+    ["", "\x00", "TUNE", "TUNE MAYBE", "SAT=", "SAT=ISS", "SAT=-5", "SAT=1234567", "ANTAZ=nan", "ANTAZ=1e309",
+     "ANTAZ=inf", "ANTEL=95x", "ANTEL=200", "ANTAZ=800", "HELLO", "X" * 5000, "TUNE ON\r\nBOGUS"],
+)
+def test_bad_pokes_are_refused_with_a_reason(text: str) -> None:
+    with pytest.raises(PokeError) as info:
+        parse_poke(text)
+    assert len(str(info.value)) > 5
+
+
+@given(st.text(max_size=300))
+def test_any_text_either_parses_or_raises_poke_error(text: str) -> None:
+    try:
+        pokes = parse_poke(text)
+    except PokeError:
+        return
+    assert pokes and all(isinstance(p, Poke) for p in pokes)
+
+
+def test_log_escaping_keeps_one_line() -> None:
+    assert escape_for_log("SAT=1\r\nINFO forged line") == "SAT=1\\r\\nINFO forged line"
+    assert "\n" not in escape_for_log("a\nb" * 100)
