@@ -18,6 +18,7 @@ from nfwserver import __version__
 
 #: Command modules, in the order their commands appear in ``--help``.
 COMMAND_MODULES: tuple[str, ...] = (
+    "tracking_commands",
     "simulate_command",
 )
 
