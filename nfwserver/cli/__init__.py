@@ -18,8 +18,10 @@ from nfwserver import __version__
 
 #: Command modules, in the order their commands appear in ``--help``.
 COMMAND_MODULES: tuple[str, ...] = (
-    "tracking_commands",
+    "run_command",
     "simulate_command",
+    "tracking_commands",
+    "config_command",
 )
 
 

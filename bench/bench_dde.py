@@ -1,0 +1,80 @@
+"""DDE server speed: the cost of one tick, and the real-time publish loop's timing error."""
+
+from __future__ import annotations
+
+import statistics
+import time
+from datetime import datetime, timedelta, timezone
+from pathlib import Path
+
+import numpy as np
+
+from nfwserver.clock import SystemClock, VirtualClock
+from nfwserver.dde.publisher import Publisher
+from nfwserver.dde.server import NovaServer
+from nfwserver.fake_dde import FakeDdeSystem
+from nfwserver.tracking.catalog import Catalog
+from nfwserver.tracking.elements import load_element_file
+from nfwserver.tracking.observer import Observer
+
+ROOT = Path(__file__).resolve().parent.parent
+CATALOG = Catalog(load_element_file(ROOT / "tests" / "data" / "visual.txt").sets)
+OBS = Observer(52.2, 0.12, 20.0)
+START = datetime(2026, 5, 8, tzinfo=timezone.utc)
+
+
+def tick_cost_us(clients: int, ticks: int = 3000) -> float:
+    clock = VirtualClock(START)
+    server = NovaServer(CATALOG, OBS, clock, satellite=25544, rate_hz=10)
+    system = FakeDdeSystem(received_capacity=4)
+    server.attach(system.server_transport())
+    for _ in range(clients):
+        system.connect("NFW32", "NFW_DATA").start_advise("NFW_SERVER")
+    server.set_tune(True)
+    times = []
+    step = timedelta(milliseconds=100)
+    when = START
+    for _ in range(ticks):
+        when += step
+        t = time.perf_counter()
+        server.tick(when)
+        times.append(time.perf_counter() - t)
+    return statistics.median(times) * 1e6
+
+
+def loop_error_ms(rate: float, seconds: float) -> tuple[float, float, float, int]:
+    server = NovaServer(CATALOG, OBS, SystemClock(), satellite=25544, rate_hz=rate)
+    system = FakeDdeSystem(received_capacity=4)
+    server.attach(system.server_transport())
+    for _ in range(10):
+        system.connect("NFW32", "NFW_DATA").start_advise("NFW_SERVER")
+    server.set_tune(True)
+    publisher = Publisher(server, SystemClock())
+    publisher.start()
+    time.sleep(seconds)
+    publisher.stop()
+    late = np.array(publisher.stats.lateness_s) * 1e3
+    return float(np.percentile(late, 50)), float(np.percentile(late, 99)), float(late.max()), publisher.stats.ticks
+
+
+def main() -> None:
+    print("## DDE server\n")
+    print("Tick = compute look angles, format the Nova string, post it to every hot advise loop on the fake "
+          "transport, record the event, call listeners. Median over 3,000 ticks.\n")
+    print("| advise clients | tick cost | goal |")
+    print("|---|---|---|")
+    for n in (1, 10, 100):
+        goal = "<= 50 us" if n == 10 else ""
+        print(f"| {n} | {tick_cost_us(n):.1f} us | {goal} |")
+    print()
+    print("Real-time publish loop (SystemClock, 10 hot clients), lateness of each tick against its schedule:\n")
+    print("| rate | duration | ticks | p50 | p99 | max | goal |")
+    print("|---|---|---|---|---|---|---|")
+    for rate in (10.0, 50.0):
+        p50, p99, worst, ticks = loop_error_ms(rate, 60.0)
+        print(f"| {rate:.0f} Hz | 60 s | {ticks} | {p50:.3f} ms | {p99:.3f} ms | {worst:.3f} ms | p99 <= 2 ms |")
+    print()
+
+
+if __name__ == "__main__":
+    main()

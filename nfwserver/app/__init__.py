@@ -1,0 +1,1 @@
+"""Assembly of the running product from a validated configuration."""

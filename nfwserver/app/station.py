@@ -1,0 +1,110 @@
+"""The running station: catalog, server core, transport, publisher and element refresh, from a Config."""
+
+from __future__ import annotations
+
+import logging
+import sys
+import threading
+
+from nfwserver.app.element_sources import FetchResult, fetch_all
+from nfwserver.clock import Clock
+from nfwserver.config.schema import Config
+from nfwserver.dde.publisher import Publisher
+from nfwserver.dde.server import NovaServer
+from nfwserver.dde.transport import DdeServerTransport
+from nfwserver.fake_dde import FakeDdeSystem
+from nfwserver.tracking.catalog import Catalog, UpdateSummary
+
+log = logging.getLogger(__name__)
+
+
+def default_transport() -> tuple[DdeServerTransport, str]:
+    """The platform's DDE transport and a sentence describing it.
+
+    Windows gets real DDE once the DDEML transport is available; everywhere else (and until then)
+    the in-process fake DDE transport serves, which local tools and the console can use.
+    """
+    if sys.platform == "win32":
+        try:
+            from nfwserver.dde.windows_transport import WindowsDdeTransport  # type: ignore[import-not-found]
+
+            return WindowsDdeTransport(), "serving real DDE (DDEML)"
+        except ImportError:
+            pass
+    return (FakeDdeSystem().server_transport(),
+            "no Windows DDE here: serving on the in-process fake DDE transport (console and local tools)")
+
+
+class Station:
+    """Everything ``nfwserver run`` starts; :meth:`start` and :meth:`stop` are idempotent."""
+
+    def __init__(self, config: Config, clock: Clock, transport: DdeServerTransport | None = None) -> None:
+        self.config = config
+        self.clock = clock
+        fetched = fetch_all(config.elements.files, config.elements.urls, config.elements.use_bundled)
+        self._report(fetched)
+        self.catalog = Catalog(fetched.sets, dde_names=config.dde_names)
+        if not len(self.catalog):
+            log.warning("no element sets loaded: nothing can be tracked until some are added")
+        srv = config.server
+        self.server = NovaServer(
+            self.catalog, config.observer, clock, horizon=config.horizon, ut1_utc=srv.ut1_utc_s,
+            rate_hz=srv.rate_hz, services=srv.services, topic=srv.topic, items=srv.items,
+        )
+        if srv.satellite is not None and not self.server.select_satellite(srv.satellite, source="config"):
+            log.warning("configured satellite %s is not in the loaded elements", srv.satellite)
+        if transport is None:
+            transport, self.transport_note = default_transport()
+        else:
+            self.transport_note = "serving on the given transport"
+        self.transport = transport
+        self.publisher = Publisher(self.server, clock)
+        self._stop = threading.Event()
+        self._refresher: threading.Thread | None = None
+        self._started = False
+
+    @staticmethod
+    def _report(fetched: FetchResult) -> None:
+        for problem in fetched.failed:
+            log.warning("element source unavailable: %s", problem)
+        for rejection in fetched.rejected:
+            log.info("element set skipped: %s", rejection)
+
+    def refresh_elements(self) -> UpdateSummary:
+        """Read every element source again; newer epochs replace older ones."""
+        cfg = self.config.elements
+        fetched = fetch_all(cfg.files, cfg.urls, cfg.use_bundled)
+        self._report(fetched)
+        summary = self.catalog.update(fetched.sets)
+        log.info("elements refreshed: %d added, %d updated", len(summary.added), len(summary.updated))
+        return summary
+
+    def _refresh_loop(self) -> None:
+        period = self.config.elements.refresh_hours * 3600.0
+        while not self._stop.wait(period):
+            try:
+                self.refresh_elements()
+            except Exception:  # never let a refresh take the station down
+                log.exception("element refresh failed")
+
+    def start(self) -> None:
+        if self._started:
+            return
+        self._started = True
+        self.server.attach(self.transport)
+        self.publisher.start()
+        if self.config.elements.refresh_hours > 0 and (self.config.elements.files or self.config.elements.urls):
+            self._refresher = threading.Thread(target=self._refresh_loop, name="nfw-elements", daemon=True)
+            self._refresher.start()
+
+    def stop(self) -> None:
+        if not self._started:
+            return
+        self._started = False
+        self._stop.set()
+        self.publisher.stop()
+        self.server.detach()
+        try:
+            self.transport.close()
+        except Exception:
+            log.exception("closing the transport failed")

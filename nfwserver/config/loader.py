@@ -1,0 +1,227 @@
+"""Reading and validating the TOML configuration.
+
+Every problem names the exact key and the reason (``[server] rate_hz: 80 is outside 1..50``), and
+a file with any problem is refused whole: the server never starts half-configured.  Unknown keys
+are errors too (a typo would otherwise be silently ignored).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+from nfwserver.config.schema import Config, ElementsConfig, ServerConfig
+from nfwserver.tracking.dde_names import validate_dde_name
+from nfwserver.tracking.horizon import HorizonTable, load_horizon
+from nfwserver.tracking.observer import Observer, parse_observer
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+APP_NAME = "nfwserver"
+
+
+class ConfigError(ValueError):
+    """The configuration cannot be used; ``problems`` lists each one as 'key: reason'."""
+
+    def __init__(self, source: str, problems: list[str]) -> None:
+        self.source = source
+        self.problems = problems
+        super().__init__(f"{source}: " + "; ".join(problems))
+
+
+def default_config_path() -> Path:
+    """``config.toml`` in the platform's user configuration directory."""
+    from platformdirs import user_config_dir
+
+    return Path(user_config_dir(APP_NAME, appauthor=False)) / "config.toml"
+
+
+class _Checker:
+    def __init__(self, source: str) -> None:
+        self.source = source
+        self.problems: list[str] = []
+
+    def table(self, doc: dict, name: str, allowed: set[str]) -> dict:
+        value = doc.get(name, {})
+        if not isinstance(value, dict):
+            self.problems.append(f"[{name}]: must be a table")
+            return {}
+        for key in value:
+            if key not in allowed:
+                self.problems.append(f"[{name}] {key}: unknown key (allowed: {', '.join(sorted(allowed))})")
+        return value
+
+    def number(self, section: str, key: str, value: Any, lo: float, hi: float) -> float | None:
+        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+            self.problems.append(f"[{section}] {key}: must be a number")
+            return None
+        if not lo <= value <= hi:
+            self.problems.append(f"[{section}] {key}: {value} is outside {lo:g}..{hi:g}")
+            return None
+        return float(value)
+
+    def strings(self, section: str, key: str, value: Any) -> tuple[str, ...] | None:
+        if not isinstance(value, list) or not all(isinstance(v, str) and v for v in value):
+            self.problems.append(f"[{section}] {key}: must be a list of non-empty strings")
+            return None
+        return tuple(value)
+
+
+def parse_config(text: str, source: str = "<config>", base_dir: Path | None = None) -> Config:
+    """Validate TOML text; raises :class:`ConfigError` listing every problem."""
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(source, [f"not valid TOML ({exc})"]) from None
+    c = _Checker(source)
+    for key in doc:
+        if key not in {"observer", "horizon", "elements", "server", "satellites"}:
+            c.problems.append(f"[{key}]: unknown section")
+    base = base_dir or Path(".")
+
+    # [observer]
+    obs_t = c.table(doc, "observer", {"location", "latitude_deg", "longitude_deg", "altitude_m"})
+    observer: Observer | None = None
+    if "location" in obs_t:
+        if not isinstance(obs_t["location"], str):
+            c.problems.append("[observer] location: must be a string such as \"JO02ae\" or \"52.2,0.12,20\"")
+        else:
+            try:
+                observer = parse_observer(obs_t["location"])
+            except ValueError as exc:
+                c.problems.append(f"[observer] location: {exc}")
+    elif obs_t:
+        lat = c.number("observer", "latitude_deg", obs_t.get("latitude_deg"), -90, 90)
+        lon = c.number("observer", "longitude_deg", obs_t.get("longitude_deg"), -180, 360)
+        alt = c.number("observer", "altitude_m", obs_t.get("altitude_m", 0.0), -12000, 100000)
+        if None not in (lat, lon, alt):
+            observer = Observer(lat, lon, alt)  # type: ignore[arg-type]
+
+    # [horizon]
+    hor_t = c.table(doc, "horizon", {"points", "file"})
+    horizon = HorizonTable()
+    if "points" in hor_t and "file" in hor_t:
+        c.problems.append("[horizon]: give either points or file, not both")
+    elif "points" in hor_t:
+        pts = hor_t["points"]
+        try:
+            if not isinstance(pts, list) or not all(isinstance(p, list) and len(p) == 2 for p in pts):
+                raise ValueError("must be a list of [azimuth, elevation] pairs")
+            horizon = HorizonTable([(float(a), float(e)) for a, e in pts])
+        except (TypeError, ValueError) as exc:
+            c.problems.append(f"[horizon] points: {exc}")
+    elif "file" in hor_t:
+        try:
+            horizon = load_horizon(base / str(hor_t["file"]))
+        except (OSError, ValueError) as exc:
+            c.problems.append(f"[horizon] file: {exc}")
+
+    # [elements]
+    el_t = c.table(doc, "elements", {"files", "urls", "refresh_hours", "use_bundled"})
+    files = c.strings("elements", "files", el_t.get("files", [])) or ()
+    urls = c.strings("elements", "urls", el_t.get("urls", [])) or ()
+    for url in urls:
+        if not url.lower().startswith(("http://", "https://")):
+            c.problems.append(f"[elements] urls: {url!r} is not an http(s) URL")
+    refresh = c.number("elements", "refresh_hours", el_t.get("refresh_hours", 24.0), 0, 24 * 30)
+    use_bundled = el_t.get("use_bundled", True)
+    if not isinstance(use_bundled, bool):
+        c.problems.append("[elements] use_bundled: must be true or false")
+    elements = ElementsConfig(tuple(str(base / f) for f in files), urls, refresh or 0.0, bool(use_bundled))
+
+    # [server]
+    sv_t = c.table(doc, "server", {"rate_hz", "services", "topic", "items", "satellite", "ut1_utc_s"})
+    rate = c.number("server", "rate_hz", sv_t.get("rate_hz", 5.0), 1, 50)
+    services = c.strings("server", "services", sv_t.get("services", ["NFW32", "NFW_SERVER"]))
+    items = c.strings("server", "items", sv_t.get("items", ["NFW_SERVER", "NFW_DATA"]))
+    topic = sv_t.get("topic", "NFW_DATA")
+    for name in [*(services or ()), *(items or ()), topic if isinstance(topic, str) else ""]:
+        if not isinstance(name, str) or not 0 < len(name) <= 255:
+            c.problems.append(f"[server] DDE name {name!r}: must have 1 to 255 characters")
+    satellite = sv_t.get("satellite", 25544)
+    if satellite is not None and (isinstance(satellite, bool) or not isinstance(satellite, int) or satellite <= 0):
+        c.problems.append("[server] satellite: must be a catalog number")
+    ut1 = c.number("server", "ut1_utc_s", sv_t.get("ut1_utc_s", 0.0), -1, 1)
+
+    # [satellites]
+    sat_t = c.table(doc, "satellites", {"names", "favourites"})
+    names: dict[int, str] = {}
+    raw_names = sat_t.get("names", {})
+    if not isinstance(raw_names, dict):
+        c.problems.append("[satellites] names: must be a table of catalog number = \"NAME\"")
+    else:
+        for key, value in raw_names.items():
+            try:
+                names[int(key)] = validate_dde_name(str(value))
+            except ValueError as exc:
+                c.problems.append(f"[satellites] names.{key}: {exc}")
+    favourites = sat_t.get("favourites", [])
+    if not isinstance(favourites, list) or not all(isinstance(f, int) and not isinstance(f, bool) for f in favourites):
+        c.problems.append("[satellites] favourites: must be a list of catalog numbers")
+        favourites = []
+
+    if c.problems:
+        raise ConfigError(source, c.problems)
+    return Config(
+        observer=observer or Config().observer, observer_configured=observer is not None, horizon=horizon,
+        elements=elements,
+        server=ServerConfig(rate or 5.0, services or (), str(topic), items or (), satellite, ut1 or 0.0),
+        dde_names=names, favourites=tuple(favourites), source=source,
+    )
+
+
+def load_config(path: str | Path | None = None) -> Config:
+    """Load ``path``, or the default location if it exists, else the built-in defaults.
+
+    Raises :class:`ConfigError` for an explicit path that cannot be read or any invalid content.
+    """
+    if path is None:
+        default = default_config_path()
+        if not default.exists():
+            return Config()
+        path = default
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(str(path), [f"cannot read the file ({exc})"]) from None
+    return parse_config(text, str(path), path.parent)
+
+
+TEMPLATE = """\
+# nfwserver configuration.  Every key is optional; the values shown are the defaults.
+# Run `nfwserver config show` to see what the server makes of this file.
+
+[observer]
+# Your station: a Maidenhead locator ("JO02ae") or "LAT,LON[,ALT_M]" ("52.2,0.12,20", "33.87S,151.21E").
+# Without it the server uses Greenwich and says so at start.
+# location = "JO02ae"
+
+[horizon]
+# Minimum elevation by azimuth (degrees), interpolated; decides AH:Y/N.  Empty = flat 0 degrees.
+# points = [[0, 5], [90, 12], [180, 3], [270, 8]]
+# file = "horizon.txt"          # or a file with one "azimuth elevation" pair per line
+
+[elements]
+# files = ["my-keps.txt"]       # TLE, AMSAT verbose or OMM JSON/CSV; relative to this file
+# urls = ["https://example.org/amateur.txt"]
+refresh_hours = 24              # 0 = never refresh while running
+use_bundled = true              # include the bundled amateur and weather satellites
+
+[server]
+rate_hz = 5                     # publish rate, 1..50 Hz
+services = ["NFW32", "NFW_SERVER"]
+topic = "NFW_DATA"
+items = ["NFW_SERVER", "NFW_DATA"]
+satellite = 25544               # AutoTracking satellite at start (catalog number)
+ut1_utc_s = 0.0                 # UT1-UTC from IERS Bulletin A (seconds)
+
+[satellites]
+# names = { 25544 = "ISS", 27607 = "SO-50" }   # DDE names (12 characters, no spaces)
+# favourites = [25544, 27607, 43017]
+"""

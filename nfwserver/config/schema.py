@@ -1,0 +1,41 @@
+"""The validated configuration, as plain records (units in the field names)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from nfwserver.tracking.horizon import HorizonTable
+from nfwserver.tracking.observer import Observer
+
+#: Used when no observer is configured (the Royal Observatory, Greenwich), with a warning.
+DEFAULT_OBSERVER = Observer(51.4779, -0.0015, 46.0)
+
+
+@dataclass(frozen=True)
+class ElementsConfig:
+    files: tuple[str, ...] = ()  #: element files, read at start and on every refresh
+    urls: tuple[str, ...] = ()  #: element URLs (http/https)
+    refresh_hours: float = 24.0  #: 0 disables the periodic refresh
+    use_bundled: bool = True  #: include the bundled amateur and weather satellites
+
+
+@dataclass(frozen=True)
+class ServerConfig:
+    rate_hz: float = 5.0
+    services: tuple[str, ...] = ("NFW32", "NFW_SERVER")
+    topic: str = "NFW_DATA"
+    items: tuple[str, ...] = ("NFW_SERVER", "NFW_DATA")
+    satellite: int | None = 25544  #: AutoTracking satellite at start (catalog number)
+    ut1_utc_s: float = 0.0
+
+
+@dataclass(frozen=True)
+class Config:
+    observer: Observer = DEFAULT_OBSERVER
+    observer_configured: bool = False
+    horizon: HorizonTable = field(default_factory=HorizonTable)
+    elements: ElementsConfig = field(default_factory=ElementsConfig)
+    server: ServerConfig = field(default_factory=ServerConfig)
+    dde_names: dict[int, str] = field(default_factory=dict)  #: catalog number -> DDE name override
+    favourites: tuple[int, ...] = ()  #: satellites whose passes the console lists
+    source: str = "<built-in defaults>"

@@ -1,0 +1,1 @@
+"""The diagnostic console (Textual): live state, outgoing (F1) and incoming (F3) strings, pokes."""

@@ -1,0 +1,172 @@
+"""The Textual console of ``nfwserver run``.
+
+Shows what Nova's diagnostic screens showed and more: the live session state (satellite, look
+angles, range rate, AH, Doppler at the satellite's beacon frequency when known, tune/track, status
+word, antenna position, clients, next pass), the outgoing strings (F1) and the incoming strings
+with the conversation that sent them (F3).  The input line at the bottom takes the same commands
+a client pokes (``TUNE ON``, ``SAT=27607`` ...).
+
+Events arrive on the server's threads; they are queued and drained on the UI thread by a timer,
+so a flood of strings at 50 Hz never blocks the publisher.
+"""
+
+from __future__ import annotations
+
+import collections
+import threading
+from datetime import datetime, timedelta
+
+from rich.text import Text
+from textual.app import App, ComposeResult
+from textual.binding import Binding
+from textual.containers import Horizontal, Vertical
+from textual.widgets import Footer, Header, Input, RichLog, Static
+
+from nfwserver.dde.events import Direction, Event
+from nfwserver.dde.protocol import escape_for_log
+from nfwserver.dde.server import NovaServer
+from nfwserver.dde.status import describe
+from nfwserver.tracking.passes import Pass, find_passes
+
+
+def _clock(when: datetime | None) -> str:
+    return when.strftime("%H:%M:%S") if when else "--:--:--"
+
+
+class NfwConsole(App):
+    """The console; give it the running server."""
+
+    TITLE = "nfwserver"
+    CSS = """
+    #state { height: auto; border: round $accent; padding: 0 1; }
+    #logs { height: 1fr; }
+    .pane { width: 1fr; border: round $primary; }
+    #poke { dock: bottom; }
+    """
+    BINDINGS = [
+        Binding("f1", "focus_outgoing", "Outgoing (F1)"),
+        Binding("f3", "focus_incoming", "Incoming (F3)"),
+        Binding("ctrl+t", "toggle_tune", "Tune on/off"),
+        Binding("ctrl+q", "quit", "Quit"),
+    ]
+
+    def __init__(self, server: NovaServer, transport_note: str = "", hint: str = "") -> None:
+        super().__init__()
+        self.server = server
+        self.transport_note = transport_note
+        self.hint = hint
+        self._queue: collections.deque[Event] = collections.deque(maxlen=2000)
+        self._lock = threading.Lock()
+        self._unsubscribe = None
+        self._next_pass: Pass | None = None
+        self._pass_key: tuple[int | None, int] | None = None
+
+    def compose(self) -> ComposeResult:
+        yield Header(show_clock=False)
+        yield Static(id="state")
+        with Horizontal(id="logs"):
+            with Vertical(classes="pane"):
+                yield Static("[b]F1 outgoing[/b]")
+                yield RichLog(id="outgoing", max_lines=500, wrap=False, markup=False)
+            with Vertical(classes="pane"):
+                yield Static("[b]F3 incoming[/b]")
+                yield RichLog(id="incoming", max_lines=500, wrap=True, markup=False)
+        yield Input(placeholder="poke: TUNE ON | TUNE OFF | TRACK ON | SAT=25544 | ANTAZ=123 ...", id="poke")
+        yield Footer()
+
+    def on_mount(self) -> None:
+        self._unsubscribe = self.server.events.subscribe(self._enqueue)
+        incoming = self.query_one("#incoming", RichLog)
+        for note in (self.transport_note, self.hint):
+            if note:
+                incoming.write(Text(f"note: {note}", style="yellow"))
+        self.set_interval(0.1, self._drain)
+        self.set_interval(0.25, self._refresh_state)
+        self._refresh_state()
+        self.query_one("#poke", Input).focus()
+
+    def on_unmount(self) -> None:
+        if self._unsubscribe is not None:
+            self._unsubscribe()
+
+    def _enqueue(self, event: Event) -> None:  # any thread
+        with self._lock:
+            self._queue.append(event)
+
+    def _drain(self) -> None:
+        with self._lock:
+            events = list(self._queue)
+            self._queue.clear()
+        outgoing = self.query_one("#outgoing", RichLog)
+        incoming = self.query_one("#incoming", RichLog)
+        for e in events:
+            stamp = _clock(e.time)
+            if e.direction is Direction.OUT:
+                who = f" -> {e.client}" if e.client else ""
+                outgoing.write(f"{stamp} {e.text}{who}")
+            else:
+                mark = "" if e.accepted is None else (" ok" if e.accepted else " REFUSED")
+                detail = f" ({e.detail})" if e.detail and not e.accepted else ""
+                who = e.client or "server"
+                style = "red" if e.accepted is False else ("dim" if e.direction is Direction.INFO else "")
+                incoming.write(Text(f"{stamp} [{who}] {escape_for_log(e.text)}{mark}{detail}", style=style))
+
+    def _upcoming_pass(self, now: datetime) -> Pass | None:
+        snap = self.server.snapshot()
+        key = (snap.catalog_number, int(now.timestamp() // 60))
+        if key != self._pass_key:
+            self._pass_key = key
+            self._next_pass = None
+            sat = self.server.catalog.get(snap.catalog_number) if snap.catalog_number else None
+            if sat is not None and self.server.observer is not None:
+                passes = find_passes([sat], self.server.observer, now, now + timedelta(hours=24),
+                                     horizon=self.server.horizon, ut1_utc=self.server.ut1_utc)
+                self._next_pass = next((p for p in passes if p.los is None or p.los > now), None)
+        return self._next_pass
+
+    def _refresh_state(self) -> None:
+        snap = self.server.snapshot()
+        sample = snap.last_sample
+        now = self.server.clock.now()
+        lines = []
+        sat = f"{snap.dde_name} ({snap.catalog_number})" if snap.catalog_number else "none selected"
+        lines.append(f"Satellite {sat}   TUNE {'ON' if snap.tune_on else 'OFF'}   "
+                     f"TRACK {'ON' if snap.track_on else 'OFF'}   rate {snap.rate_hz:g} Hz   "
+                     f"clients {snap.clients} ({snap.advise_loops} advise)")
+        if sample is not None and sample.look_angles is not None:
+            la = sample.look_angles
+            lines.append(f"AZ {la.azimuth_deg:6.1f}  EL {la.elevation_deg:5.1f}  RR {la.range_rate_km_s:+.4f} km/s  "
+                         f"range {la.range_km:8.1f} km  AH {'Y' if sample.above_horizon else 'N'}  "
+                         f"Doppler@145.8MHz {-145.8e6 * la.range_rate_km_s / 299792.458:+.0f} Hz")
+        else:
+            lines.append("no position (no satellite, no observer, or SGP4 error)")
+        ant = snap.antenna
+        ant_text = (f"{ant.azimuth_deg if ant.azimuth_deg is not None else '-'} / "
+                    f"{ant.elevation_deg if ant.elevation_deg is not None else '-'} ({ant.source or 'unknown'})")
+        nxt = self._upcoming_pass(now)
+        if nxt is not None:
+            pass_text = (f"AOS {_clock(nxt.aos)}  TCA {_clock(nxt.tca)} max {nxt.max_elevation_deg:.0f}deg  "
+                         f"LOS {_clock(nxt.los)}")
+        else:
+            pass_text = "no pass in the next 24 h"
+        lines.append(f"Antenna {ant_text}   next pass: {pass_text}")
+        status = ", ".join(describe(snap.status)) or "ok"
+        lines.append(f"Status 0x{snap.status:04X}: {status}   {_clock(now)} UTC")
+        self.query_one("#state", Static).update("\n".join(lines))
+
+    def on_input_submitted(self, message: Input.Submitted) -> None:
+        text = message.value.strip()
+        message.input.value = ""
+        if text:
+            self.server.command(text, source="console")
+            self._drain()
+            self._refresh_state()
+
+    def action_focus_outgoing(self) -> None:
+        self.query_one("#outgoing", RichLog).focus()
+
+    def action_focus_incoming(self) -> None:
+        self.query_one("#incoming", RichLog).focus()
+
+    def action_toggle_tune(self) -> None:
+        self.server.command("TUNE OFF" if self.server.snapshot().tune_on else "TUNE ON", source="console")
