@@ -28,7 +28,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def _log_to_file(path: Path) -> None:
+def _log_to_file(path: Path) -> logging.Handler:
     path.parent.mkdir(parents=True, exist_ok=True)
     handler = logging.handlers.RotatingFileHandler(path, maxBytes=5 * 2**20, backupCount=5, encoding="utf-8")
     handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
@@ -38,6 +38,7 @@ def _log_to_file(path: Path) -> None:
             existing.setLevel(max(existing.level, logging.WARNING))
     root.addHandler(handler)
     root.setLevel(min(root.level, logging.INFO))
+    return handler
 
 
 def run(args: argparse.Namespace) -> int:
@@ -56,15 +57,22 @@ def run(args: argparse.Namespace) -> int:
         hint = (f"no observer configured: using {config.observer} (Greenwich). Set [observer] location in "
                 f"{default_config_path()} (`nfwserver config init` writes a starting file).")
     console = sys.stdout.isatty() and not args.headless
+    file_handler = None
     if not console:
         from platformdirs import user_log_dir
 
-        _log_to_file(Path(args.log_file) if args.log_file else Path(user_log_dir("nfwserver", appauthor=False))
-                     / "nfwserver.log")
+        default_log = Path(user_log_dir("nfwserver", appauthor=False)) / "nfwserver.log"
+        file_handler = _log_to_file(Path(args.log_file) if args.log_file else default_log)
     station = Station(config, SystemClock())
     notes = [f"configuration: {config.source}", station.transport_note, f"{len(station.catalog)} satellites loaded"]
     if hint:
         notes.append(hint)
+    ages = [s.age_days(station.clock.now()) for s in station.catalog]
+    if ages and min(ages) > 14:
+        stale = (f"the newest element set is {min(ages):.0f} days old: positions drift; add current elements "
+                 "([elements] files or urls in the configuration)")
+        notes.append(stale)
+        hint = f"{hint} {stale}".strip()
     station.start()
     try:
         if console:
@@ -88,4 +96,7 @@ def run(args: argparse.Namespace) -> int:
     finally:
         station.stop()
         log.info("stopped")
+        if file_handler is not None:
+            logging.getLogger().removeHandler(file_handler)
+            file_handler.close()
     return 0

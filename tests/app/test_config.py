@@ -1,0 +1,95 @@
+"""Configuration validation names the exact key; defaults work; atomic writes keep the old file."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from nfwserver.cli import main
+from nfwserver.config import ConfigError, load_config, parse_config
+from nfwserver.config.loader import TEMPLATE
+from nfwserver.config.schema import DEFAULT_OBSERVER
+from nfwserver.storage import atomic_write_text
+
+
+def test_template_is_valid_and_means_the_defaults() -> None:
+    config = parse_config(TEMPLATE)
+    assert config.server.rate_hz == 5.0 and config.server.services == ("NFW32", "NFW_SERVER")
+    assert config.observer == DEFAULT_OBSERVER and not config.observer_configured
+    assert config.elements.use_bundled
+
+
+def test_a_full_file(tmp_path) -> None:
+    (tmp_path / "h.txt").write_text("0 5\n180 10\n")
+    config = parse_config(
+        '[observer]\nlocation = "QF56od"\n[horizon]\nfile = "h.txt"\n[elements]\nfiles = ["k.txt"]\n'
+        '[server]\nrate_hz = 10\nsatellite = 27607\n[satellites]\nnames = { 25544 = "ARISS" }\nfavourites = [25544]\n',
+        base_dir=tmp_path,
+    )
+    assert config.observer_configured and config.observer.latitude_deg < 0
+    assert config.horizon.min_elevation(90) == pytest.approx(7.5)
+    assert config.elements.files == (str(tmp_path / "k.txt"),)
+    assert config.server.rate_hz == 10 and config.server.satellite == 27607
+    assert config.dde_names == {25544: "ARISS"} and config.favourites == (25544,)
+
+
+@pytest.mark.parametrize(
+    ("text", "key"),
+    [
+        ("[server]\nrate_hz = 80\n", "[server] rate_hz"),
+        ("[server]\nrate_hz = 'fast'\n", "[server] rate_hz"),
+        ("[server]\nratehz = 5\n", "[server] ratehz: unknown key"),
+        ("[observer]\nlocation = 'nowhere'\n", "[observer] location"),
+        ("[observer]\nlatitude_deg = 95\nlongitude_deg = 0\n", "[observer] latitude_deg"),
+        ("[horizon]\npoints = [[0, 95]]\n", "[horizon] points"),
+        ("[horizon]\nfile = 'missing.txt'\n", "[horizon] file"),
+        ("[elements]\nurls = ['ftp://x']\n", "[elements] urls"),
+        ("[satellites]\nnames = { 25544 = 'TWO WORDS' }\n", "[satellites] names.25544"),
+        ("[rotor]\n", "[rotor]: unknown section"),
+        ("this is not toml", "not valid TOML"),
+    ],
+)
+def test_each_problem_names_its_key(text: str, key: str, tmp_path) -> None:
+    with pytest.raises(ConfigError) as info:
+        parse_config(text, "cfg.toml", tmp_path)
+    assert key in str(info.value)
+
+
+def test_all_problems_are_reported_together() -> None:
+    with pytest.raises(ConfigError) as info:
+        parse_config("[server]\nrate_hz = 80\nsatellite = -1\n[oops]\n")
+    assert len(info.value.problems) == 3
+
+
+def test_missing_explicit_file_is_refused(tmp_path) -> None:
+    with pytest.raises(ConfigError, match="cannot read"):
+        load_config(tmp_path / "absent.toml")
+
+
+def test_config_init_and_show(tmp_path, capsys) -> None:
+    path = tmp_path / "sub" / "config.toml"
+    assert main(["config", "init", "--config", str(path)]) == 0
+    assert path.read_text() == TEMPLATE
+    assert main(["config", "init", "--config", str(path)]) == 1
+    assert "already exists" in capsys.readouterr().err
+    assert main(["config", "show", "--config", str(path)]) == 0
+    assert "rate 5 Hz" in capsys.readouterr().out
+    path.write_text("[server]\nrate_hz = 0\n")
+    assert main(["config", "show", "--config", str(path)]) == 1
+    assert "[server] rate_hz" in capsys.readouterr().err
+
+
+def test_atomic_write_keeps_the_old_file_when_writing_fails(tmp_path, monkeypatch) -> None:
+    path = tmp_path / "catalog.txt"
+    atomic_write_text(path, "old content")
+
+    def broken_replace(src, dst):
+        raise OSError("disk gone")
+
+    monkeypatch.setattr(os, "replace", broken_replace)
+    with pytest.raises(OSError):
+        atomic_write_text(path, "new content")
+    monkeypatch.undo()
+    assert path.read_text() == "old content"
+    assert [p.name for p in tmp_path.iterdir()] == ["catalog.txt"]  # no temporary file left behind

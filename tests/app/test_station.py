@@ -1,0 +1,92 @@
+"""The assembled station: defaults, element sources over local HTTP, headless run."""
+
+from __future__ import annotations
+
+import http.server
+import threading
+from collections.abc import Iterator
+
+import pytest
+
+from nfwserver.app.element_sources import bundled_elements, fetch_all
+from nfwserver.app.station import Station
+from nfwserver.cli import main
+from nfwserver.clock import SystemClock
+from nfwserver.config import parse_config
+from nfwserver.config.schema import Config
+from nfwserver.fake_dde import FakeDdeSystem
+from tests.conftest import DATA
+
+
+@pytest.fixture
+def http_server() -> Iterator[str]:
+    """Serves tests/data and a garbage file on 127.0.0.1 (ephemeral port)."""
+
+    class Handler(http.server.SimpleHTTPRequestHandler):
+        def __init__(self, *a, **k):
+            super().__init__(*a, directory=str(DATA), **k)
+
+        def log_message(self, *args):  # keep test output clean
+            pass
+
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    yield f"http://127.0.0.1:{server.server_address[1]}"
+    server.shutdown()
+    server.server_close()
+
+
+def test_bundled_elements_hold_the_popular_satellites() -> None:
+    result = bundled_elements()
+    numbers = {s.catalog_number for s in result.sets}
+    assert {25544, 27607, 7530, 24278}.issubset(numbers) and not result.rejected
+
+
+def test_elements_from_local_http_and_a_dead_url(http_server) -> None:
+    result = fetch_all(urls=(f"{http_server}/visual.txt", f"{http_server}/missing.txt", "http://127.0.0.1:9/x"),
+                       use_bundled=False, timeout_s=5)
+    assert len(result.sets) == 148
+    assert len(result.failed) == 2
+
+
+def test_station_serves_dde_on_defaults() -> None:
+    system = FakeDdeSystem()
+    station = Station(Config(), SystemClock(), transport=system.server_transport())
+    assert len(station.catalog) >= 40
+    station.start()
+    try:
+        conv = system.connect("NFW32", "NFW_DATA")
+        conv.poke("NFW_SERVER", "TUNE ON")
+        station.server.tick()
+        assert conv.request_text("NFW_SERVER").startswith("ISS AZ:")
+    finally:
+        station.stop()
+    assert not conv.connected
+
+
+def test_refresh_takes_newer_elements_only(tmp_path) -> None:
+    keps = tmp_path / "keps.txt"
+    keps.write_text((DATA / "visual.txt").read_text())
+    config = parse_config(f'[elements]\nfiles = ["{keps}"]\nuse_bundled = false\n')
+    station = Station(config, SystemClock(), transport=FakeDdeSystem().server_transport())
+    assert len(station.catalog) == 148
+    summary = station.refresh_elements()
+    assert summary.added == [] and summary.updated == [] and len(summary.not_newer) == 148
+
+
+def test_run_headless_for_a_bounded_time(tmp_path, capsys) -> None:
+    log_file = tmp_path / "nfw.log"
+    config = tmp_path / "c.toml"
+    config.write_text('[observer]\nlocation = "JO02ae"\n[server]\nrate_hz = 20\n')
+    assert main(["run", "--headless", "--duration", "0.3", "--config", str(config), "--log-file", str(log_file)]) == 0
+    err = capsys.readouterr().err
+    assert "fake DDE transport" in err and "satellites loaded" in err
+    assert "stopped" in log_file.read_text()
+
+
+def test_run_refuses_a_bad_config(tmp_path, capsys) -> None:
+    config = tmp_path / "c.toml"
+    config.write_text("[server]\nrate_hz = 500\n")
+    assert main(["run", "--headless", "--duration", "0.1", "--config", str(config)]) == 1
+    assert "[server] rate_hz" in capsys.readouterr().err
