@@ -12,12 +12,16 @@ How the search works, all satellites at once where it can be:
    largest angle at which the satellite can be above the lowest horizon point, and a bound on how
    fast that margin can shrink (the satellite's angular rate plus the change of the visibility
    limit with height), each coarse interval is either proven invisible or kept as a candidate.
-2. **Fine grid.**  Candidate intervals are sampled every ``fine_step_s`` with the full look-angle
-   computation and the horizon table, giving the function ``f = elevation - horizon(azimuth)``.
-3. **Events.**  Every sign change of ``f`` is a crossing, refined by bisection to well under a
-   millisecond.  Every local maximum of ``f`` on the grid that is below zero but could reach it
-   between samples is refined by golden-section search, so passes shorter than the grid step
-   are found.  TCA is refined the same way.
+2. **Fine grid.**  Candidate intervals are sampled every ``fine_step_s`` (longer for slow
+   satellites) with the full look-angle computation and the horizon table, giving the function
+   ``f = elevation - horizon(azimuth)``.  Near-circular orbits under a flat horizon skip this
+   step: their elevation rises and falls in one smooth hump several coarse steps wide, so the
+   coarse points already bracket every event.
+3. **Events.**  Every sign change of ``f`` is a crossing, refined by safeguarded Newton iteration
+   with the analytic rate of ``f`` to well under a millisecond.  Every local maximum of ``f`` on
+   the samples that is below zero but could reach it between samples is refined by parabolic
+   search, so passes shorter than the sampling step are found.  TCA is the root of the
+   elevation rate, found by the Illinois method around the best of nine samples of the pass.
 
 Passes already in progress at ``start`` are reported with their true AOS before ``start``
 (``aos_before_start``), passes in progress at ``end`` with their LOS after it: the search looks
@@ -139,15 +143,17 @@ class _Evaluator:
 
 
 def _crossings(ev: _Evaluator, sat: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-               iterations: int = 4) -> np.ndarray:
+               iterations: int = 6, f_lo: np.ndarray | None = None, f_hi: np.ndarray | None = None) -> np.ndarray:
     """Times where f = 0 inside brackets [lo, hi] whose ends have opposite signs.
 
     Safeguarded Newton iteration with the analytic rate of f, starting from linear
     interpolation: a step that would leave the current bracket bisects it instead.
     """
     a, b = lo.astype(float).copy(), hi.astype(float).copy()
-    _, f_ab = ev.look(np.concatenate((sat, sat)), np.concatenate((a, b)))[1:]
-    fa, fb = np.maximum(f_ab[: len(a)], -180.0), np.maximum(f_ab[len(a) :], -180.0)
+    if f_lo is None or f_hi is None:
+        _, f_ab = ev.look(np.concatenate((sat, sat)), np.concatenate((a, b)))[1:]
+        f_lo, f_hi = f_ab[: len(a)], f_ab[len(a) :]
+    fa, fb = np.maximum(f_lo, -180.0), np.maximum(f_hi, -180.0)
     with np.errstate(invalid="ignore", divide="ignore"):
         c = np.where(fb != fa, (a * fb - b * fa) / (fb - fa), 0.5 * (a + b))
     a_up = fa > 0.0
@@ -165,15 +171,15 @@ def _crossings(ev: _Evaluator, sat: np.ndarray, lo: np.ndarray, hi: np.ndarray,
 
 
 def _culminations(ev: _Evaluator, sat: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                  iterations: int = 8) -> tuple[np.ndarray, np.ndarray]:
-    """Time and value of the maximum elevation in [lo, hi]: best of nine samples, then the root of
+                  iterations: int = 8, samples: int = 9) -> tuple[np.ndarray, np.ndarray]:
+    """Time and value of the maximum elevation in [lo, hi]: best of ``samples`` samples, then the root of
     d(elevation)/dt around it by the Illinois method."""
     n = len(sat)
-    frac = np.linspace(0.0, 1.0, 9)
+    frac = np.linspace(0.0, 1.0, samples)
     probe_t = (lo[:, None] + frac[None, :] * (hi - lo)[:, None]).ravel()
-    probe_el = np.nan_to_num(ev.look(np.repeat(sat, 9), probe_t)[1].reshape(n, 9), nan=-1e3)
+    probe_el = np.nan_to_num(ev.look(np.repeat(sat, samples), probe_t)[1].reshape(n, samples), nan=-1e3)
     best = np.argmax(probe_el, axis=1)
-    step = (hi - lo) / 8.0
+    step = (hi - lo) / (samples - 1)
     centre = lo + best * step
     a, b = np.maximum(centre - step, lo), np.minimum(centre + step, hi)
     rates = ev.look_rates(np.concatenate((sat, sat)), np.concatenate((a, b)))[2]
@@ -227,9 +233,10 @@ def _peaks(ev: _Evaluator, sat: np.ndarray, centre: np.ndarray, half_width: np.n
 
 def _visibility_screen(satrecs: list[Satrec], observer: Observer, t0: datetime, span_s: float,
                        coarse_step_s: float, horizon: HorizonTable, ut1_utc: float
-                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Coarse grid times (s), a mask (sats, intervals) of intervals where the satellite may rise or
-    set, and each satellite's bound on the rate of its visibility margins (rad/s).
+    set, each satellite's bound on the rate of its visibility margins (rad/s), and
+    f = elevation - horizon (deg) at every coarse point (sats, times).
 
     An interval is dropped when the satellite is provably below the lowest horizon point
     throughout, or provably above the highest one throughout (1 degree of slack covers the
@@ -251,6 +258,8 @@ def _visibility_screen(satrecs: list[Satrec], observer: Observer, t0: datetime, 
     w = theta_dot / SECONDS_PER_DAY
     mask = np.zeros((len(satrecs), n_steps), dtype=bool)
     rates_out = np.zeros(len(satrecs))
+    f_out = np.empty((len(satrecs), n_steps + 1))
+    east_u, north_u, up_u = (np.array(b) for b in observer.enu_basis())
     chunk = max(1, 400_000 // len(t))
     for i0 in range(0, len(satrecs), chunk):
         part = satrecs[i0 : i0 + chunk]
@@ -295,7 +304,17 @@ def _visibility_screen(satrecs: list[Satrec], observer: Observer, t0: datetime, 
         )
         mask[i0 : i0 + len(part)] = candidate
         rates_out[i0 : i0 + len(part)] = rate_bound
-    return t, mask, rates_out
+        # f = elevation - horizon at the coarse points, for satellites sampled on this grid alone.
+        dx, dy, dz = x - obs[0], y - obs[1], z - obs[2]
+        east = dx * east_u[0] + dy * east_u[1]
+        north = dx * north_u[0] + dy * north_u[1] + dz * north_u[2]
+        upc = dx * up_u[0] + dy * up_u[1] + dz * up_u[2]
+        with np.errstate(invalid="ignore"):
+            el = np.degrees(np.arctan2(upc, np.hypot(east, north)))
+            az = np.degrees(np.arctan2(east, north)) % 360.0
+        f = el - horizon.min_elevation_array(np.nan_to_num(az))
+        f_out[i0 : i0 + len(part)] = np.where(err == 0, f, -np.inf)
+    return t, mask, rates_out, f_out
 
 
 #: Satellites with periods up to this (s) are searched together with a short look-back.
@@ -347,12 +366,18 @@ def _find_group(satrecs: list[Satrec], observer: Observer, start: datetime, end:
     span = window_s + 2.0 * extension
     ev = _Evaluator(satrecs, observer, t0, ut1_utc, horizon)
 
-    grid, mask, rates = _visibility_screen(satrecs, observer, t0, span, coarse_step_s, horizon, ut1_utc)
+    grid, mask, rates, coarse_f = _visibility_screen(satrecs, observer, t0, span, coarse_step_s, horizon,
+                                                     ut1_utc)
     # Fine samples over every candidate coarse interval; a run of consecutive candidate intervals
     # shares its inner edges, so each sample appears once and the arrays stay sorted by (sat, t).
     # Slow satellites get proportionally longer fine steps (a divisor of the coarse step).
     wanted = fine_step_s * np.clip(_LEO_RATE / np.maximum(rates, 1e-9), 1.0, coarse_step_s / fine_step_s)
     per_sat = np.maximum(1, np.round(coarse_step_s / wanted)).astype(np.intp)
+    # Near-circular orbits under a flat horizon have one smooth elevation hump per pass, several
+    # coarse steps wide: the coarse points themselves are enough to bracket every event.
+    if horizon.is_flat:
+        circular = np.array([sr.ecco < 0.05 for sr in satrecs])
+        per_sat = np.where(circular, 1, per_sat)
     sat_idx, interval_idx = np.nonzero(mask)
     if len(sat_idx) == 0:
         return []
@@ -365,7 +390,13 @@ def _find_group(satrecs: list[Satrec], observer: Observer, start: datetime, end:
     step_in = np.arange(len(fine_sat)) - first
     sample_step = coarse_step_s / per_sat[fine_sat]
     fine_t = grid[np.repeat(interval_idx, counts)] + step_in * sample_step
-    az, el, f = ev.look(fine_sat, fine_t)
+    on_grid = per_sat[fine_sat] == 1
+    f = np.empty(len(fine_t))
+    el = np.full(len(fine_t), np.nan)
+    k = np.rint(fine_t[on_grid] / coarse_step_s).astype(np.intp)
+    f[on_grid] = coarse_f[fine_sat[on_grid], k]
+    if (~on_grid).any():
+        _, el[~on_grid], f[~on_grid] = ev.look(fine_sat[~on_grid], fine_t[~on_grid])
     same = (fine_sat[1:] == fine_sat[:-1]) & (np.abs(fine_t[1:] - fine_t[:-1] - sample_step[1:]) < 1e-3)
 
     up = f > 0.0
@@ -373,7 +404,8 @@ def _find_group(satrecs: list[Satrec], observer: Observer, start: datetime, end:
     cross = same & (up[1:] != up[:-1])
     ci = np.flatnonzero(cross)
     rising = ~up[ci]
-    times = _crossings(ev, fine_sat[ci], fine_t[ci], fine_t[ci + 1]) if len(ci) else np.empty(0)
+    times = _crossings(ev, fine_sat[ci], fine_t[ci], fine_t[ci + 1], f_lo=f[ci], f_hi=f[ci + 1]) if len(ci) \
+        else np.empty(0)
     events_sat = list(fine_sat[ci])
     events_t = list(times)
     events_rise = list(rising)
@@ -384,7 +416,7 @@ def _find_group(satrecs: list[Satrec], observer: Observer, start: datetime, end:
         inner = same[:-1] & same[1:]
         local = inner & (f[mid] >= f[mid - 1]) & (f[mid] >= f[mid + 1]) & ~up[mid] & np.isfinite(f[mid])
         # Elevation can change by at most ~ (v / range) over half a step; be generous.
-        local &= f[mid] > -8.0
+        local &= f[mid] > np.where(on_grid[mid], -15.0, -8.0)
         li = mid[local]
         if len(li):
             half = 0.5 * (fine_t[li + 1] - fine_t[li - 1])
