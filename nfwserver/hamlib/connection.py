@@ -1,0 +1,133 @@
+"""A robust client for Hamlib's daemons' line protocol (rigctld, rotctld) over TCP.
+
+Facts of the protocol this relies on (seen with Hamlib 4.5.4): a set command answers one line
+``RPRT n`` (0 = success, negative = an error, see :mod:`nfwserver.hamlib.errors`); a get command
+answers its values, one per line, with no ``RPRT`` on success but ``RPRT n`` on failure; an unknown
+command gets no reply at all and a command missing an argument makes the daemon wait for more
+input.  So only complete, known commands are sent, and every reply is awaited with a timeout.
+
+When the daemon dies (EOF, broken pipe, refused connection) the connection is dropped and
+:class:`HamlibUnavailable` is raised at once; reconnection is attempted on a later call, no sooner
+than the back-off delay (doubling from ``backoff_initial_s`` to ``backoff_max_s``, measured on the
+injected clock), so a dead daemon never stalls the caller.
+"""
+
+from __future__ import annotations
+
+import logging
+import socket
+
+from nfwserver.clock import Clock
+from nfwserver.hamlib.errors import describe_rprt
+
+log = logging.getLogger(__name__)
+
+
+class HamlibError(Exception):
+    """The daemon answered with an error (``code`` is the RPRT value) or with nonsense."""
+
+    def __init__(self, message: str, code: int | None = None) -> None:
+        self.code = code
+        super().__init__(message)
+
+
+class HamlibUnavailable(HamlibError):
+    """The daemon cannot be reached now (down, restarting, or not answering in time)."""
+
+
+class HamlibConnection:
+    """One TCP connection to a Hamlib daemon, reopened on demand."""
+
+    def __init__(self, host: str, port: int, clock: Clock, name: str = "hamlib", timeout_s: float = 1.0,
+                 backoff_initial_s: float = 0.5, backoff_max_s: float = 10.0) -> None:
+        self.host, self.port, self.clock, self.name = host, port, clock, name
+        self.timeout_s = timeout_s
+        self.backoff_initial_s, self.backoff_max_s = backoff_initial_s, backoff_max_s
+        self._sock: socket.socket | None = None
+        self._buffer = b""
+        self._backoff = 0.0
+        self._retry_at: float | None = None
+        self.failures = 0  #: consecutive failures
+        self.reconnects = 0
+
+    @property
+    def connected(self) -> bool:
+        return self._sock is not None
+
+    def _connect(self) -> socket.socket:
+        if self._sock is not None:
+            return self._sock
+        now = self.clock.monotonic()
+        if self._retry_at is not None and now < self._retry_at:
+            raise HamlibUnavailable(f"{self.name} at {self.host}:{self.port} is down; retrying in "
+                                    f"{self._retry_at - now:.1f} s")
+        try:
+            sock = socket.create_connection((self.host, self.port), timeout=self.timeout_s)
+        except OSError as exc:
+            self._fail(f"cannot connect: {exc}")
+            raise HamlibUnavailable(f"{self.name} at {self.host}:{self.port}: cannot connect ({exc})") from None
+        sock.settimeout(self.timeout_s)
+        self._sock, self._buffer = sock, b""
+        if self.failures:
+            self.reconnects += 1
+            log.info("%s at %s:%d is back", self.name, self.host, self.port)
+        self.failures, self._backoff, self._retry_at = 0, 0.0, None
+        return sock
+
+    def _fail(self, why: str) -> None:
+        if self._sock is not None:
+            try:
+                self._sock.close()
+            except OSError:
+                pass
+        self._sock, self._buffer = None, b""
+        self.failures += 1
+        self._backoff = min(self.backoff_max_s, max(self.backoff_initial_s, self._backoff * 2.0))
+        self._retry_at = self.clock.monotonic() + self._backoff
+        if self.failures == 1:
+            log.warning("%s at %s:%d lost (%s); retrying with back-off", self.name, self.host, self.port, why)
+
+    def _read_line(self, sock: socket.socket) -> str:
+        while b"\n" not in self._buffer:
+            chunk = sock.recv(4096)
+            if not chunk:
+                raise ConnectionResetError("the daemon closed the connection")
+            self._buffer += chunk
+            if len(self._buffer) > 65536:
+                raise HamlibError("reply too long")
+        line, self._buffer = self._buffer.split(b"\n", 1)
+        return line.decode("ascii", errors="replace").strip()
+
+    def transact(self, command: str, reply_lines: int) -> list[str]:
+        """Send one complete command and read ``reply_lines`` lines (0 for set commands: read RPRT).
+
+        Returns the value lines of a get command; raises :class:`HamlibError` for ``RPRT`` < 0 and
+        :class:`HamlibUnavailable` when the daemon is down or silent.
+        """
+        if "\n" in command or "\r" in command:
+            raise ValueError("a Hamlib command is one line")
+        sock = self._connect()
+        try:
+            sock.sendall(command.encode("ascii") + b"\n")
+            first = self._read_line(sock)
+            if first.startswith("RPRT"):
+                code = int(first.split()[1]) if len(first.split()) > 1 else -8
+                if code < 0:
+                    raise HamlibError(f"{self.name}: '{command}' failed: {describe_rprt(code)} (RPRT {code})", code)
+                return []
+            if reply_lines == 0:
+                raise HamlibError(f"{self.name}: unexpected reply {first!r} to '{command}'")
+            lines = [first] + [self._read_line(sock) for _ in range(reply_lines - 1)]
+            return lines
+        except HamlibError:
+            raise
+        except (OSError, ValueError) as exc:  # timeout, reset, broken pipe, garbage numbers
+            self._fail(str(exc) or type(exc).__name__)
+            raise HamlibUnavailable(f"{self.name} at {self.host}:{self.port}: {exc or type(exc).__name__}") from None
+
+    def close(self) -> None:
+        if self._sock is not None:
+            try:
+                self._sock.close()
+            finally:
+                self._sock = None

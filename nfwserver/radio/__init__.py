@@ -1,0 +1,1 @@
+"""Radio layer: transponder channels, Doppler tuning logic, and radio backends (Hamlib rigctld)."""

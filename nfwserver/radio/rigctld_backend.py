@@ -1,0 +1,70 @@
+"""Radio backend for Hamlib's ``rigctld``: receive on VFO A (``F``/``f``), transmit on the split VFO (``I``/``i``).
+
+Frequencies are validated here (100 kHz .. 300 GHz, integers) because the dummy rig and some
+real ones accept anything.  Connection handling, timeouts and back-off are
+:class:`nfwserver.hamlib.connection.HamlibConnection`'s.
+"""
+
+from __future__ import annotations
+
+from nfwserver.clock import Clock
+from nfwserver.hamlib.connection import HamlibConnection, HamlibError, HamlibUnavailable
+from nfwserver.radio.backend import RadioError, RadioUnavailable
+from nfwserver.radio.transponder import MAX_FREQUENCY_HZ, MIN_FREQUENCY_HZ
+
+_MODES = {"USB", "LSB", "CW", "CWR", "RTTY", "RTTYR", "AM", "FM", "WFM", "PKTUSB", "PKTLSB", "PKTFM", "FMN"}
+
+
+def _check_hz(hz: int) -> int:
+    value = int(round(hz))
+    if not MIN_FREQUENCY_HZ <= value <= MAX_FREQUENCY_HZ:
+        raise RadioError(f"frequency {hz} Hz is outside 100 kHz..300 GHz")
+    return value
+
+
+class RigctldBackend:
+    """A transceiver behind ``rigctld`` at ``host:port`` (127.0.0.1 unless configured otherwise)."""
+
+    def __init__(self, clock: Clock, host: str = "127.0.0.1", port: int = 4532, timeout_s: float = 1.0) -> None:
+        self.connection = HamlibConnection(host, port, clock, name="rigctld", timeout_s=timeout_s)
+
+    def _do(self, command: str, lines: int = 0) -> list[str]:
+        try:
+            return self.connection.transact(command, lines)
+        except HamlibUnavailable as exc:
+            raise RadioUnavailable(str(exc)) from None
+        except HamlibError as exc:
+            raise RadioError(str(exc)) from None
+
+    def _get_hz(self, command: str) -> int:
+        (line,) = self._do(command, 1)
+        try:
+            return int(float(line))
+        except ValueError:
+            raise RadioError(f"rigctld answered {line!r} to '{command}'") from None
+
+    def set_rx_frequency(self, hz: int) -> None:
+        self._do(f"F {_check_hz(hz)}")
+
+    def get_rx_frequency(self) -> int:
+        return self._get_hz("f")
+
+    def set_tx_frequency(self, hz: int) -> None:
+        self._do(f"I {_check_hz(hz)}")
+
+    def get_tx_frequency(self) -> int:
+        return self._get_hz("i")
+
+    def set_split(self, on: bool) -> None:
+        self._do(f"S {1 if on else 0} VFOB")
+
+    def set_modes(self, rx_mode: str, tx_mode: str | None) -> None:
+        for mode in (rx_mode, tx_mode):
+            if mode is not None and mode.upper() not in _MODES:
+                raise RadioError(f"mode {mode!r} is not one of {', '.join(sorted(_MODES))}")
+        self._do(f"M {rx_mode.upper()} 0")
+        if tx_mode is not None:
+            self._do(f"X {tx_mode.upper()} 0")
+
+    def close(self) -> None:
+        self.connection.close()
