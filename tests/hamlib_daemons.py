@@ -47,6 +47,8 @@ class HamlibDaemon:
         self.host = "127.0.0.1"
         self.port = free_port()
         self.proc: subprocess.Popen[bytes] | None = None
+        self._reader: socket.socket | None = None
+        self._pending = b""
 
     def start(self, timeout: float = 10.0) -> HamlibDaemon:
         """Start the daemon and wait until it accepts connections."""
@@ -65,6 +67,7 @@ class HamlibDaemon:
 
     def kill(self) -> None:
         """Kill the daemon (SIGKILL) and wait for it to be gone."""
+        self._close_reader()
         if self.proc is not None and self.proc.poll() is None:
             self.proc.kill()
             self.proc.wait(timeout=5)
@@ -75,8 +78,45 @@ class HamlibDaemon:
         self.kill()
         return self.start()
 
+    def query(self, line: str, lines: int = 1, timeout: float = 3.0) -> list[str]:
+        """Send a get command on the test's own persistent connection and read ``lines`` reply lines."""
+        for attempt in (1, 2):
+            try:
+                if self._reader is None:
+                    self._reader = socket.create_connection((self.host, self.port), timeout=timeout)
+                    self._reader.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+                    self._pending = b""
+                self._reader.sendall(line.encode("ascii") + b"\n")
+                out = []
+                while len(out) < lines:
+                    while b"\n" not in self._pending:
+                        chunk = self._reader.recv(4096)
+                        if not chunk:
+                            raise ConnectionResetError("closed")
+                        self._pending += chunk
+                    first, self._pending = self._pending.split(b"\n", 1)
+                    out.append(first.decode("ascii", errors="replace"))
+                return out
+            except OSError:
+                self._close_reader()
+                if attempt == 2:
+                    raise
+        raise AssertionError("unreachable")
+
+    def _close_reader(self) -> None:
+        if self._reader is not None:
+            self._reader.close()
+            self._reader = None
+
     def command(self, line: str, timeout: float = 3.0) -> str:
-        """Send one raw protocol line on a fresh connection and return the reply text (for checks)."""
+        """Send one raw protocol line and return the reply text (for checks); retried once on a reset."""
+        try:
+            return self._command_once(line, timeout)
+        except ConnectionResetError:
+            time.sleep(0.05)
+            return self._command_once(line, timeout)
+
+    def _command_once(self, line: str, timeout: float) -> str:
         with socket.create_connection((self.host, self.port), timeout=timeout) as sock:
             sock.sendall(line.encode("ascii") + b"\n")
             sock.settimeout(timeout)
@@ -87,6 +127,10 @@ class HamlibDaemon:
                     chunk = sock.recv(4096)
                 except TimeoutError:
                     break
+                except ConnectionResetError:
+                    if chunks:
+                        break
+                    raise
                 if not chunk:
                     break
                 chunks.append(chunk)

@@ -67,6 +67,7 @@ class HamlibConnection:
             self._fail(f"cannot connect: {exc}")
             raise HamlibUnavailable(f"{self.name} at {self.host}:{self.port}: cannot connect ({exc})") from None
         sock.settimeout(self.timeout_s)
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)  # one short line per command
         self._sock, self._buffer = sock, b""
         if self.failures:
             self.reconnects += 1
