@@ -13,6 +13,9 @@ from nfwserver.dde.publisher import Publisher
 from nfwserver.dde.server import NovaServer
 from nfwserver.dde.transport import DdeServerTransport
 from nfwserver.fake_dde import FakeDdeSystem
+from nfwserver.radio.coupling import RadioCoupling
+from nfwserver.radio.rigctld_backend import RigctldBackend
+from nfwserver.radio.tuning import DopplerTuner
 from nfwserver.tracking.catalog import Catalog, UpdateSummary
 
 log = logging.getLogger(__name__)
@@ -59,6 +62,14 @@ class Station:
             self.transport_note = "serving on the given transport"
         self.transport = transport
         self.publisher = Publisher(self.server, clock)
+        self.radio: RadioCoupling | None = None
+        if config.radio.backend == "rigctld":
+            backend = RigctldBackend(clock, config.radio.host, config.radio.port)
+            first = next(iter(config.channels.values()), None)
+            if first is not None:
+                tuner = DopplerTuner(first, backend, config.radio.step_hz, config.radio.knob_tolerance_hz)
+                self.radio = RadioCoupling(tuner, config.channels, enabled=config.radio.enabled)
+                self.server.add_tick_listener(self.radio.on_tick)
         self._stop = threading.Event()
         self._refresher: threading.Thread | None = None
         self._started = False
@@ -92,6 +103,8 @@ class Station:
             return
         self._started = True
         self.server.attach(self.transport)
+        if self.radio is not None:
+            self.radio.start()
         self.publisher.start()
         if self.config.elements.refresh_hours > 0 and (self.config.elements.files or self.config.elements.urls):
             self._refresher = threading.Thread(target=self._refresh_loop, name="nfw-elements", daemon=True)
@@ -103,6 +116,8 @@ class Station:
         self._started = False
         self._stop.set()
         self.publisher.stop()
+        if self.radio is not None:
+            self.radio.stop()
         self.server.detach()
         try:
             self.transport.close()

@@ -12,7 +12,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from nfwserver.config.schema import Config, ElementsConfig, ServerConfig
+from nfwserver.config.schema import Config, ElementsConfig, RadioConfig, ServerConfig
+from nfwserver.radio.defaults import DEFAULT_CHANNELS
+from nfwserver.radio.transponder import Channel
 from nfwserver.tracking.dde_names import validate_dde_name
 from nfwserver.tracking.horizon import HorizonTable, load_horizon
 from nfwserver.tracking.observer import Observer, parse_observer
@@ -80,7 +82,7 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
         raise ConfigError(source, [f"not valid TOML ({exc})"]) from None
     c = _Checker(source)
     for key in doc:
-        if key not in {"observer", "horizon", "elements", "server", "satellites"}:
+        if key not in {"observer", "horizon", "elements", "server", "satellites", "radio"}:
             c.problems.append(f"[{key}]: unknown section")
     base = base_dir or Path(".")
 
@@ -149,7 +151,7 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
     ut1 = c.number("server", "ut1_utc_s", sv_t.get("ut1_utc_s", 0.0), -1, 1)
 
     # [satellites]
-    sat_t = c.table(doc, "satellites", {"names", "favourites"})
+    sat_t = c.table(doc, "satellites", {"names", "favourites", "channels"})
     names: dict[int, str] = {}
     raw_names = sat_t.get("names", {})
     if not isinstance(raw_names, dict):
@@ -165,6 +167,44 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
         c.problems.append("[satellites] favourites: must be a list of catalog numbers")
         favourites = []
 
+    # [radio]
+    ra_t = c.table(doc, "radio", {"backend", "host", "port", "step_hz", "knob_tolerance_hz", "enabled"})
+    backend = ra_t.get("backend", "none")
+    if backend not in ("none", "rigctld"):
+        c.problems.append("[radio] backend: must be \"none\" or \"rigctld\"")
+    host = ra_t.get("host", "127.0.0.1")
+    if not isinstance(host, str) or not host:
+        c.problems.append("[radio] host: must be a host name or address")
+    port = c.number("radio", "port", ra_t.get("port", 4532), 1, 65535)
+    step = c.number("radio", "step_hz", ra_t.get("step_hz", 10.0), 1, 10000)
+    knob = c.number("radio", "knob_tolerance_hz", ra_t.get("knob_tolerance_hz", 100.0), 1, 1e6)
+    if step and knob and knob < step:
+        c.problems.append("[radio] knob_tolerance_hz: must be at least step_hz")
+    radio_enabled = ra_t.get("enabled", False)
+    if not isinstance(radio_enabled, bool):
+        c.problems.append("[radio] enabled: must be true or false")
+    channels = dict(DEFAULT_CHANNELS)
+    raw_channels = sat_t.get("channels", [])
+    if not isinstance(raw_channels, list):
+        c.problems.append("[satellites] channels: must be an array of tables ([[satellites.channels]])")
+        raw_channels = []
+    for index, entry in enumerate(raw_channels, start=1):
+        where = f"[[satellites.channels]] #{index}"
+        if not isinstance(entry, dict):
+            c.problems.append(f"{where}: must be a table")
+            continue
+        fields = dict(entry)
+        catnr = fields.pop("catalog_number", None)
+        if isinstance(catnr, bool) or not isinstance(catnr, int) or catnr <= 0:
+            c.problems.append(f"{where} catalog_number: must be a catalog number")
+            continue
+        try:
+            channels[catnr] = Channel(name=str(fields.pop("name", f"{catnr}")), **fields)
+        except TypeError as exc:
+            c.problems.append(f"{where}: {exc}")
+        except ValueError as exc:
+            c.problems.append(f"{where}: {exc}")
+
     if c.problems:
         raise ConfigError(source, c.problems)
     return Config(
@@ -172,6 +212,8 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
         elements=elements,
         server=ServerConfig(rate or 5.0, services or (), str(topic), items or (), satellite, ut1 or 0.0),
         dde_names=names, favourites=tuple(favourites), source=source,
+        radio=RadioConfig(str(backend), str(host), int(port or 4532), step or 10.0, knob or 100.0, bool(radio_enabled)),
+        channels=channels,
     )
 
 
@@ -224,4 +266,25 @@ ut1_utc_s = 0.0                 # UT1-UTC from IERS Bulletin A (seconds)
 [satellites]
 # names = { 25544 = "ISS", 27607 = "SO-50" }   # DDE names (12 characters, no spaces)
 # favourites = [25544, 27607, 43017]
+
+# Radio channels (Hz) for Doppler tuning; these add to / replace the built-in ones (ISS, SO-50, AO-91,
+# RS-44, AO-7).  hold = "satellite" (both sides move), "uplink" or "downlink" (that side stays put).
+# [[satellites.channels]]
+# catalog_number = 25544
+# name = "ISS FM"
+# downlink_hz = 437800000
+# uplink_hz = 145990000
+# downlink_mode = "FM"
+# uplink_mode = "FM"
+# inverting = false
+# hold = "satellite"
+# downlink_correction_hz = 0
+
+[radio]
+backend = "none"                # "rigctld" to tune a radio through Hamlib's rigctld
+host = "127.0.0.1"
+port = 4532
+step_hz = 10                    # send a new frequency only after it moved this much
+knob_tolerance_hz = 100         # a bigger difference on read-back means the operator retuned
+enabled = false                 # Doppler tuning on at start (Ctrl+D in the console toggles it)
 """

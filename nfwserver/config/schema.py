@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from nfwserver.radio.transponder import Channel
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer
 
@@ -30,6 +31,16 @@ class ServerConfig:
 
 
 @dataclass(frozen=True)
+class RadioConfig:
+    backend: str = "none"  #: "none" or "rigctld"
+    host: str = "127.0.0.1"
+    port: int = 4532
+    step_hz: float = 10.0
+    knob_tolerance_hz: float = 100.0
+    enabled: bool = False  #: Doppler tuning on at start (switchable at run time)
+
+
+@dataclass(frozen=True)
 class Config:
     observer: Observer = DEFAULT_OBSERVER
     observer_configured: bool = False
@@ -38,4 +49,6 @@ class Config:
     server: ServerConfig = field(default_factory=ServerConfig)
     dde_names: dict[int, str] = field(default_factory=dict)  #: catalog number -> DDE name override
     favourites: tuple[int, ...] = ()  #: satellites whose passes the console lists
+    radio: RadioConfig = field(default_factory=RadioConfig)
+    channels: dict[int, Channel] = field(default_factory=dict)  #: catalog number -> radio channel
     source: str = "<built-in defaults>"

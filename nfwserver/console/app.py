@@ -26,6 +26,7 @@ from nfwserver.dde.events import Direction, Event
 from nfwserver.dde.protocol import escape_for_log
 from nfwserver.dde.server import NovaServer
 from nfwserver.dde.status import describe
+from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.tracking.passes import Pass, find_passes
 
 
@@ -47,12 +48,15 @@ class NfwConsole(App):
         Binding("f1", "focus_outgoing", "Outgoing (F1)"),
         Binding("f3", "focus_incoming", "Incoming (F3)"),
         Binding("ctrl+t", "toggle_tune", "Tune on/off"),
+        Binding("ctrl+d", "toggle_doppler", "Doppler tuning"),
         Binding("ctrl+q", "quit", "Quit"),
     ]
 
-    def __init__(self, server: NovaServer, transport_note: str = "", hint: str = "") -> None:
+    def __init__(self, server: NovaServer, transport_note: str = "", hint: str = "",
+                 radio: RadioCoupling | None = None) -> None:
         super().__init__()
         self.server = server
+        self.radio = radio
         self.transport_note = transport_note
         self.hint = hint
         self._queue: collections.deque[Event] = collections.deque(maxlen=2000)
@@ -150,6 +154,17 @@ class NfwConsole(App):
         else:
             pass_text = "no pass in the next 24 h"
         lines.append(f"Antenna {ant_text}   next pass: {pass_text}")
+        if self.radio is not None:
+            r = self.radio.last_result
+            state = "ON" if self.radio.enabled else "OFF"
+            if not self.radio.tuner.available:
+                radio_text = f"Radio: Doppler tuning {state}, radio unreachable ({self.radio.tuner.last_error})"
+            elif r is not None:
+                tx = f" TX {r.tx_hz / 1e6:.6f} MHz" if r.tx_hz else ""
+                radio_text = f"Radio: Doppler tuning {state}, RX {r.rx_hz / 1e6:.6f} MHz{tx}"
+            else:
+                radio_text = f"Radio: Doppler tuning {state}"
+            lines.append(radio_text)
         status = ", ".join(describe(snap.status)) or "ok"
         lines.append(f"Status 0x{snap.status:04X}: {status}   {_clock(now)} UTC")
         self.query_one("#state", Static).update("\n".join(lines))
@@ -167,6 +182,12 @@ class NfwConsole(App):
 
     def action_focus_incoming(self) -> None:
         self.query_one("#incoming", RichLog).focus()
+
+    def action_toggle_doppler(self) -> None:
+        if self.radio is not None:
+            self.radio.enabled = not self.radio.enabled
+            self.server.events.add(self.server.clock.now(), Direction.INFO, "note",
+                                   f"Doppler tuning {'ON' if self.radio.enabled else 'OFF'}", client="console")
 
     def action_toggle_tune(self) -> None:
         self.server.command("TUNE OFF" if self.server.snapshot().tune_on else "TUNE ON", source="console")

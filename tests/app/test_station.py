@@ -90,3 +90,26 @@ def test_run_refuses_a_bad_config(tmp_path, capsys) -> None:
     config.write_text("[server]\nrate_hz = 500\n")
     assert main(["run", "--headless", "--duration", "0.1", "--config", str(config)]) == 1
     assert "[server] rate_hz" in capsys.readouterr().err
+
+
+@pytest.mark.hamlib
+def test_station_tunes_a_real_rigctld_when_configured(rigctld, tmp_path) -> None:
+    import time
+
+    config = parse_config(
+        f'[radio]\nbackend = "rigctld"\nport = {rigctld.port}\nenabled = true\n'
+        "[[satellites.channels]]\ncatalog_number = 25544\nname = \"ISS beacon\"\ndownlink_hz = 145800000\n"
+    )
+    assert config.channels[25544].uplink_hz is None and 27607 in config.channels
+    station = Station(config, SystemClock(), transport=FakeDdeSystem().server_transport())
+    station.start()
+    try:
+        for _ in range(300):  # bounded: the publisher ticks at 5 Hz and the radio worker follows
+            if station.radio.last_result is not None:
+                break
+            time.sleep(0.01)
+    finally:
+        station.stop()
+    result = station.radio.last_result
+    assert result is not None and abs(result.rx_hz - 145_800_000) < 145_800_000 * 8 / 299792.458
+    assert int(rigctld.query("f")[0]) == result.rx_hz
