@@ -1,0 +1,1 @@
+"""Rotor layer: the Kansas City Tracker driver model, rotor geometry and flip tracking, backends."""

@@ -1,0 +1,184 @@
+"""Autotracking (OrbitDRV's role): turn the server's ticks into rotor targets.
+
+On every tick with ``TRACK ON``, :meth:`RotorCoupling.process`:
+
+- at AOS, plans the whole pass once (:func:`nfwserver.rotor.flip.plan_pass`): normal or flipped
+  pointing and the azimuth branch that keeps the pass inside the rotor's range; it never changes
+  the plan mid-pass;
+- while the satellite is up, aims ahead of it by the rotor's travel time (so the antennas are where
+  the satellite will be when they arrive) and sends a new target only when it moved by at least
+  ``threshold_deg`` (relays wear out);
+- after LOS, parks (the driver's parking timer, or at once when the delay is 0) or pre-positions
+  to the next pass's AOS, as configured;
+- lets the driver run its clock duties and reads the rotor back, reporting the sky position the
+  antennas point at through ``on_position`` (the server's ``report_antenna_position``).
+
+It takes plain callables for the tracking engine, so it does not depend on the DDE core:
+``predict(when) -> (az, el)`` and ``pass_track(when) -> [(when, az, el), ...]`` for the pass in
+progress or the next one (from its AOS or from ``when``, to its LOS), or None.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+from collections.abc import Callable, Sequence
+from datetime import datetime, timedelta
+
+from nfwserver.dde.session import TickSample
+from nfwserver.rotor.flip import PassPlan, flip, plan_pass
+from nfwserver.rotor.geometry import unwrap
+from nfwserver.rotor.kct_driver import KctDriver
+
+log = logging.getLogger(__name__)
+
+Predict = Callable[[datetime], tuple[float, float] | None]
+PassTrack = Callable[[datetime], Sequence[tuple[datetime, float, float]] | None]
+AFTER_LOS = ("park", "next-aos", "stay")
+FLIP_MODES = ("auto", "off")
+
+
+def angular_distance(az1: float, el1: float, az2: float, el2: float) -> float:
+    """Great-circle angle (deg) between two sky directions."""
+    a1, e1, a2, e2 = map(math.radians, (az1, el1, az2, el2))
+    c = math.sin(e1) * math.sin(e2) + math.cos(e1) * math.cos(e2) * math.cos(a1 - a2)
+    return math.degrees(math.acos(min(1.0, max(-1.0, c))))
+
+
+def sky_from_rotor(rotor_az: float, rotor_el: float) -> tuple[float, float]:
+    """Sky (az, el) a rotor position points at (elevation beyond 90 means flipped)."""
+    if rotor_el > 90.0:
+        return (rotor_az + 180.0) % 360.0, 180.0 - rotor_el
+    return rotor_az % 360.0, rotor_el
+
+
+class RotorCoupling:
+    """Drives ``driver`` from ticks; see the module docstring."""
+
+    def __init__(self, driver: KctDriver, predict: Predict, pass_track: PassTrack, threshold_deg: float = 2.0,
+                 speed_deg_s: float = 6.0, max_lead_s: float = 10.0, after_los: str = "park", flip_mode: str = "auto",
+                 on_position: Callable[[float, float], None] | None = None) -> None:
+        if after_los not in AFTER_LOS or flip_mode not in FLIP_MODES:
+            raise ValueError(f"after_los must be one of {AFTER_LOS} and flip_mode one of {FLIP_MODES}")
+        if threshold_deg < 0 or speed_deg_s <= 0 or max_lead_s < 0:
+            raise ValueError("threshold must be >= 0, speed > 0 and max lead >= 0")
+        self.driver = driver
+        self.predict = predict
+        self.pass_track = pass_track
+        self.threshold_deg = threshold_deg
+        self.speed_deg_s = speed_deg_s
+        self.max_lead_s = max_lead_s
+        self.after_los = after_los
+        self.flip_mode = flip_mode
+        self.on_position = on_position
+        self.plan: PassPlan | None = None
+        self.flip_state = False
+        self._sent: tuple[float, float] | None = None  # sky (az, el) of the last target sent
+        self._pending: TickSample | None = None
+        self._wake = threading.Event()
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    # -- planning --------------------------------------------------------------------------
+    def _plan(self, track: Sequence[tuple[datetime, float, float]]) -> PassPlan:
+        geometry = self.driver.geometry
+        sky = [(az, el) for _, az, el in track]
+        if self.flip_mode == "off":
+            plan = plan_pass(type(geometry)(geometry.az_min, geometry.az_max, geometry.el_min,
+                                            min(geometry.el_max, 90.0)), sky)
+        else:
+            plan = plan_pass(geometry, sky)
+        if not plan.fits:
+            log.warning("this pass does not fit the rotor's range in any mode; following it as far as the stops allow")
+        if sky:
+            azs = [flip(az, el)[0] if plan.flipped else az for az, el in sky]
+            self.driver.set_reference_azimuth(unwrap(azs)[0] + plan.offset_deg if plan.fits else azs[0])
+        return plan
+
+    def _start_pass(self, when: datetime) -> None:
+        track = self.pass_track(when) or []
+        self.plan = self._plan(track)
+        self.flip_state = self.plan.flipped
+        self._sent = None
+        self.driver.stop_parking_timer()
+        log.info("AOS: pass planned %s", "flipped" if self.plan.flipped else "normal")
+
+    def _end_pass(self, when: datetime) -> None:
+        self.plan = None
+        if self.after_los == "park":
+            params = self.driver.parking_parameters()
+            if params.delay_minutes > 0:
+                self.driver.start_parking_timer()
+            else:
+                self.driver.set_target(params.elevation_deg, params.azimuth_deg)
+        elif self.after_los == "next-aos":
+            track = self.pass_track(when + timedelta(seconds=1))
+            if track:
+                plan = self._plan(track)
+                _, az, el = track[0]
+                az_k, el_k = flip(az, el) if plan.flipped else (az, max(el, 0.0))
+                self.driver.set_target(el_k, az_k)
+
+    # -- per tick --------------------------------------------------------------------------
+    def process(self, sample: TickSample) -> None:
+        """One tick's work (the worker's step; tests call it directly)."""
+        la = sample.look_angles
+        if sample.track_on and la is not None:
+            if sample.above_horizon:
+                if self.plan is None:
+                    self._start_pass(sample.time)
+                az, el = self._aim(sample.time, la.azimuth_deg, la.elevation_deg)
+                if self._sent is None or angular_distance(az, el, *self._sent) >= self.threshold_deg:
+                    az_k, el_k = flip(az, el) if self.plan and self.plan.flipped else (az % 360.0, el)
+                    if self.driver.set_target(el_k, az_k):
+                        self._sent = (az, el)
+            elif self.plan is not None:
+                self._end_pass(sample.time)
+        self.driver.service()
+        pos = self.driver.rotor_position()
+        if pos is not None and self.on_position is not None:
+            self.on_position(*sky_from_rotor(*pos))
+
+    def _aim(self, when: datetime, az: float, el: float) -> tuple[float, float]:
+        """Where to point: the satellite's position one rotor travel time ahead."""
+        pos = self.driver.rotor_position()
+        if pos is None or self.max_lead_s == 0:
+            return az, el
+        travel = angular_distance(az, el, *sky_from_rotor(*pos)) / self.speed_deg_s
+        lead = min(self.max_lead_s, travel)
+        if lead < 0.5:
+            return az, el
+        ahead = self.predict(when + timedelta(seconds=lead))
+        return ahead if ahead is not None else (az, el)
+
+    # -- worker ------------------------------------------------------------------------------
+    def on_tick(self, sample: TickSample) -> None:
+        """Tick listener: remember the newest sample (never blocks the publisher)."""
+        self._pending = sample
+        self._wake.set()
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            self._wake.wait(0.5)
+            self._wake.clear()
+            sample, self._pending = self._pending, None
+            if sample is not None:
+                try:
+                    self.process(sample)
+                except Exception:
+                    log.exception("rotor tracking failed")
+
+    def start(self) -> None:
+        if self._thread is None:
+            self._stop.clear()
+            self._thread = threading.Thread(target=self._run, name="nfw-rotor", daemon=True)
+            self._thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._wake.set()
+        if self._thread is not None:
+            self._thread.join(5.0)
+            self._thread = None
+        self.driver.backend.close()
