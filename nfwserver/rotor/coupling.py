@@ -84,11 +84,13 @@ class RotorCoupling:
     def _plan(self, track: Sequence[tuple[datetime, float, float]]) -> PassPlan:
         geometry = self.driver.geometry
         sky = [(az, el) for _, az, el in track]
+        pos = self.driver.rotor_position()
+        current = pos[0] if pos is not None else None
         if self.flip_mode == "off":
             plan = plan_pass(type(geometry)(geometry.az_min, geometry.az_max, geometry.el_min,
-                                            min(geometry.el_max, 90.0)), sky)
+                                            min(geometry.el_max, 90.0)), sky, current)
         else:
-            plan = plan_pass(geometry, sky)
+            plan = plan_pass(geometry, sky, current)
         if not plan.fits:
             log.warning("this pass does not fit the rotor's range in any mode; following it as far as the stops allow")
         if sky:

@@ -46,13 +46,18 @@ class PassPlan:
         return rotor_az, geometry.clamp_elevation(el)
 
 
-def plan_pass(geometry: RotorGeometry, track: Sequence[tuple[float, float]]) -> PassPlan:
-    """Choose normal or flipped pointing for a pass given as sky (az, el) samples from AOS to LOS."""
-    normal = fit_track(geometry, [az for az, _ in track])
+def plan_pass(geometry: RotorGeometry, track: Sequence[tuple[float, float]],
+              current_rotor_az: float | None = None) -> PassPlan:
+    """Choose normal or flipped pointing for a pass given as sky (az, el) samples from AOS to LOS.
+
+    ``current_rotor_az`` (rotor frame) picks, among equivalent azimuth branches, the one closest to
+    where the rotor is, so the move to AOS is shortest.
+    """
+    normal = fit_track(geometry, [az for az, _ in track], current_rotor_az)
     if normal is not None:
         return PassPlan(False, normal, True)
     if geometry.can_flip:
-        flipped = fit_track(geometry, [flip(az, el)[0] for az, el in track])
+        flipped = fit_track(geometry, [flip(az, el)[0] for az, el in track], current_rotor_az)
         if flipped is not None:
             return PassPlan(True, flipped, True)
     return PassPlan(False, 0.0, False)

@@ -77,10 +77,11 @@ def unwrap(azimuths: Sequence[float]) -> list[float]:
     return out
 
 
-def fit_track(geometry: RotorGeometry, sky_azimuths: Sequence[float]) -> float | None:
+def fit_track(geometry: RotorGeometry, sky_azimuths: Sequence[float], current: float | None = None) -> float | None:
     """Offset (a multiple of 360) placing the whole continuous track inside the azimuth range, or None.
 
-    Among feasible offsets, the one whose track starts nearest the middle of the range is chosen.
+    Among feasible offsets, the one whose track starts nearest ``current`` (the rotor's azimuth,
+    so the move to AOS is shortest) is chosen, or nearest the middle of the range if unknown.
     """
     if not sky_azimuths:
         return 0.0
@@ -90,5 +91,5 @@ def fit_track(geometry: RotorGeometry, sky_azimuths: Sequence[float]) -> float |
     k_hi = math.floor((geometry.az_max - hi) / 360.0 + 1e-12)
     if k_lo > k_hi:
         return None
-    middle = 0.5 * (geometry.az_min + geometry.az_max)
-    return 360.0 * min(range(k_lo, k_hi + 1), key=lambda k: abs(track[0] + 360.0 * k - middle))
+    anchor = 0.5 * (geometry.az_min + geometry.az_max) if current is None else current
+    return 360.0 * min(range(k_lo, k_hi + 1), key=lambda k: abs(track[0] + 360.0 * k - anchor))

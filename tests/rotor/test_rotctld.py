@@ -1,0 +1,116 @@
+"""Autotracking against real ``rotctld -m 1`` daemons (the dummy rotor moves at 6 deg/s in real time)."""
+
+from __future__ import annotations
+
+import logging
+import time
+from datetime import timedelta
+
+import pytest
+
+from nfwserver.clock import VirtualClock
+from nfwserver.dde.publisher import run_virtual
+from nfwserver.dde.server import NovaServer
+from nfwserver.rotor.backend import RotorError
+from nfwserver.rotor.coupling import RotorCoupling
+from nfwserver.rotor.geometry import RotorGeometry
+from nfwserver.rotor.kct_driver import KctDriver
+from nfwserver.rotor.kct_status import KctStatusBit
+from nfwserver.rotor.rotctld_backend import RotctldBackend
+from nfwserver.rotor.tracks import SatelliteTracks
+from tests.dde.conftest import CATALOG, OBSERVER
+from tests.hamlib_daemons import HamlibDaemon
+from tests.rotor.test_autotracking import _pass_crossing_north
+
+pytestmark = pytest.mark.hamlib
+CATNR, CROSSING = _pass_crossing_north()
+
+
+def _tracking(daemon: HamlibDaemon, geometry: RotorGeometry, start, **kwargs):
+    clock = VirtualClock(start)
+    server = NovaServer(CATALOG, OBSERVER, clock, satellite=CATNR, rate_hz=5)
+    backend = RotctldBackend(clock, geometry, port=daemon.port, timeout_s=0.5)
+    driver = KctDriver(clock, backend, geometry)
+    tracks = SatelliteTracks(lambda: CATALOG.get(CATNR).satrec, OBSERVER)
+    coupling = RotorCoupling(driver, tracks.predict, tracks.pass_track, threshold_deg=2.0, **kwargs)
+    server.add_tick_listener(coupling.process)
+    server.command("TRACK ON")
+    return clock, server, driver, coupling
+
+
+def _north_crossing_time():
+    track = SatelliteTracks(lambda: CATALOG.get(CATNR).satrec, OBSERVER, step_s=1.0).pass_track(CROSSING.aos)
+    for (t, a, _), (_, b, _) in zip(track, track[1:]):
+        if abs(a - b) > 180:
+            return t
+    raise AssertionError("no crossing")
+
+
+def test_a_real_pass_segment_is_followed_by_the_dummy_rotor() -> None:
+    geometry = RotorGeometry(-180.0, 450.0, 0.0, 90.0)  # rotctld's default limits for the dummy
+    with HamlibDaemon("rotctld") as daemon:
+        crossing = _north_crossing_time()
+        clock, server, driver, coupling = _tracking(daemon, geometry, crossing - timedelta(seconds=4),
+                                                    max_lead_s=0.0)
+        for _ in range(8):  # 8 s of the pass around the north crossing, one tick per real 0.1 s
+            run_virtual(server, clock, 0.8)
+            time.sleep(0.1)
+        target_el, target_az = driver.positions()[2:]
+        deadline = time.monotonic() + 12.0  # bounded wait for the 6 deg/s dummy to arrive
+        while time.monotonic() < deadline:
+            az, el = (float(v) for v in daemon.query("p", 2))
+            if abs(((az - target_az) + 180) % 360 - 180) < 1.0 and abs(el - target_el) < 1.0:
+                break
+            time.sleep(0.2)
+        assert abs(((az - target_az) + 180) % 360 - 180) < 1.0 and abs(el - target_el) < 1.0
+        assert -180.0 <= az <= 450.0
+        assert abs(az) < 60  # crossed north near 0 on the short branch, not by a swing to 360
+        assert not driver.status().bits & KctStatusBit.CARD_ABSENT
+
+
+@pytest.mark.parametrize(
+    ("conf", "geometry", "flipped"),
+    [("min_az=0,max_az=450,min_el=0,max_el=90", RotorGeometry(0.0, 450.0, 0.0, 90.0), False),
+     ("min_az=0,max_az=360,min_el=0,max_el=180", RotorGeometry(0.0, 360.0, 0.0, 180.0), True)],
+)
+def test_whole_pass_commands_stay_inside_the_daemons_limits(conf, geometry, flipped, caplog) -> None:
+    caplog.set_level(logging.WARNING)
+    with HamlibDaemon("rotctld", extra=[f"--set-conf={conf}"]) as daemon:
+        clock, server, driver, coupling = _tracking(daemon, geometry, CROSSING.aos - timedelta(seconds=10),
+                                                    after_los="stay")
+        sent = []
+        original = driver.backend.set_position
+
+        def spy(az: float, el: float) -> None:
+            original(az, el)  # raises RotorError if the daemon refuses (RPRT -1 when out of its limits)
+            sent.append((az, el))
+
+        driver.backend.set_position = spy
+        run_virtual(server, clock, (CROSSING.los - CROSSING.aos).total_seconds() + 20)
+        assert coupling.flip_state is flipped
+        assert len(sent) > 10
+        assert all(geometry.az_min <= az <= geometry.az_max and geometry.el_min <= el <= geometry.el_max
+                   for az, el in sent)
+        assert not [r for r in caplog.records if "refused" in r.getMessage()]
+        with pytest.raises(RotorError):  # and the daemon does enforce those limits
+            original(geometry.az_max + 5.0, 10.0)
+
+
+def test_daemon_killed_and_restarted_mid_pass() -> None:
+    geometry = RotorGeometry(-180.0, 450.0, 0.0, 90.0)
+    with HamlibDaemon("rotctld") as daemon:
+        clock, server, driver, coupling = _tracking(daemon, geometry, CROSSING.aos)
+        duration = (CROSSING.los - CROSSING.aos).total_seconds()
+        run_virtual(server, clock, duration / 3)
+        assert driver.rotor_position() is not None
+        daemon.kill()
+        run_virtual(server, clock, 20)
+        assert driver.status().bits & KctStatusBit.CARD_ABSENT  # the tick loop went on regardless
+        daemon.start()
+        run_virtual(server, clock, 30)  # back-off retries on the (virtual) clock
+        assert not driver.status().bits & KctStatusBit.CARD_ABSENT
+        target_el, target_az = driver.positions()[2:]
+        assert driver.backend.connection.reconnects >= 1
+        az, el = (float(v) for v in daemon.query("p", 2))
+        assert -180 <= az <= 450 and 0 <= el <= 90
+        assert target_el is not None and target_az is not None
