@@ -16,6 +16,13 @@ from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.radio.rigctld_backend import RigctldBackend
 from nfwserver.radio.tuning import DopplerTuner
+from nfwserver.rotor.backend import RotorBackend
+from nfwserver.rotor.coupling import RotorCoupling
+from nfwserver.rotor.geometry import RotorGeometry
+from nfwserver.rotor.kct_driver import KctDriver
+from nfwserver.rotor.rotctld_backend import RotctldBackend
+from nfwserver.rotor.sim_backend import SimulatedRotor
+from nfwserver.rotor.tracks import SatelliteTracks
 from nfwserver.tracking.catalog import Catalog, UpdateSummary
 
 log = logging.getLogger(__name__)
@@ -62,6 +69,7 @@ class Station:
             self.transport_note = "serving on the given transport"
         self.transport = transport
         self.publisher = Publisher(self.server, clock)
+        self.rotor: RotorCoupling | None = self._make_rotor(config, clock)
         self.radio: RadioCoupling | None = None
         if config.radio.backend == "rigctld":
             backend = RigctldBackend(clock, config.radio.host, config.radio.port)
@@ -73,6 +81,33 @@ class Station:
         self._stop = threading.Event()
         self._refresher: threading.Thread | None = None
         self._started = False
+
+    def _make_rotor(self, config: Config, clock: Clock) -> RotorCoupling | None:
+        rc = config.rotor
+        if rc.backend == "none":
+            return None
+        geometry = RotorGeometry.preset(rc.geometry)
+        backend: RotorBackend
+        if rc.backend == "sim":
+            backend = SimulatedRotor(clock, geometry, rc.speed_deg_s, rc.speed_deg_s)
+        else:
+            backend = RotctldBackend(clock, geometry, rc.host, rc.port)
+        driver = KctDriver(clock, backend, geometry)
+        driver.set_parking(rc.park_delay_minutes, rc.park_azimuth_deg, rc.park_elevation_deg)
+
+        def satrec_now():
+            number = self.server.snapshot().catalog_number
+            sat = self.catalog.get(number) if number is not None else None
+            return sat.satrec if sat is not None else None
+
+        tracks = SatelliteTracks(satrec_now, config.observer, config.horizon, config.server.ut1_utc_s)
+        coupling = RotorCoupling(
+            driver, tracks.predict, tracks.pass_track, rc.threshold_deg, rc.speed_deg_s, rc.max_lead_s,
+            rc.after_los, rc.flip,
+            on_position=lambda az, el: self.server.report_antenna_position(az, el, "rotor"),
+        )
+        self.server.add_tick_listener(coupling.on_tick)
+        return coupling
 
     @staticmethod
     def _report(fetched: FetchResult) -> None:
@@ -105,6 +140,8 @@ class Station:
         self.server.attach(self.transport)
         if self.radio is not None:
             self.radio.start()
+        if self.rotor is not None:
+            self.rotor.start()
         self.publisher.start()
         if self.config.elements.refresh_hours > 0 and (self.config.elements.files or self.config.elements.urls):
             self._refresher = threading.Thread(target=self._refresh_loop, name="nfw-elements", daemon=True)
@@ -118,6 +155,8 @@ class Station:
         self.publisher.stop()
         if self.radio is not None:
             self.radio.stop()
+        if self.rotor is not None:
+            self.rotor.stop()
         self.server.detach()
         try:
             self.transport.close()

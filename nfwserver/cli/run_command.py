@@ -78,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
         if console:
             from nfwserver.console.app import NfwConsole
 
-            app = NfwConsole(station.server, station.transport_note, hint, radio=station.radio)
+            app = NfwConsole(station.server, station.transport_note, hint, radio=station.radio, rotor=station.rotor)
             if args.duration:
                 threading.Timer(args.duration, app.exit).start()
             app.run()

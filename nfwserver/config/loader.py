@@ -12,9 +12,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from nfwserver.config.schema import Config, ElementsConfig, RadioConfig, ServerConfig
+from nfwserver.config.schema import Config, ElementsConfig, RadioConfig, RotorConfig, ServerConfig
 from nfwserver.radio.defaults import DEFAULT_CHANNELS
 from nfwserver.radio.transponder import Channel
+from nfwserver.rotor.geometry import RotorGeometry
 from nfwserver.tracking.dde_names import validate_dde_name
 from nfwserver.tracking.horizon import HorizonTable, load_horizon
 from nfwserver.tracking.observer import Observer, parse_observer
@@ -82,7 +83,7 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
         raise ConfigError(source, [f"not valid TOML ({exc})"]) from None
     c = _Checker(source)
     for key in doc:
-        if key not in {"observer", "horizon", "elements", "server", "satellites", "radio"}:
+        if key not in {"observer", "horizon", "elements", "server", "satellites", "radio", "rotor"}:
             c.problems.append(f"[{key}]: unknown section")
     base = base_dir or Path(".")
 
@@ -205,6 +206,35 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
         except ValueError as exc:
             c.problems.append(f"{where}: {exc}")
 
+    # [rotor]
+    ro_t = c.table(doc, "rotor", {"backend", "host", "port", "geometry", "threshold_deg", "speed_deg_s", "max_lead_s",
+                                  "after_los", "flip", "park_azimuth_deg", "park_elevation_deg",
+                                  "park_delay_minutes"})
+    ro_backend = ro_t.get("backend", "none")
+    if ro_backend not in ("none", "sim", "rotctld"):
+        c.problems.append("[rotor] backend: must be \"none\", \"sim\" or \"rotctld\"")
+    ro_host = ro_t.get("host", "127.0.0.1")
+    if not isinstance(ro_host, str) or not ro_host:
+        c.problems.append("[rotor] host: must be a host name or address")
+    ro_geometry = ro_t.get("geometry", "north-stop")
+    try:
+        RotorGeometry.preset(str(ro_geometry))
+    except ValueError:
+        c.problems.append("[rotor] geometry: must be north-stop, south-stop or overlap-450, optionally with +flip")
+    ro_port = c.number("rotor", "port", ro_t.get("port", 4533), 1, 65535)
+    ro_threshold = c.number("rotor", "threshold_deg", ro_t.get("threshold_deg", 2.0), 0, 45)
+    ro_speed = c.number("rotor", "speed_deg_s", ro_t.get("speed_deg_s", 6.0), 0.1, 90)
+    ro_lead = c.number("rotor", "max_lead_s", ro_t.get("max_lead_s", 10.0), 0, 120)
+    after_los = ro_t.get("after_los", "park")
+    if after_los not in ("park", "next-aos", "stay"):
+        c.problems.append("[rotor] after_los: must be \"park\", \"next-aos\" or \"stay\"")
+    flip_mode = ro_t.get("flip", "auto")
+    if flip_mode not in ("auto", "off"):
+        c.problems.append("[rotor] flip: must be \"auto\" or \"off\"")
+    park_az = c.number("rotor", "park_azimuth_deg", ro_t.get("park_azimuth_deg", 0), 0, 359)
+    park_el = c.number("rotor", "park_elevation_deg", ro_t.get("park_elevation_deg", 0), 0, 90)
+    park_delay = c.number("rotor", "park_delay_minutes", ro_t.get("park_delay_minutes", 0), 0, 60)
+
     if c.problems:
         raise ConfigError(source, c.problems)
     return Config(
@@ -214,6 +244,10 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
         dde_names=names, favourites=tuple(favourites), source=source,
         radio=RadioConfig(str(backend), str(host), int(port or 4532), step or 10.0, knob or 100.0, bool(radio_enabled)),
         channels=channels,
+        rotor=RotorConfig(str(ro_backend), str(ro_host), int(ro_port or 4533), str(ro_geometry),
+                          ro_threshold if ro_threshold is not None else 2.0, ro_speed or 6.0,
+                          ro_lead if ro_lead is not None else 10.0, str(after_los), str(flip_mode),
+                          int(park_az or 0), int(park_el or 0), int(park_delay or 0)),
     )
 
 
@@ -287,4 +321,19 @@ port = 4532
 step_hz = 10                    # send a new frequency only after it moved this much
 knob_tolerance_hz = 100         # a bigger difference on read-back means the operator retuned
 enabled = false                 # Doppler tuning on at start (Ctrl+D in the console toggles it)
+
+[rotor]
+backend = "none"                # "rotctld" (Hamlib) or "sim" (a simulated rotor, for trying things out)
+host = "127.0.0.1"
+port = 4533
+geometry = "north-stop"         # north-stop (0..360), south-stop (-180..180), overlap-450; add "+flip"
+                                # when the elevation rotor reaches 180 (FlipAnts-style inverted passes)
+threshold_deg = 2               # move only when the target moved this much (relays wear out)
+speed_deg_s = 6                 # rotor speed, used to aim ahead by the travel time
+max_lead_s = 10
+after_los = "park"              # "park", "next-aos" (pre-position for the next pass) or "stay"
+flip = "auto"                   # "auto": decided at AOS for the whole pass; "off"
+park_azimuth_deg = 0
+park_elevation_deg = 0
+park_delay_minutes = 0          # 0 = park at once after LOS
 """

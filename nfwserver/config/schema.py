@@ -41,6 +41,22 @@ class RadioConfig:
 
 
 @dataclass(frozen=True)
+class RotorConfig:
+    backend: str = "none"  #: "none", "sim" or "rotctld"
+    host: str = "127.0.0.1"
+    port: int = 4533
+    geometry: str = "north-stop"  #: a RotorGeometry preset, optionally "+flip"
+    threshold_deg: float = 2.0
+    speed_deg_s: float = 6.0
+    max_lead_s: float = 10.0
+    after_los: str = "park"  #: "park", "next-aos" or "stay"
+    flip: str = "auto"  #: "auto" or "off"
+    park_azimuth_deg: int = 0
+    park_elevation_deg: int = 0
+    park_delay_minutes: int = 0
+
+
+@dataclass(frozen=True)
 class Config:
     observer: Observer = DEFAULT_OBSERVER
     observer_configured: bool = False
@@ -50,5 +66,6 @@ class Config:
     dde_names: dict[int, str] = field(default_factory=dict)  #: catalog number -> DDE name override
     favourites: tuple[int, ...] = ()  #: satellites whose passes the console lists
     radio: RadioConfig = field(default_factory=RadioConfig)
+    rotor: RotorConfig = field(default_factory=RotorConfig)
     channels: dict[int, Channel] = field(default_factory=dict)  #: catalog number -> radio channel
     source: str = "<built-in defaults>"

@@ -27,6 +27,7 @@ from nfwserver.dde.protocol import escape_for_log
 from nfwserver.dde.server import NovaServer
 from nfwserver.dde.status import describe
 from nfwserver.radio.coupling import RadioCoupling
+from nfwserver.rotor.coupling import RotorCoupling
 from nfwserver.tracking.passes import Pass, find_passes
 
 
@@ -53,10 +54,11 @@ class NfwConsole(App):
     ]
 
     def __init__(self, server: NovaServer, transport_note: str = "", hint: str = "",
-                 radio: RadioCoupling | None = None) -> None:
+                 radio: RadioCoupling | None = None, rotor: RotorCoupling | None = None) -> None:
         super().__init__()
         self.server = server
         self.radio = radio
+        self.rotor = rotor
         self.transport_note = transport_note
         self.hint = hint
         self._queue: collections.deque[Event] = collections.deque(maxlen=2000)
@@ -154,6 +156,15 @@ class NfwConsole(App):
         else:
             pass_text = "no pass in the next 24 h"
         lines.append(f"Antenna {ant_text}   next pass: {pass_text}")
+        if self.rotor is not None:
+            driver = self.rotor.driver
+            _, _, tgt_el, tgt_az = driver.positions()
+            pos = driver.rotor_position()
+            bits = driver.status().bits
+            target = f"{tgt_az:.1f}/{tgt_el:.1f}" if tgt_az is not None else "-"
+            actual = f"{pos[0]:.1f}/{pos[1]:.1f}" if pos is not None else "unreachable"
+            lines.append(f"Rotor: target {target}  actual {actual}  flip {'ON' if self.rotor.flip_state else 'off'}"
+                         f"  KCT status 0x{int(bits):02X}")
         if self.radio is not None:
             r = self.radio.last_result
             state = "ON" if self.radio.enabled else "OFF"

@@ -46,7 +46,7 @@ def test_a_full_file(tmp_path) -> None:
         ("[horizon]\nfile = 'missing.txt'\n", "[horizon] file"),
         ("[elements]\nurls = ['ftp://x']\n", "[elements] urls"),
         ("[satellites]\nnames = { 25544 = 'TWO WORDS' }\n", "[satellites] names.25544"),
-        ("[rotor]\n", "[rotor]: unknown section"),
+        ("[antenna]\n", "[antenna]: unknown section"),
         ("this is not toml", "not valid TOML"),
     ],
 )

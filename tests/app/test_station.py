@@ -113,3 +113,32 @@ def test_station_tunes_a_real_rigctld_when_configured(rigctld, tmp_path) -> None
     result = station.radio.last_result
     assert result is not None and abs(result.rx_hz - 145_800_000) < 145_800_000 * 8 / 299792.458
     assert int(rigctld.query("f")[0]) == result.rx_hz
+
+
+def test_station_with_a_simulated_rotor_reports_the_antenna_position() -> None:
+    from nfwserver.clock import VirtualClock
+    from nfwserver.dde.publisher import run_virtual
+    from tests.dde.conftest import ISS_PASS
+
+    config = parse_config('[observer]\nlocation = "52.2053,0.1218,20"\n[rotor]\nbackend = "sim"\n'
+                          'geometry = "overlap-450"\nafter_los = "stay"\n')
+    clock = VirtualClock(ISS_PASS.tca)
+    station = Station(config, clock, transport=FakeDdeSystem().server_transport())
+    station.server.command("TRACK ON")
+    station.server.add_tick_listener(station.rotor.process)  # synchronous here: no worker on virtual time
+    run_virtual(station.server, clock, 60)
+    antenna = station.server.snapshot().antenna
+    la = station.server.snapshot().last_sample.look_angles
+    assert antenna.source == "rotor"
+    assert abs(((antenna.azimuth_deg - la.azimuth_deg) + 180) % 360 - 180) < 15
+    assert station.rotor.plan is not None
+
+
+def test_rotor_config_errors_name_the_key() -> None:
+    from nfwserver.config import ConfigError
+
+    with pytest.raises(ConfigError) as info:
+        parse_config('[rotor]\nbackend = "serial"\ngeometry = "round"\nthreshold_deg = 90\nafter_los = "sleep"\n')
+    text = str(info.value)
+    for key in ("[rotor] backend", "[rotor] geometry", "[rotor] threshold_deg", "[rotor] after_los"):
+        assert key in text
