@@ -11,6 +11,7 @@ import os
 import shutil
 import socket
 import subprocess
+import sys
 import time
 
 import pytest
@@ -27,7 +28,7 @@ def require_program(name: str) -> str:
     """Path of ``name``; skip the test if it is missing, except under CI where it must be there."""
     path = shutil.which(name)
     if path is None:
-        if os.environ.get("CI"):
+        if os.environ.get("CI") and sys.platform.startswith("linux"):
             pytest.fail(f"{name} is not installed (CI must install libhamlib-utils)")
         pytest.skip(f"{name} not installed (apt-get install libhamlib-utils)")
     return path

@@ -1,0 +1,104 @@
+"""The parts of Windows' DDE Management Library (user32) nfwserver uses, declared with ctypes.
+
+Importable on any OS: the constants are plain numbers, and :func:`load_user32` binds the
+functions only when called on Windows.  Values are those of ``ddeml.h``.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import sys
+
+# Transaction classes and flags.
+XCLASS_BOOL = 0x1000
+XCLASS_DATA = 0x2000
+XCLASS_FLAGS = 0x4000
+XCLASS_NOTIFICATION = 0x8000
+XTYPF_NOBLOCK = 0x0002
+XTYPF_NODATA = 0x0004
+XTYPF_ACKREQ = 0x0008
+
+# Transaction types.
+XTYP_ERROR = 0x0000 | XCLASS_NOTIFICATION | XTYPF_NOBLOCK
+XTYP_ADVDATA = 0x0010 | XCLASS_FLAGS
+XTYP_ADVREQ = 0x0020 | XCLASS_DATA | XTYPF_NOBLOCK
+XTYP_ADVSTART = 0x0030 | XCLASS_BOOL
+XTYP_ADVSTOP = 0x0040 | XCLASS_NOTIFICATION
+XTYP_EXECUTE = 0x0050 | XCLASS_FLAGS
+XTYP_CONNECT = 0x0060 | XCLASS_BOOL | XTYPF_NOBLOCK
+XTYP_CONNECT_CONFIRM = 0x0070 | XCLASS_NOTIFICATION | XTYPF_NOBLOCK
+XTYP_XACT_COMPLETE = 0x0080 | XCLASS_NOTIFICATION
+XTYP_POKE = 0x0090 | XCLASS_FLAGS
+XTYP_REGISTER = 0x00A0 | XCLASS_NOTIFICATION | XTYPF_NOBLOCK
+XTYP_REQUEST = 0x00B0 | XCLASS_DATA
+XTYP_DISCONNECT = 0x00C0 | XCLASS_NOTIFICATION | XTYPF_NOBLOCK
+XTYP_UNREGISTER = 0x00D0 | XCLASS_NOTIFICATION | XTYPF_NOBLOCK
+XTYP_WILDCONNECT = 0x00E0 | XCLASS_DATA | XTYPF_NOBLOCK
+XTYP_MASK = 0x00F0
+
+# DdeInitialize flags.
+APPCLASS_STANDARD = 0x00000000
+APPCMD_CLIENTONLY = 0x00000010
+CBF_FAIL_SELFCONNECTIONS = 0x00001000
+CBF_SKIP_REGISTRATIONS = 0x00080000
+CBF_SKIP_UNREGISTRATIONS = 0x00100000
+
+# DdeNameService.
+DNS_REGISTER = 0x0001
+DNS_UNREGISTER = 0x0002
+
+# Acknowledgement flags for pokes and executes.
+DDE_FACK = 0x8000
+DDE_FBUSY = 0x4000
+DDE_FNOTPROCESSED = 0x0000
+
+CP_WINUNICODE = 1200
+DMLERR_NO_ERROR = 0
+TIMEOUT_ASYNC = 0xFFFFFFFF
+WM_APP = 0x8000
+
+#: DDEML callback: HDDEDATA CALLBACK(UINT uType, UINT uFmt, HCONV, HSZ, HSZ, HDDEDATA, ULONG_PTR, ULONG_PTR)
+if sys.platform == "win32":  # pragma: no cover - Windows only
+    CALLBACK_TYPE = ctypes.WINFUNCTYPE(ctypes.c_void_p, ctypes.c_uint, ctypes.c_uint, ctypes.c_void_p,
+                                       ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t,
+                                       ctypes.c_size_t)
+else:
+    CALLBACK_TYPE = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_uint, ctypes.c_uint, ctypes.c_void_p,
+                                     ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t,
+                                     ctypes.c_size_t)
+
+
+def load_user32():  # pragma: no cover - Windows only
+    """user32 with the DDEML prototypes set; raises OSError off Windows."""
+    if sys.platform != "win32":
+        raise OSError("DDEML exists only on Windows")
+    from ctypes import wintypes
+
+    u = ctypes.WinDLL("user32", use_last_error=True)
+    DWORD, UINT, HANDLE, LPVOID = wintypes.DWORD, wintypes.UINT, ctypes.c_void_p, ctypes.c_void_p
+
+    def proto(name, res, *args):
+        fn = getattr(u, name)
+        fn.restype, fn.argtypes = res, list(args)
+        return fn
+
+    proto("DdeInitializeW", UINT, ctypes.POINTER(DWORD), CALLBACK_TYPE, DWORD, DWORD)
+    proto("DdeUninitialize", wintypes.BOOL, DWORD)
+    proto("DdeCreateStringHandleW", HANDLE, DWORD, wintypes.LPCWSTR, ctypes.c_int)
+    proto("DdeFreeStringHandle", wintypes.BOOL, DWORD, HANDLE)
+    proto("DdeQueryStringW", DWORD, DWORD, HANDLE, wintypes.LPWSTR, DWORD, ctypes.c_int)
+    proto("DdeNameService", HANDLE, DWORD, HANDLE, HANDLE, UINT)
+    proto("DdeCreateDataHandle", HANDLE, DWORD, LPVOID, DWORD, DWORD, HANDLE, UINT, UINT)
+    proto("DdeGetData", DWORD, HANDLE, LPVOID, DWORD, DWORD)
+    proto("DdeFreeDataHandle", wintypes.BOOL, HANDLE)
+    proto("DdePostAdvise", wintypes.BOOL, DWORD, HANDLE, HANDLE)
+    proto("DdeGetLastError", UINT, DWORD)
+    proto("DdeConnect", HANDLE, DWORD, HANDLE, HANDLE, LPVOID)
+    proto("DdeDisconnect", wintypes.BOOL, HANDLE)
+    proto("DdeClientTransaction", HANDLE, LPVOID, DWORD, HANDLE, HANDLE, UINT, UINT, DWORD, ctypes.POINTER(DWORD))
+    proto("GetMessageW", wintypes.BOOL, ctypes.POINTER(wintypes.MSG), wintypes.HWND, UINT, UINT)
+    proto("PeekMessageW", wintypes.BOOL, ctypes.POINTER(wintypes.MSG), wintypes.HWND, UINT, UINT, UINT)
+    proto("TranslateMessage", wintypes.BOOL, ctypes.POINTER(wintypes.MSG))
+    proto("DispatchMessageW", ctypes.c_ssize_t, ctypes.POINTER(wintypes.MSG))
+    proto("PostThreadMessageW", wintypes.BOOL, DWORD, UINT, wintypes.WPARAM, wintypes.LPARAM)
+    return u

@@ -1,0 +1,203 @@
+"""The Windows DDE transport: DDEML through ctypes, on a thread of its own.
+
+DDEML rules that shape this module (Microsoft's documentation, in our words):
+
+- Every DDEML call for an instance must come from the thread that called ``DdeInitialize``, and
+  DDEML delivers callbacks to that thread only while it retrieves and dispatches window messages.
+  So the transport owns one thread: it initialises DDEML, registers names, runs the message loop,
+  and performs every later call; other threads (the publisher calling :meth:`post_advise`, or
+  shutdown) queue the request and wake the loop with ``PostThreadMessage``.
+- Service names are registered with ``DdeNameService(DNS_REGISTER)`` using string handles created
+  once with ``DdeCreateStringHandleW``; they are unregistered and freed, and the instance
+  uninitialised, on :meth:`close`.
+- ``DdePostAdvise(topic, item)`` makes DDEML send ``XTYP_ADVREQ`` to our callback for every advise
+  loop on the item; data handles we return from the callback belong to DDEML.
+
+Everything that is not a user32 call is in :mod:`nfwserver.dde.ddeml_dispatch` and is tested on
+every platform.  On other operating systems constructing :class:`WindowsDdeTransport` raises
+:class:`OSError`.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import logging
+import queue
+import sys
+import threading
+from collections.abc import Callable
+
+from nfwserver.dde import ddeml
+from nfwserver.dde.ddeml_dispatch import DdemlDispatcher
+from nfwserver.dde.transport import DdeServerHandler
+
+log = logging.getLogger(__name__)
+
+_WAKE = ddeml.WM_APP + 0x4E
+
+
+class _User32Api:  # pragma: no cover - Windows only
+    """The DdemlApi over user32 for one DDEML instance."""
+
+    def __init__(self, user32, inst: int) -> None:
+        self.u, self.inst = user32, inst
+
+    def query_string(self, hsz: int) -> str:
+        if not hsz:
+            return ""
+        n = self.u.DdeQueryStringW(self.inst, hsz, None, 0, ddeml.CP_WINUNICODE)
+        buf = ctypes.create_unicode_buffer(n + 1)
+        self.u.DdeQueryStringW(self.inst, hsz, buf, n + 1, ddeml.CP_WINUNICODE)
+        return buf.value
+
+    def get_data(self, hdata: int) -> bytes:
+        if not hdata:
+            return b""
+        n = self.u.DdeGetData(hdata, None, 0, 0)
+        buf = ctypes.create_string_buffer(n)
+        self.u.DdeGetData(hdata, buf, n, 0)
+        return buf.raw[:n]
+
+    def create_data(self, data: bytes, hsz_item: int, fmt: int) -> int:
+        buf = ctypes.create_string_buffer(data, len(data))
+        return self.u.DdeCreateDataHandle(self.inst, buf, len(data), 0, hsz_item, fmt, 0) or 0
+
+
+class WindowsDdeTransport:  # pragma: no cover - Windows only
+    """A :class:`~nfwserver.dde.transport.DdeServerTransport` over real DDEML."""
+
+    def __init__(self, start_timeout_s: float = 10.0) -> None:
+        if sys.platform != "win32":
+            raise OSError("the Windows DDE transport needs Windows")
+        self._handlers: dict[str, DdeServerHandler] = {}
+        self._calls: queue.Queue[Callable[[], None]] = queue.Queue()
+        self._ready = threading.Event()
+        self._error: BaseException | None = None
+        self._hsz: dict[str, int] = {}
+        self._registered: dict[str, int] = {}
+        self._closed = False
+        self._thread = threading.Thread(target=self._run, name="nfw-ddeml", daemon=True)
+        self._thread.start()
+        if not self._ready.wait(start_timeout_s) or self._error is not None:
+            raise OSError(f"DDEML did not start: {self._error}")
+
+    # -- the DDE thread ----------------------------------------------------------------------
+    def _run(self) -> None:
+        try:
+            from ctypes import wintypes
+
+            self.u = ddeml.load_user32()
+            self._thread_id = ctypes.windll.kernel32.GetCurrentThreadId()
+            inst = wintypes.DWORD(0)
+            self._dispatcher: DdemlDispatcher | None = None
+            self._callback = ddeml.CALLBACK_TYPE(self._on_callback)  # kept alive as long as the instance
+            flags = ddeml.APPCLASS_STANDARD | ddeml.CBF_SKIP_REGISTRATIONS | ddeml.CBF_SKIP_UNREGISTRATIONS
+            err = self.u.DdeInitializeW(ctypes.byref(inst), self._callback, flags, 0)
+            if err != ddeml.DMLERR_NO_ERROR:
+                raise OSError(f"DdeInitializeW failed with DMLERR 0x{err:04X}")
+            self.inst = inst.value
+            self._dispatcher = DdemlDispatcher(self._lookup, _User32Api(self.u, self.inst))
+            msg = wintypes.MSG()
+            # Make sure this thread has a message queue before anyone posts to it.
+            self.u.PeekMessageW(ctypes.byref(msg), None, 0, 0, 0)
+        except BaseException as exc:
+            self._error = exc
+            self._ready.set()
+            return
+        self._ready.set()
+        while True:
+            got = self.u.GetMessageW(ctypes.byref(msg), None, 0, 0)
+            if got in (0, -1):
+                break
+            if msg.message == _WAKE and not msg.hWnd:
+                self._drain()
+                if self._closed:
+                    break
+                continue
+            self.u.TranslateMessage(ctypes.byref(msg))
+            self.u.DispatchMessageW(ctypes.byref(msg))
+        self._shutdown()
+
+    def _on_callback(self, utype, fmt, hconv, hsz1, hsz2, hdata, data1, data2):
+        if self._dispatcher is None:
+            return 0
+        return self._dispatcher(utype, fmt, hconv or 0, hsz1 or 0, hsz2 or 0, hdata or 0, data1, data2) or None
+
+    def _lookup(self, service: str) -> DdeServerHandler | None:
+        return self._handlers.get(service.upper())
+
+    def _string(self, text: str) -> int:
+        key = text.upper()
+        if key not in self._hsz:
+            self._hsz[key] = self.u.DdeCreateStringHandleW(self.inst, text, ddeml.CP_WINUNICODE)
+        return self._hsz[key]
+
+    def _drain(self) -> None:
+        while True:
+            try:
+                call = self._calls.get_nowait()
+            except queue.Empty:
+                return
+            try:
+                call()
+            except Exception:
+                log.exception("DDE transport call failed")
+
+    def _shutdown(self) -> None:
+        for service in list(self._registered):
+            self.u.DdeNameService(self.inst, self._registered.pop(service), None, ddeml.DNS_UNREGISTER)
+        for hsz in self._hsz.values():
+            self.u.DdeFreeStringHandle(self.inst, hsz)
+        self._hsz.clear()
+        self.u.DdeUninitialize(self.inst)
+
+    def _call(self, fn: Callable[[], None], wait: bool = True) -> None:
+        if threading.current_thread() is self._thread:
+            fn()
+            return
+        done = threading.Event()
+
+        def wrapped() -> None:
+            try:
+                fn()
+            finally:
+                done.set()
+
+        self._calls.put(wrapped)
+        self.u.PostThreadMessageW(self._thread_id, _WAKE, 0, 0)
+        if wait:
+            done.wait(5.0)
+
+    # -- DdeServerTransport ----------------------------------------------------------------
+    def register_service(self, service: str, handler: DdeServerHandler) -> None:
+        def do() -> None:
+            self._handlers[service.upper()] = handler
+            hsz = self._string(service)
+            if not self.u.DdeNameService(self.inst, hsz, None, ddeml.DNS_REGISTER):
+                raise OSError(f"DdeNameService could not register {service}")
+            self._registered[service.upper()] = hsz
+            log.info("DDE service %s registered", service)
+
+        self._call(do)
+
+    def unregister_service(self, service: str) -> None:
+        def do() -> None:
+            hsz = self._registered.pop(service.upper(), None)
+            if hsz is not None:
+                self.u.DdeNameService(self.inst, hsz, None, ddeml.DNS_UNREGISTER)
+            self._handlers.pop(service.upper(), None)
+
+        self._call(do)
+
+    def post_advise(self, topic: str, item: str) -> None:
+        self._call(lambda: self.u.DdePostAdvise(self.inst, self._string(topic), self._string(item)), wait=False)
+
+    def close(self) -> None:
+        if self._closed:
+            return
+
+        def do() -> None:
+            self._closed = True
+
+        self._call(do, wait=False)
+        self._thread.join(5.0)

@@ -1,0 +1,99 @@
+"""The Windows transport's logic (DDEML callback -> handler), run on any OS with the real core."""
+
+from __future__ import annotations
+
+from nfwserver.clock import VirtualClock
+from nfwserver.dde import ddeml
+from nfwserver.dde.clipboard import CF_TEXT, CF_UNICODETEXT, encode_text
+from nfwserver.dde.ddeml_dispatch import DdemlDispatcher
+from nfwserver.dde.server import NovaServer
+from tests.dde.conftest import CATALOG, ISS, ISS_PASS, OBSERVER
+
+
+class FakeApi:
+    """Stands in for user32's string and data handles: integers mapping to Python values."""
+
+    def __init__(self) -> None:
+        self.strings: dict[int, str] = {}
+        self.data: dict[int, bytes] = {}
+        self.created: list[tuple[bytes, str, int]] = []
+
+    def hsz(self, text: str) -> int:
+        handle = 100 + len(self.strings)
+        self.strings[handle] = text
+        return handle
+
+    def hdata(self, payload: bytes) -> int:
+        handle = 5000 + len(self.data)
+        self.data[handle] = payload
+        return handle
+
+    def query_string(self, hsz: int) -> str:
+        return self.strings[hsz]
+
+    def get_data(self, hdata: int) -> bytes:
+        return self.data[hdata]
+
+    def create_data(self, data: bytes, hsz_item: int, fmt: int) -> int:
+        self.created.append((data, self.strings[hsz_item], fmt))
+        return 9000 + len(self.created)
+
+
+def _setup():
+    server = NovaServer(CATALOG, OBSERVER, VirtualClock(ISS_PASS.tca), satellite=ISS)
+    api = FakeApi()
+    handlers = {"NFW32": server, "NFW_SERVER": server}
+    dispatch = DdemlDispatcher(lambda name: handlers.get(name.upper()), api)
+    return server, api, dispatch
+
+
+def _connect(api, dispatch, service="NFW32", topic="NFW_DATA", hconv=77) -> bool:
+    topic_h, service_h = api.hsz(topic), api.hsz(service)
+    ok = dispatch(ddeml.XTYP_CONNECT, 0, 0, topic_h, service_h, 0)
+    if ok:
+        dispatch(ddeml.XTYP_CONNECT_CONFIRM, 0, hconv, topic_h, service_h, 0)
+    return bool(ok)
+
+
+def test_connect_names_and_refusals() -> None:
+    server, api, dispatch = _setup()
+    assert _connect(api, dispatch, "nfw32", "nfw_data")
+    assert not _connect(api, dispatch, "NFW32", "OTHER", hconv=78)
+    assert not _connect(api, dispatch, "SOMEONE", "NFW_DATA", hconv=79)
+    assert dispatch.conversation_count() == 1 and server.snapshot().clients == 1
+
+
+def test_poke_request_advise_like_a_real_client() -> None:
+    server, api, dispatch = _setup()
+    assert _connect(api, dispatch)
+    topic, item = api.hsz("NFW_DATA"), api.hsz("NFW_SERVER")
+    ack = dispatch(ddeml.XTYP_POKE, CF_TEXT, 77, topic, item, api.hdata(encode_text("TUNE ON")))
+    assert ack == ddeml.DDE_FACK
+    refused = dispatch(ddeml.XTYP_POKE, CF_TEXT, 77, topic, item, api.hdata(b"JUNK\x00"))
+    assert refused == ddeml.DDE_FNOTPROCESSED
+    assert dispatch(ddeml.XTYP_ADVSTART, CF_TEXT, 77, topic, item, 0) == 1
+    assert dispatch(ddeml.XTYP_ADVSTART, 49999, 77, topic, item, 0) == 0  # a format we do not serve
+    server.tick()
+    handle = dispatch(ddeml.XTYP_REQUEST, CF_TEXT, 77, topic, item, 0)
+    assert handle and api.created[-1][0].startswith(b"ISS AZ:") and api.created[-1][0].endswith(b"\x00")
+    assert api.created[-1][1] == "NFW_SERVER" and api.created[-1][2] == CF_TEXT
+    dispatch(ddeml.XTYP_ADVREQ, CF_UNICODETEXT, 77, topic, item, 0)
+    assert api.created[-1][0].decode("utf-16-le").startswith("ISS AZ:")
+    assert dispatch(ddeml.XTYP_REQUEST, CF_TEXT, 77, topic, api.hsz("NOPE"), 0) == 0
+    assert dispatch(ddeml.XTYP_EXECUTE, 0, 77, topic, 0, api.hdata(b"TRACK ON\x00")) == ddeml.DDE_FACK
+    assert server.snapshot().track_on
+    dispatch(ddeml.XTYP_ADVSTOP, CF_TEXT, 77, topic, item, 0)
+    assert server.snapshot().advise_loops == 0
+    dispatch(ddeml.XTYP_DISCONNECT, 0, 77, 0, 0, 0)
+    assert dispatch.conversation_count() == 0 and server.snapshot().clients == 0
+
+
+def test_unknown_conversations_and_handler_failures_are_refused_not_raised() -> None:
+    server, api, dispatch = _setup()
+    topic, item = api.hsz("NFW_DATA"), api.hsz("NFW_SERVER")
+    assert dispatch(ddeml.XTYP_POKE, CF_TEXT, 55, topic, item, api.hdata(b"TUNE ON\x00")) == ddeml.DDE_FNOTPROCESSED
+    assert _connect(api, dispatch)
+    # A data handle DDEML would not know: the API raises; the callback must still answer.
+    assert dispatch(ddeml.XTYP_POKE, CF_TEXT, 77, topic, item, 424242) == ddeml.DDE_FNOTPROCESSED
+    assert dispatch(ddeml.XTYP_REQUEST, CF_TEXT, 77, 999999, item, 0) == 0
+    assert dispatch(ddeml.XTYP_WILDCONNECT, 0, 0, 0, 0, 0) == 0
