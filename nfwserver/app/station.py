@@ -7,6 +7,7 @@ import sys
 import threading
 
 from nfwserver.app.element_sources import FetchResult, fetch_all
+from nfwserver.app.element_store import ElementStore
 from nfwserver.clock import Clock
 from nfwserver.config.schema import Config
 from nfwserver.dde.publisher import Publisher
@@ -51,9 +52,13 @@ class Station:
     def __init__(self, config: Config, clock: Clock, transport: DdeServerTransport | None = None) -> None:
         self.config = config
         self.clock = clock
+        store = config.elements.store
+        self.store = ElementStore(None if store == "default" else store) if store else None
         fetched = fetch_all(config.elements.files, config.elements.urls, config.elements.use_bundled)
         self._report(fetched)
-        self.catalog = Catalog(fetched.sets, dde_names=config.dde_names)
+        stored = self.store.load() if self.store is not None else []
+        self.catalog = Catalog(stored, dde_names=config.dde_names)
+        self.catalog.update(fetched.sets)
         if not len(self.catalog):
             log.warning("no element sets loaded: nothing can be tracked until some are added")
         srv = config.server
@@ -122,6 +127,11 @@ class Station:
         fetched = fetch_all(cfg.files, cfg.urls, cfg.use_bundled)
         self._report(fetched)
         summary = self.catalog.update(fetched.sets)
+        if self.store is not None and (summary.added or summary.updated):
+            try:
+                self.store.update(fetched.sets)
+            except OSError as exc:
+                log.error("cannot save the element catalog to %s: %s", self.store.path, exc)
         log.info("elements refreshed: %d added, %d updated", len(summary.added), len(summary.updated))
         return summary
 

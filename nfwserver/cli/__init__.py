@@ -21,6 +21,7 @@ COMMAND_MODULES: tuple[str, ...] = (
     "run_command",
     "simulate_command",
     "tracking_commands",
+    "elements_command",
     "config_command",
 )
 

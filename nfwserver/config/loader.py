@@ -125,7 +125,7 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
             c.problems.append(f"[horizon] file: {exc}")
 
     # [elements]
-    el_t = c.table(doc, "elements", {"files", "urls", "refresh_hours", "use_bundled"})
+    el_t = c.table(doc, "elements", {"files", "urls", "refresh_hours", "use_bundled", "store"})
     files = c.strings("elements", "files", el_t.get("files", [])) or ()
     urls = c.strings("elements", "urls", el_t.get("urls", [])) or ()
     for url in urls:
@@ -135,7 +135,18 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
     use_bundled = el_t.get("use_bundled", True)
     if not isinstance(use_bundled, bool):
         c.problems.append("[elements] use_bundled: must be true or false")
-    elements = ElementsConfig(tuple(str(base / f) for f in files), urls, refresh or 0.0, bool(use_bundled))
+    store = el_t.get("store", "default")
+    if not isinstance(store, str):
+        c.problems.append("[elements] store: must be a file name, \"default\" or \"none\"")
+        store = "none"
+    if store == "default":
+        store_path: str | None = "default"
+    elif store == "none":
+        store_path = None
+    else:
+        store_path = str(base / store)
+    elements = ElementsConfig(tuple(str(base / f) for f in files), urls, refresh or 0.0, bool(use_bundled),
+                              store_path)
 
     # [server]
     sv_t = c.table(doc, "server", {"rate_hz", "services", "topic", "items", "satellite", "ut1_utc_s"})
@@ -288,6 +299,7 @@ TEMPLATE = """\
 # urls = ["https://example.org/amateur.txt"]
 refresh_hours = 24              # 0 = never refresh while running
 use_bundled = true              # include the bundled amateur and weather satellites
+store = "default"               # catalog kept by `nfwserver elements update`: "default", a file, or "none"
 
 [server]
 rate_hz = 5                     # publish rate, 1..50 Hz

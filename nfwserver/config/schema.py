@@ -18,6 +18,7 @@ class ElementsConfig:
     urls: tuple[str, ...] = ()  #: element URLs (http/https)
     refresh_hours: float = 24.0  #: 0 disables the periodic refresh
     use_bundled: bool = True  #: include the bundled amateur and weather satellites
+    store: str | None = "default"  #: stored catalog file (``elements update``); "default": user data dir; None: off
 
 
 @dataclass(frozen=True)

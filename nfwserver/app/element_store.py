@@ -1,0 +1,52 @@
+"""The stored element catalog: what ``nfwserver elements update`` keeps between runs.
+
+One text file of 3-line TLEs (canonical lines, so every format that was loaded is stored the same
+way) in the platform's user data directory.  Updates follow InstantTrack's UPDATE rule (a set
+replaces the stored one only when its epoch is newer) and are written atomically: a crash during
+an update leaves the previous file whole.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from nfwserver.storage import atomic_write_text
+from nfwserver.tracking.catalog import Catalog, UpdateSummary
+from nfwserver.tracking.elements import ElementSet, Rejection, load_element_file
+
+
+def default_store_path() -> Path:
+    from platformdirs import user_data_dir
+
+    return Path(user_data_dir("nfwserver", appauthor=False)) / "elements.txt"
+
+
+@dataclass
+class StoreUpdate:
+    summary: UpdateSummary
+    rejected: list[Rejection] = field(default_factory=list)
+    failed: list[str] = field(default_factory=list)
+    total: int = 0
+
+
+class ElementStore:
+    """The stored catalog at ``path``."""
+
+    def __init__(self, path: str | Path | None = None) -> None:
+        self.path = Path(path) if path is not None else default_store_path()
+
+    def load(self) -> list[ElementSet]:
+        """The stored sets (none if the file does not exist yet)."""
+        if not self.path.exists():
+            return []
+        return load_element_file(self.path).sets
+
+    def update(self, sets: list[ElementSet]) -> tuple[Catalog, UpdateSummary]:
+        """Merge ``sets`` into the stored catalog with UPDATE semantics and write it atomically."""
+        catalog = Catalog(self.load())
+        summary = catalog.update(sets)
+        if summary.added or summary.updated or not self.path.exists():
+            text = "".join(sat.elements.tle_text() for sat in catalog)
+            atomic_write_text(self.path, text)
+        return catalog, summary
