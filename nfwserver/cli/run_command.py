@@ -78,7 +78,8 @@ def run(args: argparse.Namespace) -> int:
         if console:
             from nfwserver.console.app import NfwConsole
 
-            app = NfwConsole(station.server, station.transport_note, hint, radio=station.radio, rotor=station.rotor)
+            app = NfwConsole(station.server, station.transport_note, hint, radio=station.radio, rotor=station.rotor,
+                             favourites=config.favourites or (25544, 27607, 43017, 44909, 7530))
             if args.duration:
                 threading.Timer(args.duration, app.exit).start()
             app.run()

@@ -20,14 +20,17 @@ from rich.text import Text
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
-from textual.widgets import Footer, Header, Input, RichLog, Static
+from textual.widgets import Footer, Header, Input, OptionList, RichLog, Static
+from textual.widgets.option_list import Option
 
+from nfwserver.console.skyplot import render_sky
 from nfwserver.dde.events import Direction, Event
 from nfwserver.dde.protocol import escape_for_log
 from nfwserver.dde.server import NovaServer
 from nfwserver.dde.status import describe
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.rotor.coupling import RotorCoupling
+from nfwserver.tracking.look_angles import LookAngleCalculator
 from nfwserver.tracking.passes import Pass, find_passes
 
 
@@ -43,19 +46,26 @@ class NfwConsole(App):
     #state { height: auto; border: round $accent; padding: 0 1; }
     #logs { height: 1fr; }
     .pane { width: 1fr; border: round $primary; }
+    #side { width: 40; border: round $primary; }
+    #picker { height: 12; display: none; border: round $warning; }
+    #picker.shown { display: block; }
     #poke { dock: bottom; }
     """
     BINDINGS = [
         Binding("f1", "focus_outgoing", "Outgoing (F1)"),
         Binding("f3", "focus_incoming", "Incoming (F3)"),
+        Binding("f2", "pick_satellite", "Satellites (F2)"),
         Binding("ctrl+t", "toggle_tune", "Tune on/off"),
         Binding("ctrl+d", "toggle_doppler", "Doppler tuning"),
         Binding("ctrl+q", "quit", "Quit"),
     ]
 
     def __init__(self, server: NovaServer, transport_note: str = "", hint: str = "",
-                 radio: RadioCoupling | None = None, rotor: RotorCoupling | None = None) -> None:
+                 radio: RadioCoupling | None = None, rotor: RotorCoupling | None = None,
+                 favourites: tuple[int, ...] = ()) -> None:
         super().__init__()
+        self.favourites = favourites
+        self._passes_key: int | None = None
         self.server = server
         self.radio = radio
         self.rotor = rotor
@@ -77,6 +87,12 @@ class NfwConsole(App):
             with Vertical(classes="pane"):
                 yield Static("[b]F3 incoming[/b]")
                 yield RichLog(id="incoming", max_lines=500, wrap=True, markup=False)
+            with Vertical(id="side"):
+                yield Static("[b]Upcoming passes[/b]")
+                yield Static(id="passes")
+                yield Static("[b]Sky (selected satellite)[/b]")
+                yield Static(id="sky")
+        yield OptionList(id="picker")
         yield Input(placeholder="poke: TUNE ON | TUNE OFF | TRACK ON | SAT=25544 | ANTAZ=123 ...", id="poke")
         yield Footer()
 
@@ -89,6 +105,10 @@ class NfwConsole(App):
         self.set_interval(0.1, self._drain)
         self.set_interval(0.25, self._refresh_state)
         self._refresh_state()
+        picker = self.query_one("#picker", OptionList)
+        for sat in self.server.catalog:
+            label = f"{sat.dde_name:12} {sat.catalog_number:>6}  {sat.name}"
+            picker.add_option(Option(label, id=str(sat.catalog_number)))
         self.query_one("#poke", Input).focus()
 
     def on_unmount(self) -> None:
@@ -176,6 +196,11 @@ class NfwConsole(App):
             else:
                 radio_text = f"Radio: Doppler tuning {state}"
             lines.append(radio_text)
+        self._refresh_side(now)
+        current = None
+        if sample is not None and sample.look_angles is not None:
+            current = (sample.look_angles.azimuth_deg, sample.look_angles.elevation_deg)
+        self.query_one("#sky", Static).update(render_sky(getattr(self, "_track", []), current))
         status = ", ".join(describe(snap.status)) or "ok"
         lines.append(f"Status 0x{snap.status:04X}: {status}   {_clock(now)} UTC")
         self.query_one("#state", Static).update("\n".join(lines))
@@ -187,6 +212,53 @@ class NfwConsole(App):
             self.server.command(text, source="console")
             self._drain()
             self._refresh_state()
+
+    def action_pick_satellite(self) -> None:
+        picker = self.query_one("#picker", OptionList)
+        picker.toggle_class("shown")
+        if picker.has_class("shown"):
+            picker.focus()
+        else:
+            self.query_one("#poke", Input).focus()
+
+    def on_option_list_option_selected(self, message: OptionList.OptionSelected) -> None:
+        if message.option.id:
+            self.server.command(f"SAT={message.option.id}", source="console")
+        message.option_list.remove_class("shown")
+        self.query_one("#poke", Input).focus()
+        self._passes_key = None
+        self._drain()
+        self._refresh_state()
+
+    def _refresh_side(self, now: datetime) -> None:
+        """Upcoming passes of the favourites and the sky plot, recomputed once a minute."""
+        snap = self.server.snapshot()
+        key = int(now.timestamp() // 60) * 1_000_000 + (snap.catalog_number or 0)
+        if key == self._passes_key or self.server.observer is None:
+            return
+        self._passes_key = key
+        selected = [snap.catalog_number] if snap.catalog_number else []
+        wanted = list(dict.fromkeys([*self.favourites, *selected]))
+        sats = [s for s in (self.server.catalog.get(n) for n in wanted) if s is not None]
+        lines = []
+        if sats:
+            passes = find_passes(sats, self.server.observer, now, now + timedelta(hours=12),
+                                 horizon=self.server.horizon, ut1_utc=self.server.ut1_utc)
+            for p in [p for p in passes if p.los is None or p.los > now][:8]:
+                name = self.server.catalog.get(p.catalog_number).dde_name
+                lines.append(f"{name:12} {_clock(p.aos)} {p.max_elevation_deg:3.0f}deg {_clock(p.los)}")
+        self.query_one("#passes", Static).update("\n".join(lines) or "none in the next 12 h")
+        sat = self.server.catalog.get(snap.catalog_number) if snap.catalog_number else None
+        track: list[tuple[float, float]] = []
+        nxt = self._upcoming_pass(now)
+        if sat is not None and nxt is not None and nxt.aos is not None and nxt.los is not None:
+            calc = LookAngleCalculator(self.server.observer, self.server.ut1_utc)
+            t = nxt.aos
+            while t <= nxt.los:
+                la = calc.compute(sat.satrec, t)
+                track.append((la.azimuth_deg, la.elevation_deg))
+                t += timedelta(seconds=20)
+        self._track = track
 
     def action_focus_outgoing(self) -> None:
         self.query_one("#outgoing", RichLog).focus()

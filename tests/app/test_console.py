@@ -24,7 +24,7 @@ def test_pokes_outgoing_strings_and_state_changes_show() -> None:
     station = make_station(start=ISS_PASS.tca - timedelta(seconds=5))
 
     async def scenario() -> None:
-        app = NfwConsole(station.server, "fake transport note", "set your observer")
+        app = NfwConsole(station.server, "fake transport note", "set your observer", favourites=(25544,))
         async with app.run_test(size=(140, 40)) as pilot:
             await pilot.press(*"TUNE ON", "enter")
             await pilot.pause()
@@ -51,5 +51,16 @@ def test_pokes_outgoing_strings_and_state_changes_show() -> None:
             assert "TRACK ON" in _state(app)
             assert "next pass" in _state(app)
             assert "note: set your observer" in _log_text(app, "incoming")
+            sky = str(app.query_one("#sky", Static).render())
+            assert "N" in sky and "@" in sky and "." in sky  # the pass track and the satellite now
+            assert "ISS" in str(app.query_one("#passes", Static).render())
+            # The satellite picker (F2) switches the AutoTracking satellite.
+            await pilot.press("f2")
+            await pilot.pause()
+            await pilot.press("down", "enter")
+            await pilot.pause(0.3)
+            picked = station.server.snapshot()
+            assert picked.catalog_number != 25544 and f"({picked.catalog_number})" in _state(app)
+            assert f"SAT={picked.catalog_number} ok" in _log_text(app, "incoming")
 
     asyncio.run(scenario())
