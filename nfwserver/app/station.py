@@ -13,6 +13,11 @@ from nfwserver.config.schema import Config
 from nfwserver.dde.publisher import Publisher
 from nfwserver.dde.server import NovaServer
 from nfwserver.dde.transport import DdeServerTransport
+from nfwserver.dialects.dde_service import DialectServer
+from nfwserver.dialects.orbitron import ORBITRON
+from nfwserver.dialects.predict_udp import PredictContext, PredictUdpServer
+from nfwserver.dialects.satpc32 import SATPC32
+from nfwserver.dialects.wxtrack import WXTRACK
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.radio.rigctld_backend import RigctldBackend
@@ -27,6 +32,8 @@ from nfwserver.rotor.tracks import SatelliteTracks
 from nfwserver.tracking.catalog import Catalog, UpdateSummary
 
 log = logging.getLogger(__name__)
+
+DDE_DIALECTS = {d.name: d for d in (ORBITRON, WXTRACK, SATPC32)}
 
 
 def default_transport() -> tuple[DdeServerTransport, str]:
@@ -74,6 +81,19 @@ class Station:
             self.transport_note = "serving on the given transport"
         self.transport = transport
         self.publisher = Publisher(self.server, clock)
+        self.dialect_servers = [DialectServer(DDE_DIALECTS[name], self.catalog, config.channels)
+                                for name in config.dialects.dde]
+        for dialect_server in self.dialect_servers:
+            self.server.add_tick_listener(dialect_server.on_tick)
+        self.predict: PredictUdpServer | None = None
+        if config.dialects.predict_udp:
+            context = PredictContext(
+                lambda: self.catalog, config.observer, clock,
+                lambda: list(dict.fromkeys([*config.favourites, *[s.catalog_number for s in self.catalog]]))[:24],
+                mode=lambda: f"{self.server.snapshot().dde_name or 'none'}\n", callsign=config.dialects.callsign,
+                ut1_utc=config.server.ut1_utc_s, on_reload=self.refresh_elements,
+            )
+            self.predict = PredictUdpServer(context, config.dialects.predict_host, config.dialects.predict_port)
         self.rotor: RotorCoupling | None = self._make_rotor(config, clock)
         self.radio: RadioCoupling | None = None
         if config.radio.backend == "rigctld":
@@ -148,6 +168,10 @@ class Station:
             return
         self._started = True
         self.server.attach(self.transport)
+        for dialect_server in self.dialect_servers:
+            dialect_server.attach(self.transport)
+        if self.predict is not None:
+            self.predict.start()
         if self.radio is not None:
             self.radio.start()
         if self.rotor is not None:
@@ -163,6 +187,10 @@ class Station:
         self._started = False
         self._stop.set()
         self.publisher.stop()
+        if self.predict is not None:
+            self.predict.stop()
+        for dialect_server in self.dialect_servers:
+            dialect_server.detach()
         if self.radio is not None:
             self.radio.stop()
         if self.rotor is not None:

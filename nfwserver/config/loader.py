@@ -12,7 +12,14 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from nfwserver.config.schema import Config, ElementsConfig, RadioConfig, RotorConfig, ServerConfig
+from nfwserver.config.schema import (
+    Config,
+    DialectsConfig,
+    ElementsConfig,
+    RadioConfig,
+    RotorConfig,
+    ServerConfig,
+)
 from nfwserver.radio.defaults import DEFAULT_CHANNELS
 from nfwserver.radio.transponder import Channel
 from nfwserver.rotor.geometry import RotorGeometry
@@ -83,7 +90,7 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
         raise ConfigError(source, [f"not valid TOML ({exc})"]) from None
     c = _Checker(source)
     for key in doc:
-        if key not in {"observer", "horizon", "elements", "server", "satellites", "radio", "rotor"}:
+        if key not in {"observer", "horizon", "elements", "server", "satellites", "radio", "rotor", "dialects"}:
             c.problems.append(f"[{key}]: unknown section")
     base = base_dir or Path(".")
 
@@ -246,6 +253,23 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
     park_el = c.number("rotor", "park_elevation_deg", ro_t.get("park_elevation_deg", 0), 0, 90)
     park_delay = c.number("rotor", "park_delay_minutes", ro_t.get("park_delay_minutes", 0), 0, 60)
 
+    # [dialects]
+    di_t = c.table(doc, "dialects", {"dde", "predict_udp", "predict_host", "predict_port", "callsign"})
+    dde = c.strings("dialects", "dde", di_t.get("dde", [])) or ()
+    for name in dde:
+        if name not in ("orbitron", "wxtrack", "satpc32"):
+            c.problems.append(f"[dialects] dde: {name!r} is not one of orbitron, wxtrack, satpc32")
+    predict_udp = di_t.get("predict_udp", False)
+    if not isinstance(predict_udp, bool):
+        c.problems.append("[dialects] predict_udp: must be true or false")
+    predict_host = di_t.get("predict_host", "127.0.0.1")
+    if not isinstance(predict_host, str) or not predict_host:
+        c.problems.append("[dialects] predict_host: must be a host address")
+    predict_port = c.number("dialects", "predict_port", di_t.get("predict_port", 1210), 0, 65535)
+    callsign = di_t.get("callsign", "NFWSERVER")
+    if not isinstance(callsign, str) or not callsign.isprintable() or not 0 < len(callsign) <= 12:
+        c.problems.append("[dialects] callsign: must be 1 to 12 printable characters")
+
     if c.problems:
         raise ConfigError(source, c.problems)
     return Config(
@@ -259,6 +283,8 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
                           ro_threshold if ro_threshold is not None else 2.0, ro_speed or 6.0,
                           ro_lead if ro_lead is not None else 10.0, str(after_los), str(flip_mode),
                           int(park_az or 0), int(park_el or 0), int(park_delay or 0)),
+        dialects=DialectsConfig(tuple(dde), bool(predict_udp), str(predict_host),
+                                int(predict_port if predict_port is not None else 1210), str(callsign)),
     )
 
 
@@ -348,4 +374,11 @@ flip = "auto"                   # "auto": decided at AOS for the whole pass; "of
 park_azimuth_deg = 0
 park_elevation_deg = 0
 park_delay_minutes = 0          # 0 = park at once after LOS
+
+[dialects]
+dde = []                        # also serve other trackers' DDE interfaces: "orbitron", "wxtrack", "satpc32"
+predict_udp = false             # PREDICT's UDP protocol, for Linux programs written for PREDICT
+predict_host = "127.0.0.1"
+predict_port = 1210
+callsign = "NFWSERVER"          # reported by PREDICT's GET_QTH
 """

@@ -58,6 +58,15 @@ class RotorConfig:
 
 
 @dataclass(frozen=True)
+class DialectsConfig:
+    dde: tuple[str, ...] = ()  #: other trackers' DDE interfaces to serve: "orbitron", "wxtrack", "satpc32"
+    predict_udp: bool = False  #: PREDICT's UDP protocol
+    predict_host: str = "127.0.0.1"
+    predict_port: int = 1210
+    callsign: str = "NFWSERVER"
+
+
+@dataclass(frozen=True)
 class Config:
     observer: Observer = DEFAULT_OBSERVER
     observer_configured: bool = False
@@ -68,5 +77,6 @@ class Config:
     favourites: tuple[int, ...] = ()  #: satellites whose passes the console lists
     radio: RadioConfig = field(default_factory=RadioConfig)
     rotor: RotorConfig = field(default_factory=RotorConfig)
+    dialects: DialectsConfig = field(default_factory=DialectsConfig)
     channels: dict[int, Channel] = field(default_factory=dict)  #: catalog number -> radio channel
     source: str = "<built-in defaults>"

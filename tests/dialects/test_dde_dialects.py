@@ -98,3 +98,28 @@ def test_dialects_take_no_commands_and_refuse_unknown_items() -> None:
     nova.poke("NFW_SERVER", "TUNE ON")
     station.server.tick()
     assert nova.request_text("NFW_SERVER").startswith("ISS AZ:")
+
+
+def test_station_serves_the_configured_dialects_next_to_nova() -> None:
+    import socket as _socket
+
+    from nfwserver.app.station import Station
+    from nfwserver.clock import VirtualClock
+    from nfwserver.config import parse_config
+    from nfwserver.fake_dde import FakeDdeSystem
+
+    config = parse_config('[observer]\nlocation = "52.2053,0.1218,20"\n[dialects]\ndde = ["orbitron", "satpc32"]\n'
+                          'predict_udp = true\npredict_port = 0\n')
+    system = FakeDdeSystem()
+    station = Station(config, VirtualClock(ISS_PASS.tca), transport=system.server_transport())
+    station.start()
+    try:
+        station.server.tick()
+        assert get_field(system.connect("Orbitron", "Tracking").request_text("TrackingData"), "SN") == "ISS_ZARYA"
+        assert system.connect("SatPC32", "SatPcDdeConv").request_text("SatPcDdeItem").startswith("SNISS ")
+        with _socket.socket(_socket.AF_INET, _socket.SOCK_DGRAM) as client:
+            client.settimeout(5)
+            client.sendto(b"GET_MODE", station.predict.address)
+            assert client.recvfrom(100)[0] == b"ISS\n"
+    finally:
+        station.stop()
