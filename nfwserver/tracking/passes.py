@@ -80,6 +80,8 @@ class _Evaluator:
         self.jd0, self.fr0 = julian_date(t0)
         self.ut1_days = ut1_utc / SECONDS_PER_DAY
         self.horizon = horizon
+        self._groups_for: np.ndarray | None = None
+        self._groups: list[tuple[int, np.ndarray]] = []
 
     def states(self, sat: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Earth-fixed position and velocity (n, 3) and SGP4 error codes (n,)."""
@@ -89,12 +91,15 @@ class _Evaluator:
         err = np.zeros(n, dtype=np.uint8)
         fr = self.fr0 + t / SECONDS_PER_DAY
         jd = np.full(n, self.jd0)
-        order = np.argsort(sat, kind="stable")
-        bounds = np.flatnonzero(np.diff(sat[order])) + 1
-        for group in np.split(order, bounds):
-            if len(group) == 0:
-                continue
-            e, rr, vv = self.satrecs[sat[group[0]]].sgp4_array(jd[group], fr[group])
+        # Iterative refinements call again and again with the same satellite array: group it once.
+        if self._groups_for is not sat:
+            order = np.argsort(sat, kind="stable")
+            bounds = np.flatnonzero(np.diff(sat[order])) + 1
+            self._groups = [(int(sat[g[0]]), g) for g in np.split(order, bounds) if len(g)]
+            self._groups_for = sat
+        satrecs = self.satrecs
+        for index, group in self._groups:
+            e, rr, vv = satrecs[index].sgp4_array(jd[group], fr[group])
             r[group], v[group], err[group] = rr, vv, e
         theta, theta_dot = gmst1982(jd, fr + self.ut1_days)
         c, s = np.cos(theta), np.sin(theta)
