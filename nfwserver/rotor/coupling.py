@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import logging
 import math
-import threading
 from collections.abc import Callable, Sequence
 from datetime import datetime, timedelta
 
@@ -30,6 +29,7 @@ from nfwserver.dde.session import TickSample
 from nfwserver.rotor.flip import PassPlan, flip, plan_pass
 from nfwserver.rotor.geometry import unwrap
 from nfwserver.rotor.kct_driver import KctDriver
+from nfwserver.tick_worker import TickWorker
 
 log = logging.getLogger(__name__)
 
@@ -53,12 +53,15 @@ def sky_from_rotor(rotor_az: float, rotor_el: float) -> tuple[float, float]:
     return rotor_az % 360.0, rotor_el
 
 
-class RotorCoupling:
+class RotorCoupling(TickWorker):
     """Drives ``driver`` from ticks; see the module docstring."""
+
+    worker_name = "nfw-rotor"
 
     def __init__(self, driver: KctDriver, predict: Predict, pass_track: PassTrack, threshold_deg: float = 2.0,
                  speed_deg_s: float = 6.0, max_lead_s: float = 10.0, after_los: str = "park", flip_mode: str = "auto",
                  on_position: Callable[[float, float], None] | None = None) -> None:
+        super().__init__()
         if after_los not in AFTER_LOS or flip_mode not in FLIP_MODES:
             raise ValueError(f"after_los must be one of {AFTER_LOS} and flip_mode one of {FLIP_MODES}")
         if threshold_deg < 0 or speed_deg_s <= 0 or max_lead_s < 0:
@@ -75,10 +78,6 @@ class RotorCoupling:
         self.plan: PassPlan | None = None
         self.flip_state = False
         self._sent: tuple[float, float] | None = None  # sky (az, el) of the last target sent
-        self._pending: TickSample | None = None
-        self._wake = threading.Event()
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
 
     # -- planning --------------------------------------------------------------------------
     def _plan(self, track: Sequence[tuple[datetime, float, float]]) -> PassPlan:
@@ -154,33 +153,6 @@ class RotorCoupling:
         ahead = self.predict(when + timedelta(seconds=lead))
         return ahead if ahead is not None else (az, el)
 
-    # -- worker ------------------------------------------------------------------------------
-    def on_tick(self, sample: TickSample) -> None:
-        """Tick listener: remember the newest sample (never blocks the publisher)."""
-        self._pending = sample
-        self._wake.set()
-
-    def _run(self) -> None:
-        while not self._stop.is_set():
-            self._wake.wait(0.5)
-            self._wake.clear()
-            sample, self._pending = self._pending, None
-            if sample is not None:
-                try:
-                    self.process(sample)
-                except Exception:
-                    log.exception("rotor tracking failed")
-
-    def start(self) -> None:
-        if self._thread is None:
-            self._stop.clear()
-            self._thread = threading.Thread(target=self._run, name="nfw-rotor", daemon=True)
-            self._thread.start()
-
     def stop(self) -> None:
-        self._stop.set()
-        self._wake.set()
-        if self._thread is not None:
-            self._thread.join(5.0)
-            self._thread = None
+        super().stop()
         self.driver.backend.close()
