@@ -30,6 +30,8 @@ from nfwserver.rotor.kct_table import MAX_CYCLE_MINUTES, NormalEntry, Repetitive
 log = logging.getLogger(__name__)
 
 ADD_OK, ADD_INVALID, ADD_FULL = 0, 1, 2
+#: The version number function 0A reports.
+DRIVER_VERSION = 0x0100
 #: A table entry more than this late when reached is dropped instead of executed (seconds).
 STALE_ENTRY_S = 30.0
 
@@ -88,6 +90,8 @@ class KctDriver:
         self._sent: tuple[float, float] | None = None
         self._card_absent = False
         self._position: tuple[float, float] | None = None  # rotor frame, last read back
+        self._morse_enabled = True
+        self._popups = 0
 
     # -- function 0 ----------------------------------------------------------------------
     def status(self) -> DriverStatus:
@@ -224,9 +228,41 @@ class KctDriver:
         previous, self._processing = self._processing, on
         return previous
 
+    def register_popup(self, program_mask: int) -> tuple[bool, int]:
+        """Function 0A: a TSR notes its installation; returns (already loaded, driver version).
+
+        The original reserved this for its own pop-ups; it is kept for completeness.
+        """
+        loaded = bool(self._popups & program_mask)
+        self._popups |= program_mask
+        return loaded, DRIVER_VERSION
+
     def announce(self, text: str) -> None:
         """Function 10: text for the annunciator (0xFF/0xFE characters mean AOS/LOS warbles)."""
-        self._announce("text", " ".join(text.replace("\xff", " ").replace("\xfe", " ").split()))
+        if self._morse_enabled:
+            self._announce("text", " ".join(text.replace("\xff", " ").replace("\xfe", " ").split()))
+
+    def morse_enabled(self) -> bool:
+        """Function 11, subfunction FF: is the annunciator enabled?"""
+        return self._morse_enabled
+
+    def set_morse(self, enabled: bool) -> bool:
+        """Function 11, subfunctions 00 (disable, dropping queued text) and 01-FE (enable); returns the prior state."""
+        prior, self._morse_enabled = self._morse_enabled, enabled
+        return prior
+
+    def announce_status(self) -> str:
+        """Function 12: send the driver's status on the annunciator whatever its enablement; returns the text."""
+        status = self.status()
+        cur_el, cur_az, tgt_el, tgt_az = self.positions()
+        parts = [f"ST {int(status.bits):02X}"]
+        if cur_az is not None:
+            parts.append(f"AZ {cur_az:.0f} EL {cur_el:.0f}")
+        if tgt_az is not None:
+            parts.append(f"TGT {tgt_az:.0f} {tgt_el:.0f}")
+        text = " ".join(parts)
+        self._announce("text", text)
+        return text
 
     def delete_rest_of_pass(self) -> None:
         """Function 13: drop table entries up to and including the end of the current pass."""

@@ -161,3 +161,17 @@ def test_announcements_time_and_identifier(rig) -> None:
     driver.set_satellite_id("SAUDISAT-1C")
     assert driver.table_info() == (TableMode.NORMAL, "SAUDISAT")
     assert driver.table_size() == 5
+
+
+def test_annunciator_popups_and_status_in_morse(rig) -> None:
+    _, _, driver = rig
+    assert driver.register_popup(0x0001) == (False, 0x0100)
+    assert driver.register_popup(0x0001)[0] is True
+    assert driver.morse_enabled() and driver.set_morse(False) is True
+    driver.announce("not sent")
+    assert driver.announcements == []
+    driver.set_target(10, 20)
+    driver.service()
+    text = driver.announce_status()  # sent even with the annunciator disabled
+    assert text.startswith("ST ") and "TGT 20 10" in text and driver.announcements[-1].text == text
+    assert driver.set_morse(True) is False
