@@ -8,7 +8,8 @@ input.  So only complete, known commands are sent, and every reply is awaited wi
 
 When the daemon dies (EOF, broken pipe, refused connection) the connection is dropped and
 :class:`HamlibUnavailable` is raised at once; reconnection is attempted on a later call, no sooner
-than the back-off delay (doubling from ``backoff_initial_s`` to ``backoff_max_s``, measured on the
+than the back-off delay (doubling from ``backoff_initial_s`` to ``backoff_max_s``, 1.5 s by default so a
+returning daemon is found again within 2 s; measured on the
 injected clock), so a dead daemon never stalls the caller.
 """
 
@@ -39,7 +40,7 @@ class HamlibConnection:
     """One TCP connection to a Hamlib daemon, reopened on demand."""
 
     def __init__(self, host: str, port: int, clock: Clock, name: str = "hamlib", timeout_s: float = 1.0,
-                 backoff_initial_s: float = 0.5, backoff_max_s: float = 10.0) -> None:
+                 backoff_initial_s: float = 0.25, backoff_max_s: float = 1.5) -> None:
         self.host, self.port, self.clock, self.name = host, port, clock, name
         self.timeout_s = timeout_s
         self.backoff_initial_s, self.backoff_max_s = backoff_initial_s, backoff_max_s

@@ -1,0 +1,101 @@
+"""Faults: SIGKILL during an element update, and Hamlib daemons killed and restarted 20 times."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from nfwserver.app.element_store import ElementStore
+from nfwserver.clock import SystemClock
+from nfwserver.radio.rigctld_backend import RigctldBackend
+from nfwserver.radio.transponder import Channel
+from nfwserver.radio.tuning import DopplerTuner
+from nfwserver.rotor.geometry import RotorGeometry
+from nfwserver.rotor.kct_driver import KctDriver
+from nfwserver.rotor.kct_status import KctStatusBit
+from nfwserver.rotor.rotctld_backend import RotctldBackend
+from nfwserver.tracking.elements import load_element_file
+from tests.conftest import DATA
+from tests.hamlib_daemons import HamlibDaemon
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGKILL")
+def test_sigkill_during_an_element_update_leaves_a_whole_catalog(tmp_path) -> None:
+    store = tmp_path / "elements.txt"
+    visual = load_element_file(DATA / "visual.txt").sets
+    ElementStore(store).update(visual)
+    old_count = len(ElementStore(store).load())
+    active = {s.catalog_number for s in load_element_file(DATA / "active.txt").sets}
+    expected_new = len(active | {s.catalog_number for s in visual})
+    outcomes = set()
+    for delay in (0.05, 0.2, 0.4, 0.6, 0.8, 1.0, 1.5):
+        store.write_text("".join(s.tle_text() for s in visual))  # back to the old catalog each round
+        proc = subprocess.Popen([sys.executable, "-m", "nfwserver", "elements", "update", str(DATA / "active.txt"),
+                                 "--store", str(store)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        time.sleep(delay)
+        if proc.poll() is None:
+            os.kill(proc.pid, signal.SIGKILL)
+            outcomes.add("killed")
+        else:
+            outcomes.add("finished")
+        proc.wait(10)
+        # Either the old catalog or the whole new one: never a partial file.
+        loaded = load_element_file(store)
+        assert not loaded.rejected
+        assert len(loaded.sets) in (old_count, expected_new)
+        assert store.read_text().count("\n") == 3 * len(loaded.sets)
+    assert "killed" in outcomes
+
+
+def _resume_delays(daemon: HamlibDaemon, attempt, cycles: int = 20) -> list[float]:
+    delays = []
+    for _ in range(cycles):
+        assert attempt()
+        daemon.kill()
+        for _ in range(3):
+            assert not attempt()
+            time.sleep(0.02)
+        daemon.start()
+        back = time.monotonic()
+        while not attempt():
+            assert time.monotonic() - back < 5.0, "did not resume"
+            time.sleep(0.02)
+        delays.append(time.monotonic() - back)
+    return delays
+
+
+def test_tuning_resumes_within_two_seconds_after_each_of_20_rigctld_restarts() -> None:
+    with HamlibDaemon("rigctld") as daemon:
+        tuner = DopplerTuner(Channel("ISS", 437_800_000, 145_990_000),
+                             RigctldBackend(SystemClock(), port=daemon.port, timeout_s=0.5))
+        rr = [0.0]
+
+        def attempt() -> bool:
+            rr[0] += 0.01
+            return tuner.update(rr[0]) is not None
+
+        delays = _resume_delays(daemon, attempt)
+        assert max(delays) < 2.0
+        assert daemon.query("s", 2) == ["1", "VFOB"]
+
+
+def test_rotor_resumes_within_two_seconds_after_each_of_20_rotctld_restarts() -> None:
+    geometry = RotorGeometry(-180.0, 450.0, 0.0, 90.0)
+    with HamlibDaemon("rotctld") as daemon:
+        driver = KctDriver(SystemClock(), RotctldBackend(SystemClock(), geometry, port=daemon.port, timeout_s=0.5),
+                           geometry)
+        target = [10.0]
+
+        def attempt() -> bool:
+            target[0] = 10.0 if target[0] > 15 else 20.0
+            driver.set_target(5.0, target[0])
+            driver.service()
+            return not driver.status().bits & KctStatusBit.CARD_ABSENT and driver.rotor_position() is not None
+
+        delays = _resume_delays(daemon, attempt)
+        assert max(delays) < 2.0
