@@ -20,6 +20,14 @@ ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "tests" / "data"
 
 
+@pytest.fixture(autouse=True)
+def private_user_dirs(tmp_path_factory, monkeypatch) -> None:
+    """Keep every test away from the real user's configuration, data and state directories."""
+    base = tmp_path_factory.mktemp("home")
+    for var in ("XDG_CONFIG_HOME", "XDG_DATA_HOME", "XDG_STATE_HOME", "XDG_CACHE_HOME"):
+        monkeypatch.setenv(var, str(base / var.lower()))
+
+
 @pytest.fixture
 def rotctld() -> Iterator[HamlibDaemon]:
     """A running ``rotctld -m 1`` (dummy rotor) on a free loopback port."""

@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 import logging
+import os
 import sys
 import threading
 
 from nfwserver.app.element_sources import FetchResult, fetch_all
 from nfwserver.app.element_store import ElementStore
+from nfwserver.app.session_state import SessionState, StateFile
 from nfwserver.clock import Clock
 from nfwserver.config.schema import Config
+from nfwserver.dde.events import Direction
 from nfwserver.dde.publisher import Publisher
 from nfwserver.dde.server import NovaServer
 from nfwserver.dde.transport import DdeServerTransport
@@ -73,8 +76,14 @@ class Station:
             self.catalog, config.observer, clock, horizon=config.horizon, ut1_utc=srv.ut1_utc_s,
             rate_hz=srv.rate_hz, services=srv.services, topic=srv.topic, items=srv.items,
         )
-        if srv.satellite is not None and not self.server.select_satellite(srv.satellite, source="config"):
-            log.warning("configured satellite %s is not in the loaded elements", srv.satellite)
+        self.state_file = StateFile(None if config.state_file == "default" else config.state_file) \
+            if config.state_file else None
+        saved = self.state_file.load() if self.state_file is not None else SessionState()
+        first_choice = saved.satellite if saved.satellite in self.catalog else srv.satellite
+        if first_choice is not None and not self.server.select_satellite(first_choice, source="config"):
+            log.warning("configured satellite %s is not in the loaded elements", first_choice)
+        if self.state_file is not None:
+            self.server.add_tick_listener(self._save_state)
         if transport is None:
             transport, self.transport_note = default_transport()
         else:
@@ -106,6 +115,66 @@ class Station:
         self._stop = threading.Event()
         self._refresher: threading.Thread | None = None
         self._started = False
+
+    def _save_state(self, sample) -> None:
+        if self.state_file is not None:
+            self.state_file.save(SessionState(sample.catalog_number))
+
+    def apply_config(self, new: Config) -> list[str]:
+        """Apply what can change while running (observer, horizon, UT1-UTC, rate, DDE names);
+        returns the settings that need a restart to take effect."""
+        server = self.server
+        server.set_observer(new.observer, new.server.ut1_utc_s)
+        server.set_horizon(new.horizon)
+        server.set_rate(new.server.rate_hz)
+        for catnr, name in new.dde_names.items():
+            try:
+                self.catalog.set_dde_name(catnr, name)
+            except ValueError as exc:
+                log.warning("DDE name for %s not applied: %s", catnr, exc)
+        if self.radio is not None:
+            self.radio.enabled = new.radio.enabled
+        restart = [name for name, old, now in (
+            ("[elements]", self.config.elements, new.elements), ("[rotor]", self.config.rotor, new.rotor),
+            ("[radio] backend", (self.config.radio.backend, self.config.radio.host, self.config.radio.port),
+             (new.radio.backend, new.radio.host, new.radio.port)),
+            ("[server] services/topic/items", (self.config.server.services, self.config.server.topic,
+                                                self.config.server.items),
+             (new.server.services, new.server.topic, new.server.items)),
+            ("[dialects]", self.config.dialects, new.dialects)) if old != now]
+        self.config = new
+        return restart
+
+    def watch_config(self, path: str, interval_s: float = 2.0) -> None:
+        """Re-read ``path`` when it changes; an invalid file is refused and the running configuration kept."""
+        from nfwserver.config import ConfigError, load_config
+
+        def mtime() -> float | None:
+            try:
+                return os.stat(path).st_mtime_ns
+            except OSError:
+                return None
+
+        def loop() -> None:
+            seen = mtime()
+            while not self._stop.wait(interval_s):
+                now = mtime()
+                if now == seen:
+                    continue
+                seen = now
+                try:
+                    new = load_config(path)
+                except ConfigError as exc:
+                    log.error("configuration change refused, keeping the running one: %s", exc)
+                    self.server.events.add(self.clock.now(), Direction.INFO, "note",
+                                           f"configuration change refused: {exc}", accepted=False)
+                    continue
+                restart = self.apply_config(new)
+                note = "configuration reloaded" + (f"; restart to apply {', '.join(restart)}" if restart else "")
+                log.info(note)
+                self.server.events.add(self.clock.now(), Direction.INFO, "note", note, accepted=True)
+
+        threading.Thread(target=loop, name="nfw-config", daemon=True).start()
 
     def _make_rotor(self, config: Config, clock: Clock) -> RotorCoupling | None:
         rc = config.rotor

@@ -74,6 +74,8 @@ def run(args: argparse.Namespace) -> int:
         notes.append(stale)
         hint = f"{hint} {stale}".strip()
     station.start()
+    if args.config:
+        station.watch_config(args.config)
     try:
         if console:
             from nfwserver.console.app import NfwConsole

@@ -156,7 +156,12 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
                               store_path)
 
     # [server]
-    sv_t = c.table(doc, "server", {"rate_hz", "services", "topic", "items", "satellite", "ut1_utc_s"})
+    sv_t = c.table(doc, "server", {"rate_hz", "services", "topic", "items", "satellite", "ut1_utc_s", "state_file"})
+    state_file = sv_t.get("state_file", "default")
+    if not isinstance(state_file, str):
+        c.problems.append("[server] state_file: must be a file name, \"default\" or \"none\"")
+        state_file = "none"
+    state_path = None if state_file == "none" else (state_file if state_file == "default" else str(base / state_file))
     rate = c.number("server", "rate_hz", sv_t.get("rate_hz", 5.0), 1, 50)
     services = c.strings("server", "services", sv_t.get("services", ["NFW32", "NFW_SERVER"]))
     items = c.strings("server", "items", sv_t.get("items", ["NFW_SERVER", "NFW_DATA"]))
@@ -283,6 +288,7 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
                           ro_threshold if ro_threshold is not None else 2.0, ro_speed or 6.0,
                           ro_lead if ro_lead is not None else 10.0, str(after_los), str(flip_mode),
                           int(park_az or 0), int(park_el or 0), int(park_delay or 0)),
+        state_file=state_path,
         dialects=DialectsConfig(tuple(dde), bool(predict_udp), str(predict_host),
                                 int(predict_port if predict_port is not None else 1210), str(callsign)),
     )
@@ -334,6 +340,7 @@ topic = "NFW_DATA"
 items = ["NFW_SERVER", "NFW_DATA"]
 satellite = 25544               # AutoTracking satellite at start (catalog number)
 ut1_utc_s = 0.0                 # UT1-UTC from IERS Bulletin A (seconds)
+state_file = "default"          # remembers the AutoTracking satellite across restarts; "none" to disable
 
 [satellites]
 # names = { 25544 = "ISS", 27607 = "SO-50" }   # DDE names (12 characters, no spaces)

@@ -78,5 +78,6 @@ class Config:
     radio: RadioConfig = field(default_factory=RadioConfig)
     rotor: RotorConfig = field(default_factory=RotorConfig)
     dialects: DialectsConfig = field(default_factory=DialectsConfig)
+    state_file: str | None = "default"  #: session state file; "default": user state dir; None: not kept
     channels: dict[int, Channel] = field(default_factory=dict)  #: catalog number -> radio channel
     source: str = "<built-in defaults>"

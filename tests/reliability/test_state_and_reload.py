@@ -1,0 +1,139 @@
+"""Session state across restarts and kills; configuration changed while running; slow element URLs; many files."""
+
+from __future__ import annotations
+
+import http.server
+import json
+import os
+import random
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+from nfwserver.app.element_sources import fetch_all
+from nfwserver.app.session_state import SessionState, StateFile
+from nfwserver.app.station import Station
+from nfwserver.clock import SystemClock
+from nfwserver.config import parse_config
+from nfwserver.dde.events import Direction
+from nfwserver.fake_dde import FakeDdeSystem
+from nfwserver.tracking.elements import load_elements
+from tests.conftest import DATA
+
+
+def test_the_selected_satellite_survives_a_restart(tmp_path) -> None:
+    state = tmp_path / "state.json"
+    config = parse_config(f'[server]\nstate_file = "{state}"\n')
+    first = Station(config, SystemClock(), transport=FakeDdeSystem().server_transport())
+    first.server.command("SAT=27607")
+    first.server.tick()
+    assert json.loads(state.read_text()) == {"satellite": 27607}
+    second = Station(config, SystemClock(), transport=FakeDdeSystem().server_transport())
+    assert second.server.snapshot().catalog_number == 27607
+    state.write_text("{not json")
+    third = Station(config, SystemClock(), transport=FakeDdeSystem().server_transport())
+    assert third.server.snapshot().catalog_number == 25544  # a broken file means no saved state
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGKILL")
+def test_sigkill_during_state_saves_leaves_a_valid_file(tmp_path) -> None:
+    state = tmp_path / "state.json"
+    StateFile(state).save(SessionState(1))
+    script = (
+        "import itertools, sys\n"
+        "from nfwserver.app.session_state import SessionState, StateFile\n"
+        f"f = StateFile({str(state)!r})\n"
+        "for k in itertools.count(2):\n"
+        "    f.save(SessionState(k))\n"
+    )
+    for delay in (0.05, 0.1, 0.2, 0.3, 0.5):
+        proc = subprocess.Popen([sys.executable, "-c", script])
+        time.sleep(delay)
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait(5)
+        assert isinstance(StateFile(state).load().satellite, int)
+        assert json.loads(state.read_text())["satellite"] >= 1
+
+
+def test_configuration_changed_while_running(tmp_path) -> None:
+    path = tmp_path / "c.toml"
+    path.write_text('[observer]\nlocation = "JO02ae"\n[server]\nrate_hz = 5\nstate_file = "none"\n')
+    from nfwserver.config import load_config
+
+    station = Station(load_config(path), SystemClock(), transport=FakeDdeSystem().server_transport())
+    notes = []
+    station.server.events.subscribe(lambda e: notes.append(e) if e.direction is Direction.INFO else None)
+    station.watch_config(str(path), interval_s=0.05)
+    try:
+        before = station.server.observer
+        time.sleep(0.1)
+        path.write_text('[observer]\nlocation = "QF56od"\n[server]\nrate_hz = 500\n')  # invalid rate
+        deadline = time.monotonic() + 5
+        while not any("refused" in n.text for n in notes) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert any("[server] rate_hz" in n.text for n in notes)
+        assert station.server.observer == before and station.server.rate_hz == 5  # old configuration kept
+        time.sleep(0.05)
+        path.write_text('[observer]\nlocation = "QF56od"\n[server]\nrate_hz = 10\nstate_file = "none"\n'
+                        '[rotor]\nbackend = "sim"\n')
+        while not any("reloaded" in n.text for n in notes) and time.monotonic() < deadline + 5:
+            time.sleep(0.05)
+        assert station.server.observer.latitude_deg < 0 and station.server.rate_hz == 10
+        assert any("restart to apply [rotor]" in n.text for n in notes)
+    finally:
+        station.stop()
+        station._stop.set()
+
+
+def test_a_slow_element_url_times_out_and_the_rest_loads(tmp_path) -> None:
+    class Slow(http.server.BaseHTTPRequestHandler):
+        def do_GET(self):
+            time.sleep(2.0)
+            self.send_response(200)
+            self.end_headers()
+
+        def log_message(self, *args):
+            pass
+
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Slow)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    try:
+        started = time.monotonic()
+        result = fetch_all(files=(str(DATA / "visual.txt"),), urls=(f"http://127.0.0.1:{server.server_address[1]}/x",),
+                           use_bundled=False, timeout_s=0.3)
+        assert time.monotonic() - started < 1.5
+        assert len(result.sets) == 148 and len(result.failed) == 1
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+def test_ten_thousand_generated_element_files_never_raise() -> None:
+    rng = random.Random(2026)
+    lines = (DATA / "visual.txt").read_text().splitlines()
+    junk = ["", "junk", "1 ", "2 x", "Satellite: X", "Mean motion: 3", "0 NAME", "\x00\x01", "{",
+            "NORAD_CAT_ID,MEAN_MOTION"]
+    loaded = rejected = 0
+    for _ in range(10_000):
+        pieces = []
+        for _ in range(rng.randint(0, 8)):
+            choice = rng.random()
+            if choice < 0.5:
+                k = rng.randrange(0, len(lines) - 2, 3)
+                block = lines[k : k + 3]
+                if rng.random() < 0.3:  # corrupt one character
+                    i = rng.randrange(3)
+                    j = rng.randrange(len(block[i]))
+                    block[i] = block[i][:j] + rng.choice("0123456789 -+.xZ") + block[i][j + 1 :]
+                pieces += block
+            else:
+                pieces.append(rng.choice(junk))
+        result = load_elements("\n".join(pieces), "generated")
+        loaded += len(result.sets)
+        rejected += len(result.rejected)
+        assert all(r.reason for r in result.rejected)
+    assert loaded > 10_000 and rejected > 1_000
