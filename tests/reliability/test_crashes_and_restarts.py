@@ -99,3 +99,41 @@ def test_rotor_resumes_within_two_seconds_after_each_of_20_rotctld_restarts() ->
 
         delays = _resume_delays(daemon, attempt)
         assert max(delays) < 2.0
+
+
+def test_the_dde_feed_never_pauses_while_daemons_die_and_return() -> None:
+    """A full station in real time (10 Hz) with rotctld and rigctld killed and restarted under it."""
+    from nfwserver.app.station import Station
+    from nfwserver.config import parse_config
+    from nfwserver.fake_dde import FakeDdeSystem
+
+    with HamlibDaemon("rotctld") as rot, HamlibDaemon("rigctld") as rig:
+        config = parse_config(
+            '[observer]\nlocation = "JO02ae"\n[server]\nrate_hz = 10\nstate_file = "none"\n'
+            f'[radio]\nbackend = "rigctld"\nport = {rig.port}\nenabled = true\n'
+            f'[rotor]\nbackend = "rotctld"\nport = {rot.port}\ngeometry = "overlap-450"\n'
+        )
+        system = FakeDdeSystem()
+        station = Station(config, SystemClock(), transport=system.server_transport())
+        station.start()
+        client = system.connect("NFW32", "NFW_DATA")
+        client.start_advise("NFW_SERVER")
+        try:
+            client.poke("NFW_SERVER", "TUNE ON")
+            client.poke("NFW_SERVER", "TRACK ON")
+            for _ in range(3):
+                time.sleep(0.4)
+                rot.kill()
+                rig.kill()
+                time.sleep(0.4)
+                rot.start()
+                rig.start()
+            time.sleep(2.0)  # both must be back within 2 s of the daemons' return
+        finally:
+            station.stop()
+        stats = station.publisher.stats
+        assert stats.failures == 0 and stats.skipped == 0
+        assert max(stats.lateness_s) < 0.05  # the publish loop never waited for a device
+        assert len(client.texts()) >= 0.9 * stats.ticks
+        assert station.radio.tuner.available and station.radio.last_result is not None
+        assert not station.rotor.driver.status().bits & KctStatusBit.CARD_ABSENT
