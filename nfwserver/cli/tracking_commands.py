@@ -40,6 +40,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--sat", action="append", default=[], help="catalog number or name; repeatable")
     p.add_argument("--start", required=True, help="ISO-8601 start (UTC when no zone is given)")
     p.add_argument("--hours", type=float, default=24.0)
+    p.add_argument("--workers", type=int, default=1, metavar="N",
+                   help="worker processes for large catalogs (POSIX; default 1)")
     p.set_defaults(func=run_passes)
 
     p = subparsers.add_parser("visible", help="satellites above the horizon table at an instant",
@@ -125,8 +127,10 @@ def run_passes(args: argparse.Namespace) -> int:
             sats.append(sat)
     else:
         sats = inputs.catalog.satellites()
+    if not 1 <= args.workers <= 64:
+        raise CliError("--workers must be between 1 and 64")
     passes = find_passes(sats, inputs.observer, start, start + timedelta(hours=args.hours),
-                         horizon=inputs.horizon, ut1_utc=inputs.ut1_utc)
+                         horizon=inputs.horizon, ut1_utc=inputs.ut1_utc, workers=args.workers)
     write, flush = _writer(args.format, PASS_COLUMNS)
     for p in passes:
         sat = inputs.catalog.get(p.catalog_number)

@@ -328,6 +328,17 @@ _SHORT_PERIOD_S = 3.0 * 3600.0
 _LEO_RATE = 1.2e-3
 
 
+#: Fork-time hand-over of the work to worker processes (Satrec objects cannot be pickled); set only
+#: for the duration of one parallel :func:`find_passes` call.
+_FORK_JOB: tuple | None = None
+
+
+def _fork_worker(indices: list[int]) -> list[Pass]:
+    assert _FORK_JOB is not None
+    satrecs, args = _FORK_JOB
+    return find_passes([satrecs[i] for i in indices], *args)
+
+
 def find_passes(
     satellites: Sequence,
     observer: Observer,
@@ -336,13 +347,34 @@ def find_passes(
     horizon: HorizonTable | None = None,
     ut1_utc: float = 0.0,
     fine_step_s: float = 60.0,
+    workers: int = 1,
 ) -> list[Pass]:
     """Passes of ``satellites`` (``sgp4`` Satrecs, or objects with a ``.satrec``) between ``start`` and ``end``.
 
     Returns the passes overlapping the window, sorted by AOS (TCA when AOS is unknown).  See the
     module docstring for the method and for passes cut by the window.  ``fine_step_s`` is the
     sampling step for low orbits; slower satellites are sampled proportionally more coarsely.
+
+    ``workers`` > 1 splits large catalogs over that many forked processes (POSIX only; meant for
+    command-line use: never fork a process that runs other threads, such as the server).  The
+    result is the same as with one worker.
     """
+    global _FORK_JOB
+    if workers > 1 and len(satellites) >= 200 * workers and _FORK_JOB is None:
+        import multiprocessing
+
+        if "fork" in multiprocessing.get_all_start_methods():
+            satrecs_all = [getattr(s, "satrec", s) for s in satellites]
+            _FORK_JOB = (satrecs_all, (observer, start, end, horizon, ut1_utc, fine_step_s))
+            try:
+                chunks = [list(range(k, len(satrecs_all), workers)) for k in range(workers)]
+                with multiprocessing.get_context("fork").Pool(workers) as pool:
+                    parts = pool.map(_fork_worker, chunks)
+            finally:
+                _FORK_JOB = None
+            merged = [p for part in parts for p in part]
+            merged.sort(key=lambda p: (p.aos or p.tca, p.catalog_number))
+            return merged
     horizon = horizon or _FLAT
     if start.tzinfo is None:
         start = start.replace(tzinfo=timezone.utc)

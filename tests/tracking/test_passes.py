@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from datetime import datetime, timedelta, timezone
 
 import numpy as np
@@ -131,3 +132,19 @@ def test_short_pass_between_grid_points_is_found() -> None:
     assert len(short) == 1
     assert 0 < short[0].duration_s < 30
     assert short[0].aos < short[0].tca < short[0].los
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="fork")
+def test_worker_processes_give_the_same_passes() -> None:
+    sats = list(ACTIVE.values())[:500]
+    serial = find_passes(sats, OBSERVERS[0], START, START + timedelta(hours=6))
+    parallel = find_passes(sats, OBSERVERS[0], START, START + timedelta(hours=6), workers=2)
+    assert len(serial) > 100 and len(parallel) == len(serial)
+    # Worker processes see different satellite groups (and so search grids): equal within the refinement.
+    key = lambda p: (p.catalog_number, p.tca)  # noqa: E731
+    for a, b in zip(sorted(serial, key=key), sorted(parallel, key=key)):
+        assert a.catalog_number == b.catalog_number
+        for x, y in ((a.aos, b.aos), (a.los, b.los)):
+            assert (x is None) == (y is None) and (x is None or abs((x - y).total_seconds()) < 0.01)
+        assert abs((a.tca - b.tca).total_seconds()) < 0.5
+        assert abs(a.max_elevation_deg - b.max_elevation_deg) < 1e-3
