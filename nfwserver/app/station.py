@@ -149,9 +149,10 @@ class Station:
         """Re-read ``path`` when it changes; an invalid file is refused and the running configuration kept."""
         from nfwserver.config import ConfigError, load_config
 
-        def mtime() -> float | None:
+        def mtime() -> tuple[int, int] | None:
             try:
-                return os.stat(path).st_mtime_ns
+                st = os.stat(path)
+                return st.st_mtime_ns, st.st_size
             except OSError:
                 return None
 
@@ -161,6 +162,9 @@ class Station:
                 now = mtime()
                 if now == seen:
                     continue
+                # Let a writer finish: read only once the file has stopped changing.
+                while not self._stop.wait(max(0.2, interval_s)) and mtime() != now:
+                    now = mtime()
                 seen = now
                 try:
                     new = load_config(path)

@@ -33,6 +33,7 @@ bogus events; one whose rise or set lies beyond the extension gets ``None`` for 
 from __future__ import annotations
 
 import math
+import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
@@ -356,11 +357,12 @@ def find_passes(
     sampling step for low orbits; slower satellites are sampled proportionally more coarsely.
 
     ``workers`` > 1 splits large catalogs over that many forked processes (POSIX only; meant for
-    command-line use: never fork a process that runs other threads, such as the server).  The
-    result is the same as with one worker.
+    command-line use).  Forking a process that runs other threads can deadlock the child, so the
+    work stays in this process unless it is single-threaded.  The passes found are the same as
+    with one worker (times equal within the refinement tolerance).
     """
     global _FORK_JOB
-    if workers > 1 and len(satellites) >= 200 * workers and _FORK_JOB is None:
+    if workers > 1 and len(satellites) >= 200 * workers and _FORK_JOB is None and threading.active_count() == 1:
         import multiprocessing
 
         if "fork" in multiprocessing.get_all_start_methods():
