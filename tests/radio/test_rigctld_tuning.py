@@ -126,11 +126,12 @@ def test_coupling_tunes_from_ticks_on_its_worker(rigctld) -> None:
     sample = TickSample(PASS.tca, 25544, "ISS", la, True, True, False, "", 0)
     coupling.start()
     try:
-        coupling.on_tick(sample)
-        for _ in range(200):
+        for _ in range(300):  # ticks keep coming, as from the publisher; bounded wait for the worker
+            coupling.on_tick(sample)
             if coupling.last_result is not None:
                 break
-            time.sleep(0.01)  # bounded wait for the worker thread
+            clock.advance(0.2)  # the back-off after a transient failure runs on this clock
+            time.sleep(0.01)
     finally:
         coupling.stop()
     assert coupling.last_result is not None
