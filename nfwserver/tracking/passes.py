@@ -325,6 +325,9 @@ def _visibility_screen(satrecs: list[Satrec], observer: Observer, t0: datetime, 
 
 #: Satellites with periods up to this (s) are searched together with a short look-back.
 _SHORT_PERIOD_S = 3.0 * 3600.0
+#: Screen step for low orbits, and the sampling step of near-circular ones under a flat horizon (s).
+_LEO_COARSE_S = 600.0
+_CIRCULAR_STEP_S = 300.0
 #: Geocentric angular rate (rad/s) of a low satellite, for which the fine step is ``fine_step_s``.
 _LEO_RATE = 1.2e-3
 
@@ -388,7 +391,7 @@ def find_passes(
     periods = np.array([2.0 * math.pi / max(sr.no_kozai, 1e-9) * 60.0 for sr in satrecs])  # seconds
     passes: list[Pass] = []
     short = periods <= _SHORT_PERIOD_S
-    for group, coarse in ((short, 300.0), (~short, 1200.0)):
+    for group, coarse in ((short, _LEO_COARSE_S), (~short, 1200.0)):
         members = [satrecs[i] for i in np.flatnonzero(group)]
         if members:
             extension = float(min(np.max(periods[group]), SECONDS_PER_DAY))
@@ -416,7 +419,7 @@ def _find_group(satrecs: list[Satrec], observer: Observer, start: datetime, end:
     # coarse steps wide: the coarse points themselves are enough to bracket every event.
     if horizon.is_flat:
         circular = np.array([sr.ecco < 0.05 for sr in satrecs])
-        per_sat = np.where(circular, 1, per_sat)
+        per_sat = np.where(circular, max(1, int(round(coarse_step_s / _CIRCULAR_STEP_S))), per_sat)
     sat_idx, interval_idx = np.nonzero(mask)
     if len(sat_idx) == 0:
         return []
@@ -429,7 +432,8 @@ def _find_group(satrecs: list[Satrec], observer: Observer, start: datetime, end:
     step_in = np.arange(len(fine_sat)) - first
     sample_step = coarse_step_s / per_sat[fine_sat]
     fine_t = grid[np.repeat(interval_idx, counts)] + step_in * sample_step
-    on_grid = per_sat[fine_sat] == 1
+    ratio = fine_t / coarse_step_s
+    on_grid = np.abs(ratio - np.rint(ratio)) < 1e-9
     f = np.empty(len(fine_t))
     el = np.full(len(fine_t), np.nan)
     k = np.rint(fine_t[on_grid] / coarse_step_s).astype(np.intp)
