@@ -10,8 +10,9 @@ from pathlib import Path
 import numpy as np
 
 from nfwserver.clock import SystemClock, VirtualClock
-from nfwserver.dde.publisher import Publisher
-from nfwserver.dde.server import NovaServer
+from nfwserver.core.publisher import Publisher
+from nfwserver.core.station_core import StationCore
+from nfwserver.dde.nova_service import NovaDdeService
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.elements import load_element_file
@@ -25,9 +26,9 @@ START = datetime(2026, 5, 8, tzinfo=timezone.utc)
 
 def tick_cost_us(clients: int, ticks: int = 3000) -> float:
     clock = VirtualClock(START)
-    server = NovaServer(CATALOG, OBS, clock, satellite=25544, rate_hz=10)
+    server = StationCore(CATALOG, OBS, clock, satellite=25544, rate_hz=10)
     system = FakeDdeSystem(received_capacity=4)
-    server.attach(system.server_transport())
+    NovaDdeService(server).attach(system.server_transport())
     for _ in range(clients):
         system.connect("NFW32", "NFW_DATA").start_advise("NFW_SERVER")
     server.set_tune(True)
@@ -43,9 +44,9 @@ def tick_cost_us(clients: int, ticks: int = 3000) -> float:
 
 
 def loop_error_ms(rate: float, seconds: float) -> tuple[float, float, float, int]:
-    server = NovaServer(CATALOG, OBS, SystemClock(), satellite=25544, rate_hz=rate)
+    server = StationCore(CATALOG, OBS, SystemClock(), satellite=25544, rate_hz=rate)
     system = FakeDdeSystem(received_capacity=4)
-    server.attach(system.server_transport())
+    NovaDdeService(server).attach(system.server_transport())
     for _ in range(10):
         system.connect("NFW32", "NFW_DATA").start_advise("NFW_SERVER")
     server.set_tune(True)

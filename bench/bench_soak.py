@@ -13,7 +13,8 @@ from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
 from nfwserver.clock import VirtualClock
-from nfwserver.dde.server import NovaServer
+from nfwserver.core.station_core import StationCore
+from nfwserver.dde.nova_service import NovaDdeService
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.elements import load_element_file
@@ -39,9 +40,9 @@ def main() -> None:
     catalog = Catalog(sets)
     numbers = [s.catalog_number for s in catalog]
     clock = VirtualClock(datetime(2026, 5, 8, tzinfo=timezone.utc))
-    server = NovaServer(catalog, Observer(52.2, 0.12, 20.0), clock, satellite=25544, rate_hz=RATE)
+    server = StationCore(catalog, Observer(52.2, 0.12, 20.0), clock, satellite=25544, rate_hz=RATE)
     system = FakeDdeSystem(received_capacity=64)
-    server.attach(system.server_transport())
+    NovaDdeService(server).attach(system.server_transport())
     clients = [system.connect("NFW32", "NFW_DATA") for _ in range(CLIENTS)]
     for c in clients:
         c.start_advise("NFW_SERVER")
@@ -54,7 +55,7 @@ def main() -> None:
         nonlocal published
         published += bool(sample.text)
 
-    server.add_tick_listener(count)
+    server.subscribe(count)
     rss_start = None
     started = time.perf_counter()
     step = timedelta(seconds=1.0 / RATE)

@@ -31,6 +31,14 @@ class Clock(Protocol):
         """Block (or, for a virtual clock, advance) for ``seconds``; non-positive returns at once."""
         ...
 
+    def wait(self, event: threading.Event, seconds: float) -> bool:
+        """Block until ``event`` is set or ``seconds`` of *this clock's* time have passed.
+
+        Returns True when the event was set.  Every loop in the server waits through this, so a
+        whole station runs on a :class:`VirtualClock` in tests without real sleeps.
+        """
+        ...
+
 
 class SystemClock:
     """Real time: UTC from the operating system, ``time.monotonic`` and ``time.sleep``."""
@@ -45,12 +53,19 @@ class SystemClock:
         if seconds > 0:
             time.sleep(seconds)
 
+    def wait(self, event: threading.Event, seconds: float) -> bool:
+        return event.wait(max(0.0, seconds))
+
 
 class VirtualClock:
     """A clock that stands still until advanced; ``sleep`` advances it instantly.
 
-    Thread-safe.  ``start`` must be timezone-aware (naive datetimes are taken as UTC).
+    Thread-safe.  ``start`` must be timezone-aware (naive datetimes are taken as UTC).  Threads in
+    :meth:`wait` wake when another thread advances the clock past their deadline (or their event is
+    set; that is noticed within :attr:`POLL_S` real seconds), so loops run on virtual time.
     """
+
+    POLL_S = 0.01
 
     def __init__(self, start: datetime) -> None:
         if start.tzinfo is None:
@@ -58,6 +73,7 @@ class VirtualClock:
         self._start = start.astimezone(timezone.utc)
         self._elapsed = 0.0
         self._lock = threading.Lock()
+        self._advanced = threading.Condition(self._lock)
 
     def now(self) -> datetime:
         with self._lock:
@@ -73,6 +89,7 @@ class VirtualClock:
             raise ValueError("a virtual clock cannot go backwards")
         with self._lock:
             self._elapsed += seconds
+            self._advanced.notify_all()
 
     def set(self, when: datetime) -> None:
         """Jump to ``when`` (must not be earlier than now)."""
@@ -83,3 +100,10 @@ class VirtualClock:
     def sleep(self, seconds: float) -> None:
         if seconds > 0:
             self.advance(seconds)
+
+    def wait(self, event: threading.Event, seconds: float) -> bool:
+        with self._lock:
+            deadline = self._elapsed + max(0.0, seconds)
+            while not event.is_set() and self._elapsed < deadline:
+                self._advanced.wait(self.POLL_S)
+        return event.is_set()

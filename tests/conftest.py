@@ -40,3 +40,23 @@ def rigctld() -> Iterator[HamlibDaemon]:
     """A running ``rigctld -m 1`` (dummy rig) on a free loopback port."""
     with HamlibDaemon("rigctld") as daemon:
         yield daemon
+
+
+def advance_until(clock, predicate, step_s: float = 0.2, limit_s: float = 600.0, real_timeout_s: float = 20.0) -> bool:
+    """Advance a :class:`VirtualClock` in ``step_s`` steps until ``predicate()`` holds.
+
+    The station's threads wait on that clock, so each step lets them run; between steps the test
+    yields the processor briefly (never a fixed sleep of seconds).  Returns the predicate's last value:
+    False when ``limit_s`` of virtual time or ``real_timeout_s`` of real time ran out.
+    """
+    import time
+
+    deadline = time.monotonic() + real_timeout_s
+    advanced = 0.0
+    while not predicate():
+        if advanced >= limit_s or time.monotonic() > deadline:
+            return bool(predicate())
+        clock.advance(step_s)
+        advanced += step_s
+        time.sleep(0.002)
+    return True

@@ -1,7 +1,12 @@
 """The session state kept across restarts: the AutoTracking satellite.
 
 Saved as a small JSON file, atomically (:mod:`nfwserver.storage`), whenever it changes; a missing,
-unreadable or malformed file just means "no saved state".
+unreadable or malformed file just means "no saved state".  The file also records which
+``[server] satellite`` was configured when the choice was made, so an edit of the configuration
+wins over a choice saved before it (the station says so in its log).
+
+:class:`SessionSaver` follows the ticks on its own worker thread: saving (an fsync) never runs on
+the publisher.
 """
 
 from __future__ import annotations
@@ -11,6 +16,8 @@ import logging
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from nfwserver.core.sample import TickSample
+from nfwserver.core.tick_worker import TickWorker
 from nfwserver.storage import atomic_write_text
 
 log = logging.getLogger(__name__)
@@ -18,7 +25,8 @@ log = logging.getLogger(__name__)
 
 @dataclass(frozen=True)
 class SessionState:
-    satellite: int | None = None
+    satellite: int | None = None  #: the AutoTracking satellite chosen while running
+    configured: int | None = None  #: ``[server] satellite`` at the time of that choice
 
 
 def default_state_path() -> Path:
@@ -35,10 +43,11 @@ class StateFile:
     def load(self) -> SessionState:
         try:
             doc = json.loads(self.path.read_text(encoding="utf-8"))
-            satellite = doc.get("satellite")
-            if satellite is not None and (isinstance(satellite, bool) or not isinstance(satellite, int)):
-                raise ValueError("satellite is not a catalog number")
-            state = SessionState(satellite)
+            numbers = [doc.get("satellite"), doc.get("configured")]
+            for number in numbers:
+                if number is not None and (isinstance(number, bool) or not isinstance(number, int)):
+                    raise ValueError("satellite is not a catalog number")
+            state = SessionState(*numbers)
         except FileNotFoundError:
             state = SessionState()
         except (OSError, ValueError, AttributeError) as exc:
@@ -56,3 +65,17 @@ class StateFile:
             self._last = state
         except OSError as exc:
             log.error("cannot save the session state to %s: %s", self.path, exc)
+
+
+class SessionSaver(TickWorker):
+    """Saves the AutoTracking satellite when it changes, on the worker thread ``nfw-session``."""
+
+    worker_name = "nfw-session"
+
+    def __init__(self, state_file: StateFile, configured: int | None) -> None:
+        super().__init__()
+        self.state_file = state_file
+        self.configured = configured
+
+    def process(self, sample: TickSample) -> None:
+        self.state_file.save(SessionState(sample.catalog_number, self.configured))

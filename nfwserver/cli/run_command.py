@@ -64,6 +64,11 @@ def run(args: argparse.Namespace) -> int:
         default_log = Path(user_log_dir("nfwserver", appauthor=False)) / "nfwserver.log"
         file_handler = _log_to_file(Path(args.log_file) if args.log_file else default_log)
     station = Station(config, SystemClock())
+    try:
+        station.start()
+    except OSError as exc:
+        station.stop()
+        raise CliError(f"cannot start the station: {exc}") from None
     notes = [f"configuration: {config.source}", station.transport_note, f"{len(station.catalog)} satellites loaded"]
     if hint:
         notes.append(hint)
@@ -73,15 +78,15 @@ def run(args: argparse.Namespace) -> int:
                  "([elements] files or urls in the configuration)")
         notes.append(stale)
         hint = f"{hint} {stale}".strip()
-    station.start()
     if args.config:
         station.watch_config(args.config)
     try:
         if console:
             from nfwserver.console.app import NfwConsole
 
-            app = NfwConsole(station.server, station.transport_note, hint, radio=station.radio, rotor=station.rotor,
-                             favourites=config.favourites or (25544, 27607, 43017, 44909, 7530))
+            app = NfwConsole(station.core, station.transport_note, hint, radio=station.radio, rotor=station.rotor,
+                             favourites=config.favourites or (25544, 27607, 43017, 44909, 7530),
+                             clients=station.nova.client_count)
             if args.duration:
                 threading.Timer(args.duration, app.exit).start()
             app.run()

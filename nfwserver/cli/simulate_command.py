@@ -13,9 +13,11 @@ import sys
 
 from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs, parse_time
 from nfwserver.clock import VirtualClock
+from nfwserver.core.publisher import run_virtual
+from nfwserver.core.state import MAX_RATE_HZ, MIN_RATE_HZ
+from nfwserver.core.station_core import StationCore
 from nfwserver.dde.clipboard import CF_TEXT
-from nfwserver.dde.publisher import run_virtual
-from nfwserver.dde.server import MAX_RATE_HZ, MIN_RATE_HZ, NovaServer
+from nfwserver.dde.nova_service import NovaDdeService
 from nfwserver.fake_dde import DdeError, FakeDdeSystem, Received
 
 
@@ -57,17 +59,21 @@ def run(args: argparse.Namespace) -> int:
         raise CliError(f"--start: {exc}") from None
     inputs = load_tracking_inputs(args)
     clock = VirtualClock(start)
-    server = NovaServer(inputs.catalog, inputs.observer, clock, horizon=inputs.horizon,
-                        ut1_utc=inputs.ut1_utc, rate_hz=args.rate)
+    server = StationCore(inputs.catalog, inputs.observer, clock, horizon=inputs.horizon,
+                         ut1_utc=inputs.ut1_utc, rate_hz=args.rate)
     if args.sat is None:
         print("nfwserver: no --sat given: no AutoTracking satellite, so nothing is published", file=sys.stderr)
     elif not server.select_satellite(args.sat, source="simulate"):
         print(f"nfwserver: satellite {args.sat} is not in the element files; nothing is published",
               file=sys.stderr)
-    # Refusals are reported below with their time; keep the server's own warning out of the way.
-    logging.getLogger("nfwserver.dde.server").setLevel(logging.ERROR)
+    # Refusals are reported below with their time; keep the core's own warning out of the way
+    # (restored on the way out: the logger is shared with anything else in this process).
+    core_log = logging.getLogger("nfwserver.core.station_core")
+    saved_level = core_log.level
+    core_log.setLevel(logging.ERROR)
     system = FakeDdeSystem(received_capacity=16)
-    server.attach(system.server_transport())
+    service = NovaDdeService(server)
+    service.attach(system.server_transport())
     client = system.connect("NFW32", "NFW_DATA", client_name="simulate")
     lines: list[str] = []
 
@@ -104,5 +110,6 @@ def run(args: argparse.Namespace) -> int:
         sys.stderr.close()
         return 0
     finally:
-        server.detach()
+        service.detach()
+        core_log.setLevel(saved_level)
     return 0

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import collections
 import threading
+from collections.abc import Callable
 from datetime import datetime, timedelta
 
 from rich.text import Text
@@ -24,10 +25,10 @@ from textual.widgets import Footer, Header, Input, OptionList, RichLog, Static
 from textual.widgets.option_list import Option
 
 from nfwserver.console.skyplot import render_sky
-from nfwserver.dde.events import Direction, Event
-from nfwserver.dde.protocol import escape_for_log
-from nfwserver.dde.server import NovaServer
-from nfwserver.dde.status import describe
+from nfwserver.core.events import Direction, Event
+from nfwserver.core.nova_protocol import escape_for_log
+from nfwserver.core.station_core import StationCore
+from nfwserver.core.status import describe
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.rotor.coupling import RotorCoupling
 from nfwserver.tracking.look_angles import LookAngleCalculator
@@ -60,13 +61,14 @@ class NfwConsole(App):
         Binding("ctrl+q", "quit", "Quit"),
     ]
 
-    def __init__(self, server: NovaServer, transport_note: str = "", hint: str = "",
+    def __init__(self, core: StationCore, transport_note: str = "", hint: str = "",
                  radio: RadioCoupling | None = None, rotor: RotorCoupling | None = None,
-                 favourites: tuple[int, ...] = ()) -> None:
+                 favourites: tuple[int, ...] = (), clients: Callable[[], tuple[int, int]] | None = None) -> None:
         super().__init__()
+        self.clients = clients or (lambda: (0, 0))
         self.favourites = favourites
         self._passes_key: int | None = None
-        self.server = server
+        self.core = core
         self.radio = radio
         self.rotor = rotor
         self.transport_note = transport_note
@@ -97,7 +99,7 @@ class NfwConsole(App):
         yield Footer()
 
     def on_mount(self) -> None:
-        self._unsubscribe = self.server.events.subscribe(self._enqueue)
+        self._unsubscribe = self.core.events.subscribe(self._enqueue)
         incoming = self.query_one("#incoming", RichLog)
         for note in (self.transport_note, self.hint):
             if note:
@@ -106,7 +108,7 @@ class NfwConsole(App):
         self.set_interval(0.25, self._refresh_state)
         self._refresh_state()
         picker = self.query_one("#picker", OptionList)
-        for sat in self.server.catalog:
+        for sat in self.core.state.catalog:
             label = f"{sat.dde_name:12} {sat.catalog_number:>6}  {sat.name}"
             picker.add_option(Option(label, id=str(sat.catalog_number)))
         self.query_one("#poke", Input).focus()
@@ -138,27 +140,28 @@ class NfwConsole(App):
                 incoming.write(Text(f"{stamp} [{who}] {escape_for_log(e.text)}{mark}{detail}", style=style))
 
     def _upcoming_pass(self, now: datetime) -> Pass | None:
-        snap = self.server.snapshot()
+        snap = self.core.snapshot()
         key = (snap.catalog_number, int(now.timestamp() // 60))
         if key != self._pass_key:
             self._pass_key = key
             self._next_pass = None
-            sat = self.server.catalog.get(snap.catalog_number) if snap.catalog_number else None
-            if sat is not None and self.server.observer is not None:
-                passes = find_passes([sat], self.server.observer, now, now + timedelta(hours=24),
-                                     horizon=self.server.horizon, ut1_utc=self.server.ut1_utc)
+            sat = self.core.state.catalog.get(snap.catalog_number) if snap.catalog_number else None
+            if sat is not None and self.core.state.observer is not None:
+                passes = find_passes([sat], self.core.state.observer, now, now + timedelta(hours=24),
+                                     horizon=self.core.state.horizon, ut1_utc=self.core.state.ut1_utc_s)
                 self._next_pass = next((p for p in passes if p.los is None or p.los > now), None)
         return self._next_pass
 
     def _refresh_state(self) -> None:
-        snap = self.server.snapshot()
+        snap = self.core.snapshot()
         sample = snap.last_sample
-        now = self.server.clock.now()
+        now = self.core.clock.now()
         lines = []
         sat = f"{snap.dde_name} ({snap.catalog_number})" if snap.catalog_number else "none selected"
-        lines.append(f"Satellite {sat}   TUNE {'ON' if snap.tune_on else 'OFF'}   "
-                     f"TRACK {'ON' if snap.track_on else 'OFF'}   rate {snap.rate_hz:g} Hz   "
-                     f"clients {snap.clients} ({snap.advise_loops} advise)")
+        conversations, loops = self.clients()
+        lines.append(f"Satellite {sat}   TUNE {'ON' if snap.state.dde_output else 'OFF'}   "
+                     f"TRACK {'ON' if snap.state.tracking else 'OFF'}   rate {snap.state.rate_hz:g} Hz   "
+                     f"clients {conversations} ({loops} advise)")
         if sample is not None and sample.look_angles is not None:
             la = sample.look_angles
             lines.append(f"AZ {la.azimuth_deg:6.1f}  EL {la.elevation_deg:5.1f}  RR {la.range_rate_km_s:+.4f} km/s  "
@@ -166,7 +169,7 @@ class NfwConsole(App):
                          f"Doppler@145.8MHz {-145.8e6 * la.range_rate_km_s / 299792.458:+.0f} Hz")
         else:
             lines.append("no position (no satellite, no observer, or SGP4 error)")
-        ant = snap.antenna
+        ant = snap.state.antenna
         ant_text = (f"{ant.azimuth_deg if ant.azimuth_deg is not None else '-'} / "
                     f"{ant.elevation_deg if ant.elevation_deg is not None else '-'} ({ant.source or 'unknown'})")
         nxt = self._upcoming_pass(now)
@@ -187,7 +190,7 @@ class NfwConsole(App):
                          f"  KCT status 0x{int(bits):02X}")
         if self.radio is not None:
             r = self.radio.last_result
-            state = "ON" if self.radio.enabled else "OFF"
+            state = "ON" if snap.state.radio_tuning else "OFF"
             if not self.radio.tuner.available:
                 radio_text = f"Radio: Doppler tuning {state}, radio unreachable ({self.radio.tuner.last_error})"
             elif r is not None:
@@ -209,7 +212,7 @@ class NfwConsole(App):
         text = message.value.strip()
         message.input.value = ""
         if text:
-            self.server.command(text, source="console")
+            self.core.command(text, source="console")
             self._drain()
             self._refresh_state()
 
@@ -223,7 +226,7 @@ class NfwConsole(App):
 
     def on_option_list_option_selected(self, message: OptionList.OptionSelected) -> None:
         if message.option.id:
-            self.server.command(f"SAT={message.option.id}", source="console")
+            self.core.command(f"SAT={message.option.id}", source="console")
         message.option_list.remove_class("shown")
         self.query_one("#poke", Input).focus()
         self._passes_key = None
@@ -232,27 +235,27 @@ class NfwConsole(App):
 
     def _refresh_side(self, now: datetime) -> None:
         """Upcoming passes of the favourites and the sky plot, recomputed once a minute."""
-        snap = self.server.snapshot()
+        snap = self.core.snapshot()
         key = int(now.timestamp() // 60) * 1_000_000 + (snap.catalog_number or 0)
-        if key == self._passes_key or self.server.observer is None:
+        if key == self._passes_key or self.core.state.observer is None:
             return
         self._passes_key = key
         selected = [snap.catalog_number] if snap.catalog_number else []
         wanted = list(dict.fromkeys([*self.favourites, *selected]))
-        sats = [s for s in (self.server.catalog.get(n) for n in wanted) if s is not None]
+        sats = [s for s in (self.core.state.catalog.get(n) for n in wanted) if s is not None]
         lines = []
         if sats:
-            passes = find_passes(sats, self.server.observer, now, now + timedelta(hours=12),
-                                 horizon=self.server.horizon, ut1_utc=self.server.ut1_utc)
+            passes = find_passes(sats, self.core.state.observer, now, now + timedelta(hours=12),
+                                 horizon=self.core.state.horizon, ut1_utc=self.core.state.ut1_utc_s)
             for p in [p for p in passes if p.los is None or p.los > now][:8]:
-                name = self.server.catalog.get(p.catalog_number).dde_name
+                name = self.core.state.catalog.get(p.catalog_number).dde_name
                 lines.append(f"{name:12} {_clock(p.aos)} {p.max_elevation_deg:3.0f}deg {_clock(p.los)}")
         self.query_one("#passes", Static).update("\n".join(lines) or "none in the next 12 h")
-        sat = self.server.catalog.get(snap.catalog_number) if snap.catalog_number else None
+        sat = self.core.state.catalog.get(snap.catalog_number) if snap.catalog_number else None
         track: list[tuple[float, float]] = []
         nxt = self._upcoming_pass(now)
         if sat is not None and nxt is not None and nxt.aos is not None and nxt.los is not None:
-            calc = LookAngleCalculator(self.server.observer, self.server.ut1_utc)
+            calc = LookAngleCalculator(self.core.state.observer, self.core.state.ut1_utc_s)
             t = nxt.aos
             while t <= nxt.los:
                 la = calc.compute(sat.satrec, t)
@@ -268,9 +271,7 @@ class NfwConsole(App):
 
     def action_toggle_doppler(self) -> None:
         if self.radio is not None:
-            self.radio.enabled = not self.radio.enabled
-            self.server.events.add(self.server.clock.now(), Direction.INFO, "note",
-                                   f"Doppler tuning {'ON' if self.radio.enabled else 'OFF'}", client="console")
+            self.core.set_radio_tuning(not self.core.state.radio_tuning, source="console")
 
     def action_toggle_tune(self) -> None:
-        self.server.command("TUNE OFF" if self.server.snapshot().tune_on else "TUNE ON", source="console")
+        self.core.command("TUNE OFF" if self.core.snapshot().state.dde_output else "TUNE ON", source="console")

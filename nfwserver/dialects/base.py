@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from nfwserver.dde.session import TickSample
+from nfwserver.core.sample import TickSample
 from nfwserver.radio.transponder import Channel
 
 

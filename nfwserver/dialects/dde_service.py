@@ -1,4 +1,4 @@
-"""Serving a dialect over DDE, from the Nova core's ticks.
+"""Serving a dialect over DDE, an adapter on the station core's ticks.
 
 :class:`DialectServer` is a :class:`~nfwserver.dde.transport.DdeServerHandler` for one dialect's names
 (case-insensitive, as DDEML compares them) and a tick listener: each tick it formats the dialect's
@@ -9,23 +9,23 @@ These trackers take no commands over DDE, so pokes and executes are refused.
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 
+from nfwserver.core.sample import TickSample
+from nfwserver.core.station_core import StationCore
 from nfwserver.dde.clipboard import TEXT_FORMATS, encode_text
-from nfwserver.dde.session import TickSample
 from nfwserver.dde.transport import ConversationId, DdeServerTransport, PokeResult
 from nfwserver.dialects.base import Dialect, view_from_sample
-from nfwserver.radio.transponder import Channel
-from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.derived import revolution_and_phase
 
 
 class DialectServer:
-    """One dialect on one transport; attach it to the core with ``core.add_tick_listener(ds.on_tick)``."""
+    """One dialect on one transport; reads the catalog and channels from ``core.state`` on every tick."""
 
-    def __init__(self, dialect: Dialect, catalog: Catalog, channels: dict[int, Channel] | None = None) -> None:
+    def __init__(self, dialect: Dialect, core: StationCore) -> None:
         self.dialect = dialect
-        self.catalog = catalog
-        self.channels = dict(channels or {})
+        self.core = core
+        self._unsubscribe: Callable[[], None] | None = None
         self._items = {i.upper() for i in dialect.items}
         self._lock = threading.Lock()
         self._text = dialect.format(None)
@@ -34,8 +34,13 @@ class DialectServer:
     def attach(self, transport: DdeServerTransport) -> None:
         transport.register_service(self.dialect.service, self)
         self._transport = transport
+        if self._unsubscribe is None:
+            self._unsubscribe = self.core.subscribe(self.on_tick)
 
     def detach(self) -> None:
+        if self._unsubscribe is not None:
+            self._unsubscribe()
+            self._unsubscribe = None
         if self._transport is not None:
             self._transport.unregister_service(self.dialect.service)
             self._transport = None
@@ -47,10 +52,11 @@ class DialectServer:
     def on_tick(self, sample: TickSample) -> None:
         view = None
         if sample.catalog_number is not None:
-            sat = self.catalog.get(sample.catalog_number)
+            state = self.core.state
+            sat = state.catalog.get(sample.catalog_number)
             if sat is not None:
                 phase = revolution_and_phase(sat.elements, sample.time)[1] if sample.look_angles else None
-                view = view_from_sample(sample, sat.name, self.channels.get(sample.catalog_number),
+                view = view_from_sample(sample, sat.name, state.channels.get(sample.catalog_number),
                                         float(phase) if phase is not None else None)
         text = self.dialect.format(view)
         with self._lock:

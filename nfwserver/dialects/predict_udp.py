@@ -34,6 +34,7 @@ import numpy as np
 
 from nfwserver import __version__
 from nfwserver.clock import Clock
+from nfwserver.core.state import StationState
 from nfwserver.tracking.catalog import Catalog, Satellite
 from nfwserver.tracking.derived import geodetic_from_itrs, revolution_and_phase
 from nfwserver.tracking.doppler import SPEED_OF_LIGHT_KM_S
@@ -51,17 +52,30 @@ EARTH_RADIUS_KM = 6378.16  # PREDICT's value for the footprint
 
 @dataclass
 class PredictContext:
-    """What the PREDICT protocol reports about: the station and its satellites."""
+    """What the PREDICT protocol reports about: the live station state (never a copy) and its satellites."""
 
-    catalog: Callable[[], Catalog]
-    observer: Observer
+    state: StationState
     clock: Clock
     tracked: Callable[[], list[int]]  #: catalog numbers listed by GET_LIST (at most 24)
     mode: Callable[[], str] = lambda: "none"
     callsign: str = "NFWSERVER"
-    ut1_utc: float = 0.0
     on_reload: Callable[[], None] | None = None
-    _next_event: dict[int, tuple[datetime, datetime]] = field(default_factory=dict)
+    #: next AOS/LOS per satellite: (observer it was computed for, computed at, event)
+    _next_event: dict[int, tuple[object, datetime, datetime]] = field(default_factory=dict)
+
+    def catalog(self) -> Catalog:
+        return self.state.catalog
+
+    @property
+    def observer(self) -> Observer:
+        observer = self.state.observer
+        if observer is None:
+            raise ValueError("no station location is configured")
+        return observer
+
+    @property
+    def ut1_utc(self) -> float:
+        return self.state.ut1_utc_s
 
 
 def _find(catalog: Catalog, text: str) -> Satellite | None:
@@ -163,14 +177,14 @@ class PredictProtocol:
 
     def _next_event(self, sat: Satellite, now: datetime, up: bool) -> datetime | None:
         cached = self.ctx._next_event.get(sat.catalog_number)
-        if cached is None or not (cached[0] <= now < cached[1]):
+        if cached is None or cached[0] != self.ctx.observer or not (cached[1] <= now < cached[2]):
             passes = find_passes([sat], self.ctx.observer, now, now + timedelta(days=2), ut1_utc=self.ctx.ut1_utc)
             events = sorted(t for p in passes for t in (p.aos, p.los) if t is not None and t > now)
             if not events:
                 return None
-            self.ctx._next_event[sat.catalog_number] = (now, events[0])
+            self.ctx._next_event[sat.catalog_number] = (self.ctx.observer, now, events[0])
             return events[0]
-        return cached[1]
+        return cached[2]
 
     def _get_sat(self, sat: Satellite, now: datetime) -> str:
         calc = LookAngleCalculator(self.ctx.observer, self.ctx.ut1_utc)
@@ -205,25 +219,36 @@ class PredictProtocol:
 
 
 class PredictUdpServer:
-    """The UDP listener on its own thread."""
+    """The UDP listener on its own thread (``nfw-predict``).  Construction does no I/O; :meth:`start`
+    binds the socket (raising :class:`OSError` when the port is taken) and starts the thread."""
 
     def __init__(self, context: PredictContext, host: str = "127.0.0.1", port: int = DEFAULT_PORT) -> None:
         self.protocol = PredictProtocol(context)
-        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        self.sock.bind((host, port))
-        self.sock.settimeout(0.2)
-        self.address = self.sock.getsockname()
+        self.host, self.port = host, port
+        self.sock: socket.socket | None = None
+        self.address: tuple[str, int] = (host, port)
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="nfw-predict", daemon=True)
-        log.info("PREDICT protocol on UDP %s:%d", *self.address)
 
     def start(self) -> None:
+        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        try:
+            sock.bind((self.host, self.port))
+        except OSError:
+            sock.close()
+            raise
+        sock.settimeout(0.2)
+        self.sock = sock
+        self.address = sock.getsockname()
+        log.info("PREDICT protocol on UDP %s:%d", *self.address)
         self._thread.start()
 
     def _run(self) -> None:
+        sock = self.sock
+        assert sock is not None
         while not self._stop.is_set():
             try:
-                data, peer = self.sock.recvfrom(2048)
+                data, peer = sock.recvfrom(2048)
             except TimeoutError:
                 continue
             except OSError:
@@ -231,7 +256,7 @@ class PredictUdpServer:
                     return
                 continue
             try:
-                self.sock.sendto(self.protocol.reply(data), peer)
+                sock.sendto(self.protocol.reply(data), peer)
             except OSError as exc:
                 log.warning("PREDICT reply to %s failed: %s", peer, exc)
 
@@ -239,4 +264,5 @@ class PredictUdpServer:
         self._stop.set()
         if self._thread.is_alive():
             self._thread.join(2.0)
-        self.sock.close()
+        if self.sock is not None:
+            self.sock.close()

@@ -3,43 +3,47 @@
 :class:`RadioCoupling` is a tick listener: it only records the newest sample.  A worker thread
 (or a direct :meth:`RadioCoupling.process` call in tests) tunes the radio for it, so a slow or dead
 ``rigctld`` cannot delay the DDE feed.  Tuning runs while tuning is enabled (OrbitDRV's "enable
-tuning" call; off by default), the sample has a position, and the selected satellite has a channel.
+tuning" call, carried in the sample from the live station state; off by default), the sample has a
+position, and the selected satellite has a channel in the live state's channel table.  The tuner and
+backend are owned by the worker thread.
 """
 
 from __future__ import annotations
 
 import logging
 
-from nfwserver.dde.session import TickSample
+from nfwserver.core.sample import TickSample
+from nfwserver.core.state import StationState
+from nfwserver.core.tick_worker import TickWorker
 from nfwserver.radio.transponder import Channel
 from nfwserver.radio.tuning import DopplerTuner, TuneResult
-from nfwserver.tick_worker import TickWorker
 
 log = logging.getLogger(__name__)
 
 
 class RadioCoupling(TickWorker):
-    """Follows ticks with ``tuner``; ``channels`` maps catalog numbers to their channel."""
+    """Follows ticks with ``tuner``; channels come from ``state.channels`` (catalog number -> channel)."""
 
     worker_name = "nfw-radio"
 
-    def __init__(self, tuner: DopplerTuner, channels: dict[int, Channel], enabled: bool = False) -> None:
+    def __init__(self, tuner: DopplerTuner, state: StationState) -> None:
         super().__init__()
         self.tuner = tuner
-        self.channels = dict(channels)
-        self.enabled = enabled
+        self.state = state
         self.last_result: TuneResult | None = None
         self._catalog_number: int | None = None
+        self._channel: Channel | None = None
 
     def process(self, sample: TickSample) -> TuneResult | None:
         """Tune for one sample now (the worker's step; tests call it directly)."""
-        if not self.enabled or sample.look_angles is None or sample.catalog_number is None:
+        if not sample.radio_tuning or sample.look_angles is None or sample.catalog_number is None:
             return None
-        channel = self.channels.get(sample.catalog_number)
+        channel = self.state.channels.get(sample.catalog_number)
         if channel is None:
             return None
-        if sample.catalog_number != self._catalog_number:
-            self._catalog_number = sample.catalog_number
+        if sample.catalog_number != self._catalog_number or channel is not self._channel:
+            # another satellite, or its channel was reconfigured (the knob offset starts again)
+            self._catalog_number, self._channel = sample.catalog_number, channel
             self.tuner.set_channel(channel)
         self.last_result = self.tuner.update(sample.look_angles.range_rate_km_s)
         return self.last_result

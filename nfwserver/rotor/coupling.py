@@ -25,11 +25,11 @@ import math
 from collections.abc import Callable, Sequence
 from datetime import datetime, timedelta
 
-from nfwserver.dde.session import TickSample
+from nfwserver.core.sample import TickSample
+from nfwserver.core.tick_worker import TickWorker
 from nfwserver.rotor.flip import PassPlan, flip, plan_pass
 from nfwserver.rotor.geometry import unwrap
 from nfwserver.rotor.kct_driver import KctDriver
-from nfwserver.tick_worker import TickWorker
 
 log = logging.getLogger(__name__)
 
@@ -125,7 +125,7 @@ class RotorCoupling(TickWorker):
     def process(self, sample: TickSample) -> None:
         """One tick's work (the worker's step; tests call it directly)."""
         la = sample.look_angles
-        if sample.track_on and la is not None:
+        if sample.tracking and la is not None:
             if sample.above_horizon:
                 if self.plan is None:
                     self._start_pass(sample.time)

@@ -24,7 +24,8 @@ def test_pokes_outgoing_strings_and_state_changes_show() -> None:
     station = make_station(start=ISS_PASS.tca - timedelta(seconds=5))
 
     async def scenario() -> None:
-        app = NfwConsole(station.server, "fake transport note", "set your observer", favourites=(25544,))
+        app = NfwConsole(station.core, "fake transport note", "set your observer", favourites=(25544,),
+                         clients=station.nova.client_count)
         async with app.run_test(size=(140, 40)) as pilot:
             await pilot.press(*"TUNE ON", "enter")
             await pilot.pause()
@@ -59,7 +60,7 @@ def test_pokes_outgoing_strings_and_state_changes_show() -> None:
             await pilot.pause()
             await pilot.press("down", "enter")
             await pilot.pause(0.3)
-            picked = station.server.snapshot()
+            picked = station.core.snapshot()
             assert picked.catalog_number != 25544 and f"({picked.catalog_number})" in _state(app)
             assert f"SAT={picked.catalog_number} ok" in _log_text(app, "incoming")
 

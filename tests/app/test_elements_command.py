@@ -90,4 +90,6 @@ def test_the_station_starts_from_the_stored_catalog(tmp_path) -> None:
     assert main(["elements", "update", str(DATA / "visual.txt"), "--store", str(store)]) == 0
     config = parse_config(f'[elements]\nuse_bundled = false\nstore = "{store}"\n')
     station = Station(config, SystemClock(), transport=FakeDdeSystem().server_transport())
+    station.start()
+    station.stop()
     assert len(station.catalog) == 148

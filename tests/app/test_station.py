@@ -5,13 +5,14 @@ from __future__ import annotations
 import http.server
 import threading
 from collections.abc import Iterator
+from datetime import datetime, timezone
 
 import pytest
 
 from nfwserver.app.element_sources import bundled_elements, fetch_all
 from nfwserver.app.station import Station
 from nfwserver.cli import main
-from nfwserver.clock import SystemClock
+from nfwserver.clock import SystemClock, VirtualClock
 from nfwserver.config import parse_config
 from nfwserver.config.schema import Config
 from nfwserver.fake_dde import FakeDdeSystem
@@ -53,12 +54,13 @@ def test_elements_from_local_http_and_a_dead_url(http_server) -> None:
 def test_station_serves_dde_on_defaults() -> None:
     system = FakeDdeSystem()
     station = Station(Config(), SystemClock(), transport=system.server_transport())
-    assert len(station.catalog) >= 40
+    assert len(station.catalog) == 0  # construction does no I/O
     station.start()
+    assert len(station.catalog) >= 40
     try:
         conv = system.connect("NFW32", "NFW_DATA")
         conv.poke("NFW_SERVER", "TUNE ON")
-        station.server.tick()
+        station.core.tick()
         assert conv.request_text("NFW_SERVER").startswith("ISS AZ:")
     finally:
         station.stop()
@@ -69,9 +71,14 @@ def test_refresh_takes_newer_elements_only(tmp_path) -> None:
     keps = tmp_path / "keps.txt"
     keps.write_text((DATA / "visual.txt").read_text())
     config = parse_config(f'[elements]\nfiles = ["{keps}"]\nuse_bundled = false\n')
-    station = Station(config, SystemClock(), transport=FakeDdeSystem().server_transport())
-    assert len(station.catalog) == 148
-    summary = station.refresh_elements()
+    station = Station(config, VirtualClock(datetime(2026, 5, 8, tzinfo=timezone.utc)),
+                      transport=FakeDdeSystem().server_transport())
+    station.start()
+    try:
+        assert len(station.catalog) == 148
+        summary = station.refresh_elements()
+    finally:
+        station.stop()
     assert summary.added == [] and summary.updated == [] and len(summary.not_newer) == 148
 
 
@@ -81,7 +88,7 @@ def test_run_headless_for_a_bounded_time(tmp_path, capsys) -> None:
     config.write_text('[observer]\nlocation = "JO02ae"\n[server]\nrate_hz = 20\n')
     assert main(["run", "--headless", "--duration", "0.3", "--config", str(config), "--log-file", str(log_file)]) == 0
     err = capsys.readouterr().err
-    assert "fake DDE transport" in err and "satellites loaded" in err
+    assert "in-process DDE transport" in err and "satellites loaded" in err
     assert "stopped" in log_file.read_text()
 
 
@@ -117,18 +124,20 @@ def test_station_tunes_a_real_rigctld_when_configured(rigctld, tmp_path) -> None
 
 def test_station_with_a_simulated_rotor_reports_the_antenna_position() -> None:
     from nfwserver.clock import VirtualClock
-    from nfwserver.dde.publisher import run_virtual
+    from nfwserver.core.publisher import run_virtual
     from tests.dde.conftest import ISS_PASS
 
     config = parse_config('[observer]\nlocation = "52.2053,0.1218,20"\n[rotor]\nbackend = "sim"\n'
                           'geometry = "overlap-450"\nafter_los = "stay"\n')
     clock = VirtualClock(ISS_PASS.tca)
     station = Station(config, clock, transport=FakeDdeSystem().server_transport())
-    station.server.command("TRACK ON")
-    station.server.add_tick_listener(station.rotor.process)  # synchronous here: no worker on virtual time
-    run_virtual(station.server, clock, 60)
-    antenna = station.server.snapshot().antenna
-    la = station.server.snapshot().last_sample.look_angles
+    station._load_catalog()  # what start() loads, without starting the threads: ticks run synchronously here
+    station.core.select_satellite(25544)
+    station.core.command("TRACK ON")
+    station.core.subscribe(station.rotor.process)
+    run_virtual(station.core, clock, 60)
+    antenna = station.core.snapshot().state.antenna
+    la = station.core.snapshot().last_sample.look_angles
     assert antenna.source == "rotor"
     assert abs(((antenna.azimuth_deg - la.azimuth_deg) + 180) % 360 - 180) < 15
     assert station.rotor.plan is not None

@@ -1,4 +1,4 @@
-"""A Nova server on the fake DDE transport under a virtual clock, near a real ISS pass."""
+"""A station core with Nova's DDE service on the in-process transport under a virtual clock, near a real ISS pass."""
 
 from __future__ import annotations
 
@@ -8,8 +8,10 @@ from datetime import datetime, timedelta, timezone
 import pytest
 
 from nfwserver.clock import VirtualClock
-from nfwserver.dde.publisher import run_virtual
-from nfwserver.dde.server import NovaServer
+from nfwserver.core.publisher import run_virtual
+from nfwserver.core.state import StationState
+from nfwserver.core.station_core import StationCore
+from nfwserver.dde.nova_service import NovaDdeService
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.elements import load_element_file
@@ -28,22 +30,32 @@ ISS_PASS = max(find_passes([CATALOG.get(ISS)], OBSERVER, DAY, DAY + timedelta(da
 
 @dataclass
 class Station:
-    server: NovaServer
+    core: StationCore
+    nova: NovaDdeService
     system: FakeDdeSystem
     clock: VirtualClock
 
     def run(self, seconds: float, before_tick=None) -> int:
-        return run_virtual(self.server, self.clock, seconds, before_tick)
+        return run_virtual(self.core, self.clock, seconds, before_tick)
 
 
 def make_station(start: datetime | None = None, rate_hz: float = 5.0, horizon: HorizonTable | None = None,
-                 satellite: int | None = ISS, ut1_utc: float = 0.0) -> Station:
+                 satellite: int | None = ISS, ut1_utc: float = 0.0, channels=None,
+                 catalog: Catalog = CATALOG) -> Station:
     clock = VirtualClock(start or ISS_PASS.aos - timedelta(seconds=60))
-    server = NovaServer(CATALOG, OBSERVER, clock, horizon=horizon, rate_hz=rate_hz, satellite=satellite,
-                        ut1_utc=ut1_utc)
+    core = StationCore(catalog, OBSERVER, clock, horizon=horizon, rate_hz=rate_hz, satellite=satellite,
+                       ut1_utc=ut1_utc, channels=channels)
     system = FakeDdeSystem()
-    server.attach(system.server_transport())
-    return Station(server, system, clock)
+    nova = NovaDdeService(core)
+    nova.attach(system.server_transport())
+    return Station(core, nova, system, clock)
+
+
+def state_for(catalog_number: int, observer: Observer = OBSERVER) -> StationState:
+    """A live station state at ``observer`` with ``catalog_number`` selected (for pass tracks)."""
+    state = StationState(CATALOG, observer)
+    state.select(catalog_number)
+    return state
 
 
 @pytest.fixture

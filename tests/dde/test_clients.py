@@ -3,18 +3,16 @@
 from __future__ import annotations
 
 import re
-from datetime import timedelta
 
 import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
+from nfwserver.core.events import Direction
+from nfwserver.core.nova_protocol import PokeError, parse_poke
 from nfwserver.dde.clipboard import CF_TEXT, CF_UNICODETEXT
-from nfwserver.dde.events import Direction
-from nfwserver.dde.protocol import PokeError, parse_poke
-from nfwserver.dde.status import StatusBit
 from nfwserver.fake_dde import DMLERR_NOTPROCESSED, DdeError
-from tests.dde.conftest import ISS, ISS_PASS, make_station
+from tests.dde.conftest import ISS, make_station
 
 NOVA = re.compile(r"^(\S{1,12}) AZ:(\d{1,3}\.\d) EL:(-?\d{1,2}\.\d) RR:(-?\d+\.\d{10}) AH:([YN])$")
 
@@ -41,7 +39,7 @@ def test_matlab_style_poke_then_request(station) -> None:
     conv = station.system.connect("NFW_SERVER", "NFW_DATA")
     conv.poke("NFW_SERVER", "TUNE ON")
     conv.poke("NFW_SERVER", "SAT=25544")
-    station.server.tick()
+    station.core.tick()
     m = NOVA.match(conv.request_text("NFW_SERVER"))
     assert m and m.group(1) == "ISS"
 
@@ -97,14 +95,14 @@ def test_unknown_satellite_keeps_the_current_one(station) -> None:
     with pytest.raises(DdeError) as info:
         conv.poke("NFW_SERVER", "SAT=99999")
     assert info.value.code == DMLERR_NOTPROCESSED
-    station.server.tick()
+    station.core.tick()
     assert conv.request_text("NFW_SERVER").startswith("ISS ")
-    refusal = station.server.events.recent(direction=Direction.IN)[-1]
+    refusal = station.core.events.recent(direction=Direction.IN)[-1]
     assert refusal.accepted is False and "not in the catalog" in refusal.detail
 
 
 def test_satellite_switch_renames_the_stream(station) -> None:
-    other = next(s for s in station.server.catalog if s.catalog_number != ISS)
+    other = next(s for s in station.core.catalog if s.catalog_number != ISS)
     conv = station.system.connect("NFW32", "NFW_DATA")
     conv.start_advise("NFW_SERVER")
     conv.poke("NFW_SERVER", "TUNE ON")
@@ -125,7 +123,7 @@ def test_hundred_clients_at_ten_hertz_receive_the_same_stream() -> None:
     first = convs[0].texts()
     assert len(first) == 101
     assert all(conv.texts() == first for conv in convs)
-    assert station.server.snapshot().advise_loops == 100
+    assert station.nova.client_count()[1] == 100
 
 
 def test_clients_disconnecting_mid_advise_do_not_disturb_the_rest(station) -> None:
@@ -143,8 +141,8 @@ def test_clients_disconnecting_mid_advise_do_not_disturb_the_rest(station) -> No
     for k, conv in enumerate(convs):
         expected = 41 if k == 0 or k > 5 else 5 * k
         assert len(conv.texts()) == expected, k
-    assert station.server.snapshot().clients == 5
-    assert station.server.snapshot().advise_loops == 5
+    assert station.nova.client_count()[0] == 5
+    assert station.nova.client_count()[1] == 5
 
 
 @settings(max_examples=150, suppress_health_check=[HealthCheck.function_scoped_fixture])
@@ -162,7 +160,7 @@ def test_fuzzed_pokes_never_disturb_another_conversation(junk) -> None:
     victim.poke("NFW_SERVER", "TUNE ON")
     attacker = station.system.connect("NFW32", "NFW_DATA")
     station.run(0.4)
-    before = station.server.snapshot()
+    before = station.core.snapshot()
     try:
         attacker.poke("NFW_SERVER", junk)
     except DdeError as exc:
@@ -170,34 +168,17 @@ def test_fuzzed_pokes_never_disturb_another_conversation(junk) -> None:
     else:  # binary data can decode to a valid command; then it must have been one
         assert isinstance(junk, bytes)
     station.run(0.4)
-    after = station.server.snapshot()
+    after = station.core.snapshot()
     if isinstance(junk, str):
-        assert (after.tune_on, after.catalog_number) == (before.tune_on, before.catalog_number)
-    assert len(victim.texts()) >= 3 or not after.tune_on
-
-
-def test_status_word_follows_the_session(station) -> None:
-    server = station.server
-    word = server.tick().status
-    assert word & StatusBit.TUNING_DISABLED and word & StatusBit.TRACKING_DISABLED
-    assert not word & StatusBit.SATELLITE_MISSING
-    server.command("TUNE ON")
-    server.command("TRACK ON")
-    word = server.tick(ISS_PASS.aos - timedelta(minutes=5)).status
-    assert word & StatusBit.NOT_IN_VIEW and not word & StatusBit.TUNING_DISABLED
-    assert not server.tick(ISS_PASS.tca).status & StatusBit.NOT_IN_VIEW
-    far = server.tick(ISS_PASS.tca + timedelta(days=3650))
-    assert far.status & StatusBit.ARITHMETIC_ERROR and far.text == ""
-    assert not server.tick(ISS_PASS.tca).status & StatusBit.ARITHMETIC_ERROR
-    server.clear_satellite()
-    assert server.tick().status & StatusBit.SATELLITE_MISSING
+        assert (after.state.dde_output, after.catalog_number) == (before.state.dde_output, before.catalog_number)
+    assert len(victim.texts()) >= 3 or not after.state.dde_output
 
 
 def test_tick_listeners_and_a_broken_listener(station) -> None:
     samples = []
-    station.server.add_tick_listener(lambda s: 1 / 0)
-    remove = station.server.add_tick_listener(samples.append)
-    station.server.command("TUNE ON")
+    station.core.subscribe(lambda s: 1 / 0)
+    remove = station.core.subscribe(samples.append)
+    station.core.command("TUNE ON")
     station.run(1.0)
     assert len(samples) == 6 and samples[-1].catalog_number == ISS and samples[-1].text
     remove()
@@ -211,12 +192,12 @@ def test_event_stream_shows_incoming_and_outgoing(station) -> None:
     conv.poke("NFW_SERVER", "ANTAZ=123.4")
     conv.poke("NFW_SERVER", "ANTEL=45.6")
     station.run(0.4)
-    incoming = [e for e in station.server.events.recent(direction=Direction.IN) if e.kind == "poke"]
+    incoming = [e for e in station.core.events.recent(direction=Direction.IN) if e.kind == "poke"]
     assert [e.text for e in incoming] == ["TUNE ON", "ANTAZ=123.4", "ANTEL=45.6"]
     assert all(e.conversation == conv.conv_id and e.accepted for e in incoming)
-    outgoing = station.server.events.recent(direction=Direction.OUT)
+    outgoing = station.core.events.recent(direction=Direction.OUT)
     assert len(outgoing) == 3 and NOVA.match(outgoing[-1].text)
-    antenna = station.server.snapshot().antenna
+    antenna = station.core.snapshot().state.antenna
     assert (antenna.azimuth_deg, antenna.elevation_deg) == (123.4, 45.6)
 
 

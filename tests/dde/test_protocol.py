@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from nfwserver.dde.protocol import (
+from nfwserver.core.nova_protocol import (
     Poke,
     PokeError,
     PokeKind,

@@ -6,7 +6,7 @@ from datetime import timedelta
 
 import numpy as np
 
-from nfwserver.dde.session import TickSample
+from nfwserver.core.sample import TickSample
 from nfwserver.tracking.horizon import HorizonTable
 from tests.dde.conftest import CATALOG, ISS, ISS_PASS, OBSERVER, make_station
 from tests.dde.test_clients import NOVA
@@ -24,7 +24,7 @@ def test_a_whole_pass_matches_skyfield_rounded_as_printed() -> None:
     conv.poke("NFW_SERVER", "TUNE ON")
     stamped: list[tuple[object, str]] = []
     samples: list[TickSample] = []
-    station.server.add_tick_listener(samples.append)
+    station.core.subscribe(samples.append)
     conv.on_receive = lambda r: stamped.append((station.clock.now(), r.text))
     duration = (ISS_PASS.los - start).total_seconds() + 30
     station.run(duration)

@@ -9,7 +9,7 @@ import pytest
 
 from nfwserver.cli import main
 from nfwserver.clock import SystemClock
-from nfwserver.dde.publisher import Publisher
+from nfwserver.core.publisher import Publisher
 from tests.conftest import DATA
 from tests.dde.conftest import make_station
 
@@ -67,8 +67,8 @@ def test_bad_observer_and_missing_file(capsys, tmp_path) -> None:
 
 def test_real_time_publisher_ticks_at_its_rate_and_stops() -> None:
     station = make_station(rate_hz=50.0)
-    station.server.clock = SystemClock()
-    publisher = Publisher(station.server, SystemClock())
+    station.core.clock = SystemClock()
+    publisher = Publisher(station.core, SystemClock())
     publisher.start()
     time.sleep(0.25)
     publisher.stop()

@@ -7,7 +7,7 @@ from datetime import timedelta
 
 import pytest
 
-from nfwserver.dde.publisher import run_virtual
+from nfwserver.core.publisher import run_virtual
 from nfwserver.dialects.dde_service import DialectServer
 from nfwserver.dialects.orbitron import ORBITRON, orbitron_name
 from nfwserver.dialects.satpc32 import NO_SATELLITE, SATPC32
@@ -28,10 +28,9 @@ def get_field(source: str, label: str) -> str:
 
 def _station_with(dialect, start):
     dut1 = float(skyfield_look_angles(CATALOG.get(ISS).elements, OBSERVER, [start])[4][0])
-    station = make_station(start=start, ut1_utc=dut1)
-    server = DialectServer(dialect, CATALOG, {ISS: FM})
+    station = make_station(start=start, ut1_utc=dut1, channels={ISS: FM})
+    server = DialectServer(dialect, station.core)
     server.attach(station.system.server_transport())
-    station.server.add_tick_listener(server.on_tick)
     return station, server
 
 
@@ -45,7 +44,7 @@ def test_orbitron_format_values_against_skyfield(dialect, service, topic, item) 
     conv.start_advise(item)
     stamps = []
     conv.on_receive = lambda r: stamps.append((station.clock.now(), r.text))
-    run_virtual(station.server, station.clock, 60)
+    run_virtual(station.core, station.clock, 60)
     assert len(stamps) > 250
     times = [t for t, _ in stamps]
     az, el, _, rr, _ = skyfield_look_angles(CATALOG.get(ISS).elements, OBSERVER, times)
@@ -68,9 +67,9 @@ def test_satpc32_by_field_order_and_no_satellite() -> None:
     station, server = _station_with(SATPC32, ISS_PASS.aos - timedelta(seconds=20))
     conv = station.system.connect("SatPC32", "SatPcDdeConv")
     conv.start_advise("SatPcDdeItem")
-    run_virtual(station.server, station.clock, 10)
+    run_virtual(station.core, station.clock, 10)
     assert conv.request_text("SatPcDdeItem") == NO_SATELLITE  # before AOS
-    run_virtual(station.server, station.clock, 50)
+    run_virtual(station.core, station.clock, 50)
     up = [t for t in conv.texts() if not t.startswith("**")]
     assert up and station.clock.now() > ISS_PASS.aos
     fields = up[-1].split(" ")
@@ -79,8 +78,8 @@ def test_satpc32_by_field_order_and_no_satellite() -> None:
     assert fields[0] == "SNISS" and 0 <= float(fields[7][2:]) < 256
     assert int(fields[3][2:]) > 145_000_000 and int(fields[5][2:]) > 437_000_000
     assert server.text() == up[-1]
-    station.server.clear_satellite()
-    station.server.tick()
+    station.core.clear_satellite()
+    station.core.tick()
     assert conv.request_text("SatPcDdeItem") == NO_SATELLITE
 
 
@@ -96,7 +95,7 @@ def test_dialects_take_no_commands_and_refuse_unknown_items() -> None:
     # Nova's own service is still served next to it.
     nova = station.system.connect("NFW32", "NFW_DATA")
     nova.poke("NFW_SERVER", "TUNE ON")
-    station.server.tick()
+    station.core.tick()
     assert nova.request_text("NFW_SERVER").startswith("ISS AZ:")
 
 
@@ -114,7 +113,7 @@ def test_station_serves_the_configured_dialects_next_to_nova() -> None:
     station = Station(config, VirtualClock(ISS_PASS.tca), transport=system.server_transport())
     station.start()
     try:
-        station.server.tick()
+        station.core.tick()
         assert get_field(system.connect("Orbitron", "Tracking").request_text("TrackingData"), "SN") == "ISS_ZARYA"
         assert system.connect("SatPC32", "SatPcDdeConv").request_text("SatPcDdeItem").startswith("SNISS ")
         with _socket.socket(_socket.AF_INET, _socket.SOCK_DGRAM) as client:

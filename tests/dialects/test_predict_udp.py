@@ -12,6 +12,7 @@ import pytest
 from skyfield.api import load
 
 from nfwserver.clock import VirtualClock
+from nfwserver.core.state import StationState
 from nfwserver.dialects.predict_udp import PredictContext, PredictUdpServer
 from nfwserver.tracking.doppler import SPEED_OF_LIGHT_KM_S as C
 from nfwserver.tracking.look_angles import LookAngleCalculator
@@ -26,7 +27,7 @@ SF62 = r"[+-]\d+\.\d\d *"  # %+-6.2f
 def predict() -> Iterator[tuple[socket.socket, tuple[str, int], VirtualClock, list[str]]]:
     clock = VirtualClock(ISS_PASS.tca)
     reloads: list[str] = []
-    ctx = PredictContext(lambda: CATALOG, OBSERVER, clock, lambda: [ISS, 27607], mode=lambda: "ISS\n",
+    ctx = PredictContext(StationState(CATALOG, OBSERVER), clock, lambda: [ISS, 27607], mode=lambda: "ISS\n",
                          callsign="G0XYZ", on_reload=lambda: reloads.append("x"))
     server = PredictUdpServer(ctx, "127.0.0.1", 0)
     server.start()

@@ -3,17 +3,20 @@
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from datetime import datetime, timedelta, timezone
 
 import pytest
 
 from nfwserver.clock import VirtualClock
-from nfwserver.dde.session import TickSample
+from nfwserver.core.sample import TickSample
+from nfwserver.core.state import StationState
 from nfwserver.radio.backend import RadioError
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.radio.rigctld_backend import RigctldBackend
 from nfwserver.radio.transponder import Channel
 from nfwserver.radio.tuning import DopplerTuner
+from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.doppler import SPEED_OF_LIGHT_KM_S as C
 from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.look_angles import LookAngleCalculator
@@ -121,9 +124,9 @@ def test_frequencies_are_validated_before_reaching_the_rig(rigctld) -> None:
 def test_coupling_tunes_from_ticks_on_its_worker(rigctld) -> None:
     clock = VirtualClock(PASS.tca)
     tuner = DopplerTuner(FM, RigctldBackend(clock, port=rigctld.port), step_hz=STEP)
-    coupling = RadioCoupling(tuner, {25544: FM}, enabled=True)
+    coupling = RadioCoupling(tuner, StationState(Catalog([ISS]), OBS, channels={25544: FM}))
     la = LookAngleCalculator(OBS).compute(ISS.satrec, PASS.tca)
-    sample = TickSample(PASS.tca, 25544, "ISS", la, True, True, False, "", 0)
+    sample = TickSample(PASS.tca, 25544, "ISS", la, True, True, False, "", 0, radio_tuning=True)
     coupling.start()
     try:
         for _ in range(300):  # ticks keep coming, as from the publisher; bounded wait for the worker
@@ -136,5 +139,4 @@ def test_coupling_tunes_from_ticks_on_its_worker(rigctld) -> None:
         coupling.stop()
     assert coupling.last_result is not None
     assert abs(_read(rigctld, "f") - FM.downlink_hz * (1 - la.range_rate_km_s / C)) <= STEP + 1
-    coupling.enabled = False
-    assert coupling.process(sample) is None
+    assert coupling.process(replace(sample, radio_tuning=False)) is None  # OrbitDRV tuning disabled

@@ -11,32 +11,47 @@ import subprocess
 import sys
 import threading
 import time
+from datetime import datetime, timezone
 
 import pytest
 
 from nfwserver.app.element_sources import fetch_all
 from nfwserver.app.session_state import SessionState, StateFile
 from nfwserver.app.station import Station
-from nfwserver.clock import SystemClock
+from nfwserver.clock import VirtualClock
 from nfwserver.config import parse_config
-from nfwserver.dde.events import Direction
+from nfwserver.core.events import Direction
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tracking.elements import load_elements
-from tests.conftest import DATA
+from tests.conftest import DATA, advance_until
 
 
 def test_the_selected_satellite_survives_a_restart(tmp_path) -> None:
     state = tmp_path / "state.json"
     config = parse_config(f'[server]\nstate_file = "{state}"\n')
-    first = Station(config, SystemClock(), transport=FakeDdeSystem().server_transport())
-    first.server.command("SAT=27607")
-    first.server.tick()
-    assert json.loads(state.read_text()) == {"satellite": 27607}
-    second = Station(config, SystemClock(), transport=FakeDdeSystem().server_transport())
-    assert second.server.snapshot().catalog_number == 27607
+    clock = VirtualClock(datetime(2026, 5, 8, tzinfo=timezone.utc))
+
+    def started(cfg=config) -> Station:
+        station = Station(cfg, clock, transport=FakeDdeSystem().server_transport())
+        station.start()
+        return station
+
+    first = started()
+    assert first.core.command("SAT=27607").ok
+    saved = advance_until(clock, lambda: state.exists() and json.loads(state.read_text())["satellite"] == 27607)
+    first.stop()
+    assert saved and json.loads(state.read_text()) == {"satellite": 27607, "configured": 25544}
+    second = started()
+    assert second.core.snapshot().catalog_number == 27607
+    second.stop()
+    # An edited [server] satellite wins over a choice saved before the edit.
+    edited = started(parse_config(f'[server]\nstate_file = "{state}"\nsatellite = 7530\n'))
+    assert edited.core.snapshot().catalog_number == 7530
+    edited.stop()
     state.write_text("{not json")
-    third = Station(config, SystemClock(), transport=FakeDdeSystem().server_transport())
-    assert third.server.snapshot().catalog_number == 25544  # a broken file means no saved state
+    third = started()
+    assert third.core.snapshot().catalog_number == 25544  # a broken file means no saved state
+    third.stop()
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="SIGKILL")
@@ -60,33 +75,36 @@ def test_sigkill_during_state_saves_leaves_a_valid_file(tmp_path) -> None:
 
 
 def test_configuration_changed_while_running(tmp_path) -> None:
+    """The watcher runs on the station's virtual clock: no real sleeps, only clock steps."""
     path = tmp_path / "c.toml"
     path.write_text('[observer]\nlocation = "JO02ae"\n[server]\nrate_hz = 5\nstate_file = "none"\n')
     from nfwserver.config import load_config
 
-    station = Station(load_config(path), SystemClock(), transport=FakeDdeSystem().server_transport())
+    clock = VirtualClock(datetime(2026, 5, 8, tzinfo=timezone.utc))
+    station = Station(load_config(path), clock, transport=FakeDdeSystem().server_transport())
     notes = []
-    station.server.events.subscribe(lambda e: notes.append(e) if e.direction is Direction.INFO else None)
-    station.watch_config(str(path), interval_s=0.05)
+    station.core.events.subscribe(lambda e: notes.append(e) if e.direction is Direction.INFO else None)
+    station.start()
+    station.watch_config(str(path), interval_s=0.5)
+    state = station.core.state
     try:
-        before = station.server.observer
-        time.sleep(0.1)
+        before = state.observer
         path.write_text('[observer]\nlocation = "QF56od"\n[server]\nrate_hz = 500\n')  # invalid rate
-        deadline = time.monotonic() + 5
-        while not any("refused" in n.text for n in notes) and time.monotonic() < deadline:
-            time.sleep(0.05)
+        assert advance_until(clock, lambda: any("refused" in n.text for n in notes))
         assert any("[server] rate_hz" in n.text for n in notes)
-        assert station.server.observer == before and station.server.rate_hz == 5  # old configuration kept
-        time.sleep(0.05)
+        assert state.observer == before and state.rate_hz == 5  # old configuration kept
         path.write_text('[observer]\nlocation = "QF56od"\n[server]\nrate_hz = 10\nstate_file = "none"\n'
                         '[rotor]\nbackend = "sim"\n')
-        while not any("reloaded" in n.text for n in notes) and time.monotonic() < deadline + 5:
-            time.sleep(0.05)
-        assert station.server.observer.latitude_deg < 0 and station.server.rate_hz == 10
+        assert advance_until(clock, lambda: any("reloaded" in n.text for n in notes))
+        assert state.observer.latitude_deg < 0 and state.rate_hz == 10
         assert any("restart to apply [rotor]" in n.text for n in notes)
+        # Restoring what is running needs no restart, and the message says so.
+        notes.clear()
+        path.write_text('[observer]\nlocation = "QF56od"\n[server]\nrate_hz = 10\nstate_file = "none"\n')
+        assert advance_until(clock, lambda: any("reloaded" in n.text for n in notes))
+        assert not any("restart" in n.text for n in notes)
     finally:
         station.stop()
-        station._stop.set()
 
 
 def test_a_slow_element_url_times_out_and_the_rest_loads(tmp_path) -> None:

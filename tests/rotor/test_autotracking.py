@@ -8,25 +8,25 @@ from datetime import datetime, timedelta, timezone
 import numpy as np
 
 from nfwserver.clock import VirtualClock
-from nfwserver.dde.publisher import run_virtual
-from nfwserver.dde.server import NovaServer
+from nfwserver.core.publisher import run_virtual
+from nfwserver.core.station_core import StationCore
 from nfwserver.rotor.coupling import RotorCoupling, angular_distance, sky_from_rotor
 from nfwserver.rotor.geometry import RotorGeometry
 from nfwserver.rotor.kct_driver import KctDriver
 from nfwserver.rotor.sim_backend import SimulatedRotor
 from nfwserver.rotor.tracks import SatelliteTracks
 from nfwserver.tracking.passes import find_passes
-from tests.dde.conftest import CATALOG, ISS, ISS_PASS, OBSERVER
+from tests.dde.conftest import CATALOG, ISS, ISS_PASS, OBSERVER, state_for
 
 DAY = datetime(2026, 5, 8, tzinfo=timezone.utc)
 
 
 def _station(start: datetime, geometry: RotorGeometry, satellite: int = ISS, **coupling_args):
     clock = VirtualClock(start)
-    server = NovaServer(CATALOG, OBSERVER, clock, satellite=satellite, rate_hz=5)
+    server = StationCore(CATALOG, OBSERVER, clock, satellite=satellite, rate_hz=5)
     rotor = SimulatedRotor(clock, geometry, az_speed_deg_s=6.0, el_speed_deg_s=6.0, start=(180.0, 0.0))
     driver = KctDriver(clock, rotor, geometry)
-    tracks = SatelliteTracks(lambda: CATALOG.get(server.snapshot().catalog_number).satrec, OBSERVER)
+    tracks = SatelliteTracks(server.state)
     coupling = RotorCoupling(driver, tracks.predict, tracks.pass_track,
                              on_position=lambda az, el: server.report_antenna_position(az, el, "rotor"),
                              **coupling_args)
@@ -39,7 +39,7 @@ def _station(start: datetime, geometry: RotorGeometry, satellite: int = ISS, **c
             la = sample.look_angles
             errors.append(angular_distance(la.azimuth_deg, la.elevation_deg, *sky_from_rotor(*pos)))
 
-    server.add_tick_listener(follow)
+    server.subscribe(follow)
     server.command("TRACK ON")
     return clock, server, rotor, driver, coupling, errors
 
@@ -54,7 +54,7 @@ def test_a_whole_pass_is_followed_within_the_threshold_and_then_parked() -> None
     assert np.median(settled) < 3.0 and np.percentile(settled, 90) < 6.0
     assert len(rotor.commands) < ticks / 3  # moves only past the threshold
     assert rotor.target == (180.0, 0.0)  # parked after LOS
-    antenna = server.snapshot().antenna
+    antenna = server.snapshot().state.antenna
     assert antenna.source == "rotor" and antenna.azimuth_deg is not None
 
 
@@ -65,7 +65,7 @@ def _pass_crossing_north():
         for p in find_passes([sat], OBSERVER, DAY, DAY + timedelta(days=1)):
             if p.aos is None or p.los is None or p.max_elevation_deg < 20:
                 continue
-            track = SatelliteTracks(lambda sat=sat: sat.satrec, OBSERVER).pass_track(p.aos)
+            track = SatelliteTracks(state_for(sat.catalog_number)).pass_track(p.aos)
             azs = [az for _, az, _ in track]
             if any(abs(a - b) > 180 for a, b in zip(azs, azs[1:])):
                 return sat.catalog_number, p
@@ -78,7 +78,7 @@ def test_a_pass_across_north_is_flipped_on_a_north_stop_rotor_and_never_leaves_i
     clock, server, rotor, driver, coupling, errors = _station(crossing.aos - timedelta(seconds=30), geometry,
                                                              satellite=catnr, threshold_deg=1.0, after_los="stay")
     flips = []
-    server.add_tick_listener(lambda s: flips.append(coupling.flip_state) if coupling.plan else None)
+    server.subscribe(lambda s: flips.append(coupling.flip_state) if coupling.plan else None)
     run_virtual(server, clock, (crossing.los - crossing.aos).total_seconds() + 30)
     assert flips and all(flips)  # flipped from AOS to LOS, never switched mid-pass
     assert all(0 <= az <= 360 and 0 <= el <= 180 for az, el in rotor.commands)
@@ -92,7 +92,7 @@ def test_next_aos_pre_positioning_and_track_off() -> None:
     clock, server, rotor, driver, coupling, _ = _station(ISS_PASS.los - timedelta(seconds=20), geometry,
                                                         after_los="next-aos")
     run_virtual(server, clock, 60)
-    nxt = SatelliteTracks(lambda: CATALOG.get(ISS).satrec, OBSERVER).pass_track(ISS_PASS.los + timedelta(minutes=1))
+    nxt = SatelliteTracks(state_for(ISS)).pass_track(ISS_PASS.los + timedelta(minutes=1))
     aos_az = nxt[0][1]
     assert abs(((rotor.target[0] - aos_az) + 180) % 360 - 180) < 1.0 and abs(rotor.target[1]) < 0.01
     before = list(rotor.commands)

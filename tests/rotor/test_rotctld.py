@@ -9,8 +9,8 @@ from datetime import timedelta
 import pytest
 
 from nfwserver.clock import VirtualClock
-from nfwserver.dde.publisher import run_virtual
-from nfwserver.dde.server import NovaServer
+from nfwserver.core.publisher import run_virtual
+from nfwserver.core.station_core import StationCore
 from nfwserver.rotor.backend import RotorError
 from nfwserver.rotor.coupling import RotorCoupling
 from nfwserver.rotor.geometry import RotorGeometry
@@ -18,7 +18,7 @@ from nfwserver.rotor.kct_driver import KctDriver
 from nfwserver.rotor.kct_status import KctStatusBit
 from nfwserver.rotor.rotctld_backend import RotctldBackend
 from nfwserver.rotor.tracks import SatelliteTracks
-from tests.dde.conftest import CATALOG, OBSERVER
+from tests.dde.conftest import CATALOG, OBSERVER, state_for
 from tests.hamlib_daemons import HamlibDaemon
 from tests.rotor.test_autotracking import _pass_crossing_north
 
@@ -28,18 +28,18 @@ CATNR, CROSSING = _pass_crossing_north()
 
 def _tracking(daemon: HamlibDaemon, geometry: RotorGeometry, start, **kwargs):
     clock = VirtualClock(start)
-    server = NovaServer(CATALOG, OBSERVER, clock, satellite=CATNR, rate_hz=5)
+    server = StationCore(CATALOG, OBSERVER, clock, satellite=CATNR, rate_hz=5)
     backend = RotctldBackend(clock, geometry, port=daemon.port, timeout_s=0.5)
     driver = KctDriver(clock, backend, geometry)
-    tracks = SatelliteTracks(lambda: CATALOG.get(CATNR).satrec, OBSERVER)
+    tracks = SatelliteTracks(server.state)
     coupling = RotorCoupling(driver, tracks.predict, tracks.pass_track, threshold_deg=2.0, **kwargs)
-    server.add_tick_listener(coupling.process)
+    server.subscribe(coupling.process)
     server.command("TRACK ON")
     return clock, server, driver, coupling
 
 
 def _north_crossing_time():
-    track = SatelliteTracks(lambda: CATALOG.get(CATNR).satrec, OBSERVER, step_s=1.0).pass_track(CROSSING.aos)
+    track = SatelliteTracks(state_for(CATNR), step_s=1.0).pass_track(CROSSING.aos)
     for (t, a, _), (_, b, _) in zip(track, track[1:]):
         if abs(a - b) > 180:
             return t

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 from nfwserver.clock import VirtualClock
+from nfwserver.core.station_core import StationCore
 from nfwserver.dde import ddeml
 from nfwserver.dde.clipboard import CF_TEXT, CF_UNICODETEXT, encode_text
 from nfwserver.dde.ddeml_dispatch import DdemlDispatcher
-from nfwserver.dde.server import NovaServer
+from nfwserver.dde.nova_service import NovaDdeService
 from tests.dde.conftest import CATALOG, ISS, ISS_PASS, OBSERVER
 
 
@@ -40,7 +41,8 @@ class FakeApi:
 
 
 def _setup():
-    server = NovaServer(CATALOG, OBSERVER, VirtualClock(ISS_PASS.tca), satellite=ISS)
+    core = StationCore(CATALOG, OBSERVER, VirtualClock(ISS_PASS.tca), satellite=ISS)
+    server = NovaDdeService(core)
     api = FakeApi()
     handlers = {"NFW32": server, "NFW_SERVER": server}
     dispatch = DdemlDispatcher(lambda name: handlers.get(name.upper()), api)
@@ -60,7 +62,7 @@ def test_connect_names_and_refusals() -> None:
     assert _connect(api, dispatch, "nfw32", "nfw_data")
     assert not _connect(api, dispatch, "NFW32", "OTHER", hconv=78)
     assert not _connect(api, dispatch, "SOMEONE", "NFW_DATA", hconv=79)
-    assert dispatch.conversation_count() == 1 and server.snapshot().clients == 1
+    assert dispatch.conversation_count() == 1 and server.client_count()[0] == 1
 
 
 def test_poke_request_advise_like_a_real_client() -> None:
@@ -73,7 +75,7 @@ def test_poke_request_advise_like_a_real_client() -> None:
     assert refused == ddeml.DDE_FNOTPROCESSED
     assert dispatch(ddeml.XTYP_ADVSTART, CF_TEXT, 77, topic, item, 0) == 1
     assert dispatch(ddeml.XTYP_ADVSTART, 49999, 77, topic, item, 0) == 0  # a format we do not serve
-    server.tick()
+    server.core.tick()
     handle = dispatch(ddeml.XTYP_REQUEST, CF_TEXT, 77, topic, item, 0)
     assert handle and api.created[-1][0].startswith(b"ISS AZ:") and api.created[-1][0].endswith(b"\x00")
     assert api.created[-1][1] == "NFW_SERVER" and api.created[-1][2] == CF_TEXT
@@ -81,11 +83,11 @@ def test_poke_request_advise_like_a_real_client() -> None:
     assert api.created[-1][0].decode("utf-16-le").startswith("ISS AZ:")
     assert dispatch(ddeml.XTYP_REQUEST, CF_TEXT, 77, topic, api.hsz("NOPE"), 0) == 0
     assert dispatch(ddeml.XTYP_EXECUTE, 0, 77, topic, 0, api.hdata(b"TRACK ON\x00")) == ddeml.DDE_FACK
-    assert server.snapshot().track_on
+    assert server.core.snapshot().state.tracking
     dispatch(ddeml.XTYP_ADVSTOP, CF_TEXT, 77, topic, item, 0)
-    assert server.snapshot().advise_loops == 0
+    assert server.client_count()[1] == 0
     dispatch(ddeml.XTYP_DISCONNECT, 0, 77, 0, 0, 0)
-    assert dispatch.conversation_count() == 0 and server.snapshot().clients == 0
+    assert dispatch.conversation_count() == 0 and server.client_count()[0] == 0
 
 
 def test_unknown_conversations_and_handler_failures_are_refused_not_raised() -> None:

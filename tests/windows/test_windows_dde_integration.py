@@ -21,17 +21,19 @@ NOVA = re.compile(r"^\S{1,12} AZ:\d{1,3}\.\d EL:-?\d{1,2}\.\d RR:-?\d+\.\d{10} A
 @pytest.fixture
 def live_server():
     from nfwserver.clock import SystemClock
-    from nfwserver.dde.publisher import Publisher
-    from nfwserver.dde.server import NovaServer
+    from nfwserver.core.publisher import Publisher
+    from nfwserver.core.station_core import StationCore
+    from nfwserver.dde.nova_service import NovaDdeService
     from nfwserver.dde.windows_transport import WindowsDdeTransport
     from tests.dde.conftest import CATALOG, ISS, OBSERVER
 
-    server = NovaServer(CATALOG, OBSERVER, SystemClock(), satellite=ISS, rate_hz=10)
+    core = StationCore(CATALOG, OBSERVER, SystemClock(), satellite=ISS, rate_hz=10)
+    server = NovaDdeService(core)
     transport = WindowsDdeTransport()
     server.attach(transport)
-    publisher = Publisher(server, SystemClock())
+    publisher = Publisher(core, SystemClock())
     publisher.start()
-    yield server
+    yield core
     publisher.stop()
     server.detach()
     transport.close()

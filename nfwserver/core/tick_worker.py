@@ -11,7 +11,7 @@ from __future__ import annotations
 import logging
 import threading
 
-from nfwserver.dde.session import TickSample
+from nfwserver.core.sample import TickSample
 
 log = logging.getLogger(__name__)
 

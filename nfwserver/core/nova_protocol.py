@@ -77,11 +77,22 @@ class Poke:
 
 
 class PokeError(ValueError):
-    """A poke that is not part of the grammar; the message says why in one sentence."""
+    """A poke that is not part of the grammar; the message says why in one sentence.
+
+    ``bad_argument`` is True for a known command with a bad argument (OrbitDRV's "bad subfunction"),
+    False for something that is not a command at all ("bad function").
+    """
+
+    def __init__(self, message: str, bad_argument: bool = False) -> None:
+        super().__init__(message)
+        self.bad_argument = bad_argument
 
 
 _ON_OFF = re.compile(r"^(TUNE|TRACK)\s+(ON|OFF)$", re.IGNORECASE)
 _ASSIGN = re.compile(r"^(SAT|ANTAZ|ANTEL)\s*=\s*(\S*)$", re.IGNORECASE)
+_KNOWN_WORD = re.compile(r"^(TUNE|TRACK|SAT|ANTAZ|ANTEL)\b", re.IGNORECASE)
+_USAGE = {"TUNE": "ON or OFF", "TRACK": "ON or OFF", "SAT": "=<catalog number>", "ANTAZ": "=<degrees>",
+          "ANTEL": "=<degrees>"}
 _NUMBER = re.compile(r"^[+-]?(\d+(\.\d*)?|\.\d+)$")
 
 
@@ -108,21 +119,24 @@ def parse_poke_line(line: str) -> Poke:
         return Poke(PokeKind(m.group(1).upper()), m.group(2).upper() == "ON")
     m = _ASSIGN.match(text)
     if not m:
+        known = _KNOWN_WORD.match(text)
+        if known:
+            raise PokeError(f"{known.group(1).upper()} needs {_USAGE[known.group(1).upper()]}", bad_argument=True)
         raise PokeError("not a Nova command (TUNE ON|OFF, TRACK ON|OFF, SAT=n, ANTAZ=deg, ANTEL=deg)")
     kind, value = PokeKind(m.group(1).upper()), m.group(2)
     if kind is PokeKind.SAT:
         if not value.isdigit() or not 1 <= len(value) <= 6:
-            raise PokeError(f"SAT needs a catalog number, got {escape_for_log(value, 20)!r}")
+            raise PokeError(f"SAT needs a catalog number, got {escape_for_log(value, 20)!r}", bad_argument=True)
         return Poke(kind, int(value))
     if not _NUMBER.match(value):
-        raise PokeError(f"{kind.value} needs a number of degrees, got {escape_for_log(value, 20)!r}")
+        raise PokeError(f"{kind.value} needs a number of degrees, got {escape_for_log(value, 20)!r}", bad_argument=True)
     number = float(value)
     if not math.isfinite(number):
-        raise PokeError(f"{kind.value} value is not finite")
+        raise PokeError(f"{kind.value} value is not finite", bad_argument=True)
     if kind is PokeKind.ANTAZ and not -360.0 <= number <= 720.0:
-        raise PokeError(f"ANTAZ {number} is outside -360..720 degrees")
+        raise PokeError(f"ANTAZ {number} is outside -360..720 degrees", bad_argument=True)
     if kind is PokeKind.ANTEL and not -90.0 <= number <= 180.0:
-        raise PokeError(f"ANTEL {number} is outside -90..180 degrees")
+        raise PokeError(f"ANTEL {number} is outside -90..180 degrees", bad_argument=True)
     return Poke(kind, number + 0.0)
 
 

@@ -3,7 +3,7 @@
 Nova showed incoming (F3) and outgoing (F1) strings for diagnosis; the console shows these events.
 The log is bounded (a ring of ``capacity`` events) and fans each event out to subscribers;
 a subscriber that raises is logged and dropped from that one delivery, never breaking the server.
-Texts are stored as received; :func:`nfwserver.dde.protocol.escape_for_log` renders them safely.
+Texts are stored as received; :func:`nfwserver.core.nova_protocol.escape_for_log` renders them safely.
 """
 
 from __future__ import annotations

@@ -1,6 +1,8 @@
-"""The publish loop: ticks the server at its rate, in real time or in virtual time.
+"""The publish loop: ticks the station core at its rate, on the clock it is given.
 
-Real time (:class:`Publisher`): ticks are scheduled on the clock's monotonic time at
+:class:`Publisher` runs on its own thread and waits through the clock (``Clock.wait``), so it
+follows real time with a :class:`~nfwserver.clock.SystemClock` and virtual time with a
+:class:`~nfwserver.clock.VirtualClock` advanced by a test.  Ticks are scheduled on the clock's monotonic time at
 ``t0 + k / rate``, so errors never accumulate; a tick that overruns makes the loop skip the
 slots it missed (counted in :attr:`PublishStats.skipped`) instead of bursting to catch up.  Each
 tick computes for the wall-clock instant it runs at.  A tick that raises is logged and the loop
@@ -20,7 +22,7 @@ from dataclasses import dataclass, field
 from datetime import timedelta
 
 from nfwserver.clock import Clock, VirtualClock
-from nfwserver.dde.server import NovaServer
+from nfwserver.core.station_core import StationCore
 
 log = logging.getLogger(__name__)
 
@@ -43,10 +45,10 @@ class PublishStats:
 
 
 class Publisher:
-    """Runs ``server.tick()`` at ``server.rate_hz`` on a background thread, on real time."""
+    """Runs ``core.tick()`` at the state's rate on a background thread (thread ``nfw-publisher``)."""
 
-    def __init__(self, server: NovaServer, clock: Clock) -> None:
-        self.server = server
+    def __init__(self, core: StationCore, clock: Clock) -> None:
+        self.core = core
         self.clock = clock
         self.stats = PublishStats()
         self._stop = threading.Event()
@@ -68,20 +70,20 @@ class Publisher:
     def _run(self) -> None:
         t0 = self.clock.monotonic()
         k = 0
-        rate = self.server.rate_hz
+        rate = self.core.state.rate_hz
         while not self._stop.is_set():
-            if self.server.rate_hz != rate:  # rate changed: restart the schedule from now
-                rate, t0, k = self.server.rate_hz, self.clock.monotonic(), 0
+            if self.core.state.rate_hz != rate:  # rate changed: restart the schedule from now
+                rate, t0, k = self.core.state.rate_hz, self.clock.monotonic(), 0
             due = t0 + k / rate
             now = self.clock.monotonic()
             if due > now:
                 # Waiting on the event lets stop() interrupt the wait at once.
-                if self._stop.wait(due - now):
+                if self.clock.wait(self._stop, due - now):
                     break
                 now = self.clock.monotonic()
             late = now - due
             try:
-                self.server.tick()
+                self.core.tick()
             except Exception:
                 self.stats.failures += 1
                 log.exception("publish tick failed")
@@ -95,26 +97,27 @@ class Publisher:
 
 
 def run_virtual(
-    server: NovaServer,
+    core: StationCore,
     clock: VirtualClock,
     duration_s: float,
     before_tick: Callable[[float], None] | None = None,
 ) -> int:
-    """Tick ``server`` at its rate for ``duration_s`` of virtual time; returns the number of ticks.
+    """Tick ``core`` at its rate for ``duration_s`` of virtual time; returns the number of ticks.
 
     The first tick is at the clock's current instant.  ``before_tick(offset_s)`` runs before each
     tick (with the clock already at that instant), e.g. to deliver scheduled pokes.
     """
     start = clock.now()
-    period = 1.0 / server.rate_hz
-    count = int(math.floor(duration_s * server.rate_hz + 1e-9)) + 1
+    rate = core.state.rate_hz
+    period = 1.0 / rate
+    count = int(math.floor(duration_s * rate + 1e-9)) + 1
     for k in range(count):
         offset = k * period
         clock.set(start + timedelta(seconds=offset))
         if before_tick is not None:
             before_tick(offset)
         try:
-            server.tick(clock.now())
+            core.tick(clock.now())
         except Exception:
             log.exception("publish tick failed")
     return count

@@ -1,0 +1,100 @@
+"""Watching the configuration file while the station runs.
+
+:class:`ConfigWatcher` checks the file's size and modification time every ``interval_s`` seconds of
+the station's clock, waits until a change has stopped changing (a writer may be halfway through),
+then reads it.  A valid file is handed to ``apply`` (the station's live reload); an invalid one is
+refused with one message and the running configuration stays.  Only regular files are read, so a
+FIFO or device put in place of the file never blocks the watcher.
+
+Owned by its own thread, ``nfw-config``; it waits on the injected clock, so tests drive it with a
+:class:`~nfwserver.clock.VirtualClock`.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import stat
+import threading
+from collections.abc import Callable
+from pathlib import Path
+
+from nfwserver.clock import Clock
+from nfwserver.config.schema import Config
+
+log = logging.getLogger(__name__)
+
+Signature = tuple[int, int, int] | None  # (mtime ns, size, inode) of a regular file; None if absent/unusable
+
+
+def file_signature(path: Path) -> Signature:
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    if not stat.S_ISREG(st.st_mode):
+        return None
+    return st.st_mtime_ns, st.st_size, st.st_ino
+
+
+class ConfigWatcher:
+    """Calls ``apply(config)`` for each valid change of ``path``; ``refused(message)`` for an invalid one."""
+
+    def __init__(self, path: str | Path, clock: Clock, apply: Callable[[Config], None],
+                 refused: Callable[[str], None], interval_s: float = 2.0, settle_s: float = 1.0) -> None:
+        self.path = Path(path)
+        self.clock = clock
+        self.apply = apply
+        self.refused = refused
+        self.interval_s = interval_s
+        self.settle_s = settle_s
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._seen: Signature = None
+
+    def start(self) -> None:
+        if self._thread is None:
+            self._seen = file_signature(self.path)
+            self._stop.clear()
+            self._thread = threading.Thread(target=self._run, name="nfw-config", daemon=True)
+            self._thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(5.0)
+            self._thread = None
+
+    def check(self) -> bool:
+        """One look at the file (the thread's step; returns True when a change was handled)."""
+        from nfwserver.config import ConfigError, load_config
+
+        now = file_signature(self.path)
+        if now == self._seen:
+            return False
+        # Let a writer finish: read only once the file has stayed the same for settle_s.
+        while not self.clock.wait(self._stop, self.settle_s):
+            later = file_signature(self.path)
+            if later == now:
+                break
+            now = later
+        if self._stop.is_set():
+            return False
+        self._seen = now
+        if now is None:
+            self.refused(f"{self.path} is missing or not a regular file; keeping the running configuration")
+            return True
+        try:
+            new = load_config(self.path)
+        except ConfigError as exc:
+            self.refused(f"configuration change refused, keeping the running one: {exc}")
+            return True
+        self.apply(new)
+        return True
+
+    def _run(self) -> None:
+        while not self.clock.wait(self._stop, self.interval_s):
+            try:
+                self.check()
+            except Exception:  # the watcher must outlive any surprise
+                log.exception("checking the configuration file failed")

@@ -1,0 +1,52 @@
+"""Building the rotor and radio adapters from their configuration sections.
+
+Construction only: no connection is opened until the coupling's worker starts (``start()``).
+"""
+
+from __future__ import annotations
+
+from nfwserver.clock import Clock
+from nfwserver.config.schema import RadioConfig, RotorConfig
+from nfwserver.core.station_core import StationCore
+from nfwserver.radio.coupling import RadioCoupling
+from nfwserver.radio.rigctld_backend import RigctldBackend
+from nfwserver.radio.tuning import DopplerTuner
+from nfwserver.rotor.backend import RotorBackend
+from nfwserver.rotor.coupling import RotorCoupling
+from nfwserver.rotor.geometry import RotorGeometry
+from nfwserver.rotor.kct_driver import KctDriver
+from nfwserver.rotor.rotctld_backend import RotctldBackend
+from nfwserver.rotor.sim_backend import SimulatedRotor
+from nfwserver.rotor.tracks import SatelliteTracks
+
+
+def make_rotor(rc: RotorConfig, core: StationCore, clock: Clock) -> RotorCoupling | None:
+    """The autotracking coupling for ``[rotor]`` (None when ``backend = "none"``)."""
+    if rc.backend == "none":
+        return None
+    geometry = RotorGeometry.preset(rc.geometry)
+    backend: RotorBackend
+    if rc.backend == "sim":
+        backend = SimulatedRotor(clock, geometry, rc.speed_deg_s, rc.speed_deg_s)
+    else:
+        backend = RotctldBackend(clock, geometry, rc.host, rc.port)
+    driver = KctDriver(clock, backend, geometry)
+    driver.set_parking(rc.park_delay_minutes, rc.park_azimuth_deg, rc.park_elevation_deg)
+    tracks = SatelliteTracks(core.state)
+    return RotorCoupling(
+        driver, tracks.predict, tracks.pass_track, rc.threshold_deg, rc.speed_deg_s, rc.max_lead_s,
+        rc.after_los, rc.flip,
+        on_position=lambda az, el: core.report_antenna_position(az, el, "rotor"),
+    )
+
+
+def make_radio(rc: RadioConfig, core: StationCore, clock: Clock) -> RadioCoupling | None:
+    """The Doppler-tuning coupling for ``[radio]`` (None without a backend or any channel)."""
+    if rc.backend != "rigctld":
+        return None
+    first = next(iter(core.state.channels.values()), None)
+    if first is None:
+        return None
+    backend = RigctldBackend(clock, rc.host, rc.port)
+    tuner = DopplerTuner(first, backend, rc.step_hz, rc.knob_tolerance_hz)
+    return RadioCoupling(tuner, core.state)

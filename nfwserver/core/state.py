@@ -1,0 +1,181 @@
+"""The one live station state that every output reads.
+
+:class:`StationState` holds what the station *is* at this moment: the catalog, the observer, the
+horizon table, UT1-UTC, the radio channels, the publish rate, and the session switches that
+clients and the operator change (the AutoTracking satellite, Nova's ``TUNE`` (DDE output), OrbitDRV's
+tracking and tuning enables, the antenna position last reported).
+
+Nothing else in the server keeps a copy of these values: the tracker, the DDE services, the
+dialects, PREDICT, the rotor and radio couplings and the console read them from here each time they
+need them, so a live configuration reload (:meth:`StationState.configure`) is seen by every output on
+the next tick.
+
+Threading: any thread may read or change the state; every change happens under one lock and bumps
+:attr:`StationState.generation`, which readers use to invalidate derived caches.  Readers that need
+several values consistent with each other take a :meth:`StationState.snapshot`.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from datetime import datetime
+from types import MappingProxyType
+
+from nfwserver.core.sample import AntennaPosition
+from nfwserver.radio.transponder import Channel
+from nfwserver.tracking.catalog import Catalog, Satellite
+from nfwserver.tracking.horizon import HorizonTable
+from nfwserver.tracking.observer import Observer
+
+MIN_RATE_HZ, MAX_RATE_HZ, DEFAULT_RATE_HZ = 1.0, 50.0, 5.0
+
+
+def check_rate(rate_hz: float) -> float:
+    """The publish rate as a float; :class:`ValueError` outside 1..50 Hz."""
+    rate = float(rate_hz)
+    if not MIN_RATE_HZ <= rate <= MAX_RATE_HZ:
+        raise ValueError(f"publish rate {rate_hz} Hz is outside {MIN_RATE_HZ:g}..{MAX_RATE_HZ:g} Hz")
+    return rate
+
+
+@dataclass(frozen=True)
+class StateSnapshot:
+    """A consistent view of :class:`StationState` at one instant (for one tick or one screen)."""
+
+    generation: int
+    catalog: Catalog
+    observer: Observer | None
+    horizon: HorizonTable
+    ut1_utc_s: float
+    rate_hz: float
+    catalog_number: int | None
+    satellite: Satellite | None  #: the AutoTracking satellite's record, None when unknown/none
+    dde_output: bool  #: Nova's TUNE ON: the DDE string is published
+    tracking: bool  #: OrbitDRV "tracking enabled": the rotor follows the satellite (Nova's TRACK ON)
+    radio_tuning: bool  #: OrbitDRV "tuning enabled": the radio receives Doppler updates
+    antenna: AntennaPosition
+    channels: Mapping[int, Channel] = field(default_factory=dict)
+
+
+class StationState:
+    """The live state; see the module docstring.  All setters return True when something changed."""
+
+    def __init__(self, catalog: Catalog, observer: Observer | None, *, horizon: HorizonTable | None = None,
+                 ut1_utc_s: float = 0.0, rate_hz: float = DEFAULT_RATE_HZ,
+                 channels: Mapping[int, Channel] | None = None) -> None:
+        self._lock = threading.RLock()
+        self._catalog = catalog
+        self._observer = observer
+        self._horizon = horizon or HorizonTable()
+        self._ut1_utc_s = float(ut1_utc_s)
+        self._rate_hz = check_rate(rate_hz)
+        self._channels: Mapping[int, Channel] = MappingProxyType(dict(channels or {}))
+        self._catalog_number: int | None = None
+        self._dde_output = False
+        self._tracking = False
+        self._radio_tuning = False
+        self._antenna = AntennaPosition(None, None, "", None)
+        self.generation = 0
+
+    # -- reading -----------------------------------------------------------------------------
+    @property
+    def catalog(self) -> Catalog:
+        return self._catalog
+
+    @property
+    def observer(self) -> Observer | None:
+        return self._observer
+
+    @property
+    def horizon(self) -> HorizonTable:
+        return self._horizon
+
+    @property
+    def ut1_utc_s(self) -> float:
+        return self._ut1_utc_s
+
+    @property
+    def rate_hz(self) -> float:
+        return self._rate_hz
+
+    @property
+    def channels(self) -> Mapping[int, Channel]:
+        return self._channels
+
+    @property
+    def catalog_number(self) -> int | None:
+        return self._catalog_number
+
+    @property
+    def radio_tuning(self) -> bool:
+        return self._radio_tuning
+
+    def selected(self) -> Satellite | None:
+        """The AutoTracking satellite's catalog record (None when none is selected or it is unknown)."""
+        with self._lock:
+            number = self._catalog_number
+            return self._catalog.get(number) if number is not None else None
+
+    def snapshot(self) -> StateSnapshot:
+        with self._lock:
+            return StateSnapshot(self.generation, self._catalog, self._observer, self._horizon, self._ut1_utc_s,
+                                 self._rate_hz, self._catalog_number, self.selected(), self._dde_output,
+                                 self._tracking, self._radio_tuning, self._antenna, self._channels)
+
+    # -- changing ----------------------------------------------------------------------------
+    def _set(self, name: str, value: object) -> bool:
+        with self._lock:
+            if getattr(self, name) == value:
+                return False
+            setattr(self, name, value)
+            self.generation += 1
+            return True
+
+    def configure(self, *, observer: Observer | None, horizon: HorizonTable, ut1_utc_s: float, rate_hz: float,
+                  channels: Mapping[int, Channel]) -> None:
+        """Replace the station's configured values at once (start-up or a live reload)."""
+        rate = check_rate(rate_hz)
+        with self._lock:
+            self._observer = observer
+            self._horizon = horizon
+            self._ut1_utc_s = float(ut1_utc_s)
+            self._rate_hz = rate
+            self._channels = MappingProxyType(dict(channels))
+            self.generation += 1
+
+    def set_rate(self, rate_hz: float) -> bool:
+        return self._set("_rate_hz", check_rate(rate_hz))
+
+    def set_observer(self, observer: Observer | None) -> bool:
+        return self._set("_observer", observer)
+
+    def set_horizon(self, horizon: HorizonTable) -> bool:
+        return self._set("_horizon", horizon)
+
+    def select(self, catalog_number: int | None) -> bool:
+        return self._set("_catalog_number", catalog_number)
+
+    def set_dde_output(self, on: bool) -> bool:
+        return self._set("_dde_output", bool(on))
+
+    def set_tracking(self, on: bool) -> bool:
+        return self._set("_tracking", bool(on))
+
+    def set_radio_tuning(self, on: bool) -> bool:
+        return self._set("_radio_tuning", bool(on))
+
+    def catalog_changed(self) -> None:
+        """Tell readers the catalog's contents changed (an element refresh updated it in place)."""
+        with self._lock:
+            self.generation += 1
+
+    def report_antenna(self, azimuth_deg: float | None, elevation_deg: float | None, source: str,
+                       when: datetime) -> None:
+        """Record where the antennas point; None keeps that axis's previous value."""
+        with self._lock:
+            old = self._antenna
+            self._antenna = AntennaPosition(old.azimuth_deg if azimuth_deg is None else azimuth_deg,
+                                            old.elevation_deg if elevation_deg is None else elevation_deg,
+                                            source, when)

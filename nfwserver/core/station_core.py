@@ -1,0 +1,191 @@
+"""The station core: the live state, the tracker, the event stream and the command port, together.
+
+:class:`StationCore` is what every output adapter is given.  Adapters read the state
+(:attr:`StationCore.state`), subscribe to ticks (:meth:`StationCore.subscribe`) and talk back
+through narrow ports: :meth:`command` (Nova's commands, from DDE pokes, TCP lines, the console),
+:meth:`select_satellite`, :meth:`report_antenna_position`, :meth:`set_radio_tuning`.  No adapter
+keeps its own copy of the station.
+
+Commands follow Nova's grammar (:mod:`nfwserver.core.nova_protocol`): ``TUNE ON|OFF`` (the DDE
+output), ``TRACK ON|OFF`` (autotracking), ``SAT=<catalog number>``, ``ANTAZ=<deg>``, ``ANTEL=<deg>``.
+``TRACK ON`` is an OrbitDRV enable call: "ignored if the station or satellite parameters have not
+been set".  It is then acknowledged (a client without error handling must not die on it) but does
+nothing, and the reason is logged, recorded in the event stream and returned in
+:attr:`CommandResult.note`.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
+from datetime import datetime
+
+from nfwserver.clock import Clock
+from nfwserver.core.events import Direction, EventLog
+from nfwserver.core.nova_protocol import Poke, PokeError, PokeKind, escape_for_log, parse_poke
+from nfwserver.core.sample import TickSample
+from nfwserver.core.state import DEFAULT_RATE_HZ, StateSnapshot, StationState
+from nfwserver.core.status import INTERFACE_VERSION, StatusBit
+from nfwserver.core.tracker import TickListener, Tracker
+from nfwserver.radio.transponder import Channel
+from nfwserver.tracking.catalog import Catalog
+from nfwserver.tracking.horizon import HorizonTable
+from nfwserver.tracking.observer import Observer
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class CommandResult:
+    """The answer to one command string."""
+
+    accepted: bool  #: understood and acknowledged (DDE_FACK); False: refused (DDE_FNOTPROCESSED)
+    note: str | None  #: why it was refused, or why an acknowledged command had no effect
+    status: int  #: the status word after the command (with 0x4000/0x8000 for a bad function/subfunction)
+
+    @property
+    def ok(self) -> bool:
+        """Accepted and took effect."""
+        return self.accepted and self.note is None
+
+
+@dataclass(frozen=True)
+class CoreSnapshot:
+    """What the console and status commands show, read consistently."""
+
+    state: StateSnapshot
+    last_sample: TickSample | None
+    status: int
+    interface_version: int = INTERFACE_VERSION
+
+    @property
+    def catalog_number(self) -> int | None:
+        return self.state.catalog_number
+
+    @property
+    def dde_name(self) -> str | None:
+        return self.state.satellite.dde_name if self.state.satellite is not None else None
+
+
+class StationCore:
+    """State + tracker + events + commands; see the module docstring."""
+
+    def __init__(self, catalog: Catalog, observer: Observer | None, clock: Clock, *,
+                 horizon: HorizonTable | None = None, ut1_utc: float = 0.0, rate_hz: float = DEFAULT_RATE_HZ,
+                 channels: Mapping[int, Channel] | None = None, events: EventLog | None = None,
+                 satellite: int | None = None) -> None:
+        self.clock = clock
+        self.events = events if events is not None else EventLog()
+        self.state = StationState(catalog, observer, horizon=horizon, ut1_utc_s=ut1_utc, rate_hz=rate_hz,
+                                  channels=channels)
+        self.tracker = Tracker(self.state, clock, self.events)
+        if satellite is not None and not self.select_satellite(satellite, source="startup"):
+            log.warning("satellite %s is not in the catalog; no satellite selected", satellite)
+
+    # -- reading -----------------------------------------------------------------------------
+    @property
+    def catalog(self) -> Catalog:
+        return self.state.catalog
+
+    def subscribe(self, listener: TickListener) -> Callable[[], None]:
+        return self.tracker.subscribe(listener)
+
+    def tick(self, when: datetime | None = None) -> TickSample:
+        return self.tracker.tick(when)
+
+    def current_text(self) -> str:
+        return self.tracker.current_text()
+
+    def snapshot(self) -> CoreSnapshot:
+        return CoreSnapshot(self.state.snapshot(), self.tracker.last_sample, self.tracker.status_word())
+
+    # -- ports -------------------------------------------------------------------------------
+    def _note(self, text: str, source: str, accepted: bool | None = None) -> None:
+        self.events.add(self.clock.now(), Direction.INFO, "note", text, client=source, accepted=accepted)
+
+    def set_tune(self, on: bool, source: str = "console") -> None:
+        """Nova's TUNE ON/OFF: switch the DDE output."""
+        if on:
+            self.tracker.enable_call()
+        else:
+            self.tracker.dde_output_off()
+        if self.state.set_dde_output(on):
+            self._note(f"TUNE {'ON' if on else 'OFF'}", source)
+
+    def set_track(self, on: bool, source: str = "console") -> str | None:
+        """Nova's TRACK ON/OFF; returns why TRACK ON was ignored, or None."""
+        if on:
+            snap = self.state.snapshot()
+            missing = [what for what, bad in (("station", snap.observer is None),
+                                              ("satellite", snap.satellite is None)) if bad]
+            if missing:
+                reason = f"TRACK ON ignored: no {' and no '.join(missing)} elements set"
+                log.warning("%s (from %s)", reason, escape_for_log(source))
+                self._note(reason, source, accepted=False)
+                return reason
+            self.tracker.enable_call()
+        if self.state.set_tracking(on):
+            self._note(f"TRACK {'ON' if on else 'OFF'}", source)
+        return None
+
+    def set_radio_tuning(self, on: bool, source: str = "console") -> None:
+        """OrbitDRV's Enable/Disable Tuning: Doppler updates to the radio."""
+        if on:
+            self.tracker.enable_call()
+        if self.state.set_radio_tuning(on):
+            self._note(f"radio Doppler tuning {'on' if on else 'off'}", source)
+
+    def select_satellite(self, catalog_number: int, source: str = "console") -> bool:
+        """Make ``catalog_number`` the AutoTracking satellite; False (and no change) when unknown."""
+        sat = self.state.catalog.get(catalog_number)
+        if sat is None:
+            return False
+        if self.state.select(catalog_number):
+            self.tracker.selection_changed()
+            self._note(f"satellite {catalog_number} {sat.dde_name} selected", source)
+        return True
+
+    def clear_satellite(self) -> None:
+        if self.state.select(None):
+            self.tracker.selection_changed()
+
+    def report_antenna_position(self, azimuth_deg: float | None, elevation_deg: float | None,
+                                source: str = "rotor") -> None:
+        """Record where the antennas point (sky degrees; a rotor read-back, or ANTAZ/ANTEL)."""
+        self.state.report_antenna(azimuth_deg, elevation_deg, source, self.clock.now())
+
+    def apply(self, pokes: Iterable[Poke], source: str) -> tuple[str | None, str | None]:
+        """Apply parsed commands in order; returns (refusal reason, note on an ignored command)."""
+        note = None
+        for poke in pokes:
+            if poke.kind is PokeKind.TUNE:
+                self.set_tune(bool(poke.value), source)
+            elif poke.kind is PokeKind.TRACK:
+                note = self.set_track(bool(poke.value), source) or note
+            elif poke.kind is PokeKind.SAT:
+                if not self.select_satellite(int(poke.value), source):
+                    return f"satellite {poke.value} is not in the catalog; keeping the current one", note
+            elif poke.kind is PokeKind.ANTAZ:
+                self.report_antenna_position(float(poke.value), None, source)
+            elif poke.kind is PokeKind.ANTEL:
+                self.report_antenna_position(None, float(poke.value), source)
+        return None, note
+
+    def command(self, text: str, source: str = "console", conversation: int | None = None) -> CommandResult:
+        """Handle one command string (a poke, a TCP line, the console's command line)."""
+        bits = 0
+        try:
+            reason, note = self.apply(parse_poke(text), source)
+            if reason is not None:
+                bits = StatusBit.BAD_SUBFUNCTION
+        except PokeError as exc:
+            reason, note = str(exc), None
+            bits = StatusBit.BAD_SUBFUNCTION if exc.bad_argument else StatusBit.BAD_FUNCTION
+        self.tracker.note_command(int(bits))
+        accepted = reason is None
+        self.events.add(self.clock.now(), Direction.IN, "poke", text, conversation=conversation, client=source,
+                        accepted=accepted, detail=reason or note or "")
+        if not accepted:
+            log.warning("refused command %s from %s: %s", escape_for_log(text), escape_for_log(source), reason)
+        return CommandResult(accepted, reason or note, self.tracker.status_word())

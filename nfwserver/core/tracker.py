@@ -1,0 +1,199 @@
+"""The tracker: turns a clock tick into a :class:`~nfwserver.core.sample.TickSample` and hands it to every output.
+
+Each :meth:`Tracker.tick` reads the live :class:`~nfwserver.core.state.StationState` once, computes
+the AutoTracking satellite's look angles for the tick's instant (SGP4, topocentric az/el in degrees,
+range rate in km/s), decides ``AH`` from the horizon table, formats Nova's string once, works out
+OrbitDRV's status word, and calls every subscriber with the sample.
+
+Status word (seed: OrbitDRV interrupt interface), as this tracker reads it:
+
+- 0x0001 / 0x0002: no station / no (known) satellite selected.
+- 0x0004: tracking disabled (Nova's ``TRACK OFF``); 0x0008: *tuning* disabled in OrbitDRV's sense,
+  i.e. the radio gets no Doppler updates.  Nova's ``TUNE`` (DDE output) is reported separately
+  (:attr:`TickSample.dde_output`), because OrbitDRV's tuning is the radio's, not the feed's.
+- 0x0010: an arithmetic error.  As the spec says, it *latches*: "No computations will be done until a
+  new Enable call is made".  Enable calls here are ``TRACK ON``, ``TUNE ON`` and switching radio tuning
+  on; selecting another satellite (OrbitDRV's Set Satellite Elements) clears it too, since the error
+  belonged to the old satellite's elements.  While latched the feed is empty.
+- 0x0020: not in view (only while tracking is enabled); 0x0040: not recomputed since the last
+  parameter change.
+- 0x4000 / 0x8000: the most recent command had a bad function (not a command we know) / a bad
+  subfunction (a known command with a bad argument).  They describe that command and clear with the
+  next accepted one (:meth:`Tracker.note_command`).
+
+Threading: :meth:`tick` runs on the publisher thread (or the caller's, in virtual time).
+Subscribers run on that thread and must be quick: they record the sample, post DDE advises or format
+a string; anything slow belongs on a :class:`~nfwserver.core.tick_worker.TickWorker`.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from collections.abc import Callable
+from dataclasses import replace
+from datetime import datetime
+
+from nfwserver.clock import Clock
+from nfwserver.core.events import Direction, EventLog
+from nfwserver.core.nova_protocol import format_nova
+from nfwserver.core.sample import TickSample
+from nfwserver.core.state import StateSnapshot, StationState
+from nfwserver.core.status import ArithmeticErrorCode, StatusBit
+from nfwserver.tracking.look_angles import LookAngleCalculator, LookAngles, PropagationError
+
+log = logging.getLogger(__name__)
+
+TickListener = Callable[[TickSample], None]
+
+
+class Tracker:
+    """Computes ticks from ``state``; see the module docstring."""
+
+    def __init__(self, state: StationState, clock: Clock, events: EventLog) -> None:
+        self.state = state
+        self.clock = clock
+        self.events = events
+        self._lock = threading.Lock()
+        self._listeners: list[TickListener] = []
+        self._calculator: tuple[object, LookAngleCalculator] | None = None
+        self._last: TickSample | None = None
+        self._text = ""
+        self._computed_generation = -1
+        self._error = ArithmeticErrorCode.NONE
+        self._error_satellite: int | None = None
+        self._command_bits = 0
+
+    # -- subscribers -------------------------------------------------------------------------
+    def subscribe(self, listener: TickListener) -> Callable[[], None]:
+        """Call ``listener(sample)`` after every tick; returns a function that unsubscribes it."""
+        with self._lock:
+            self._listeners.append(listener)
+
+        def unsubscribe() -> None:
+            with self._lock:
+                if listener in self._listeners:
+                    self._listeners.remove(listener)
+
+        return unsubscribe
+
+    # -- what clients read -------------------------------------------------------------------
+    @property
+    def last_sample(self) -> TickSample | None:
+        return self._last
+
+    def current_text(self) -> str:
+        """What a request answers now: this tick's Nova string; "" before TUNE ON, after TUNE OFF,
+        after a change of satellite until the next tick, and while the computation fails."""
+        with self._lock:
+            return self._text
+
+    @property
+    def arithmetic_error(self) -> ArithmeticErrorCode:
+        return self._error
+
+    def status_word(self) -> int:
+        """The status word now (OrbitDRV's Get Status Only)."""
+        snap = self.state.snapshot()
+        with self._lock:
+            return self._status(snap, self._last)
+
+    # -- what commands tell the tracker --------------------------------------------------------
+    def enable_call(self) -> None:
+        """An OrbitDRV enable call (TRACK ON, TUNE ON, radio tuning on): resets a latched arithmetic error."""
+        with self._lock:
+            self._error = ArithmeticErrorCode.NONE
+
+    def selection_changed(self) -> None:
+        """A new AutoTracking satellite: never serve the old one's string, forget its error."""
+        with self._lock:
+            self._text = ""
+            self._error = ArithmeticErrorCode.NONE
+
+    def dde_output_off(self) -> None:
+        with self._lock:
+            self._text = ""
+
+    def note_command(self, bits: int) -> None:
+        """Record the bad-function/subfunction bits of the most recent command (0 when accepted)."""
+        with self._lock:
+            self._command_bits = bits & (StatusBit.BAD_FUNCTION | StatusBit.BAD_SUBFUNCTION)
+
+    # -- ticking -----------------------------------------------------------------------------
+    def _status(self, snap: StateSnapshot, sample: TickSample | None) -> int:
+        word = self._command_bits
+        if snap.observer is None:
+            word |= StatusBit.STATION_MISSING
+        if snap.satellite is None:
+            word |= StatusBit.SATELLITE_MISSING
+        if not snap.tracking:
+            word |= StatusBit.TRACKING_DISABLED
+        if not snap.radio_tuning:
+            word |= StatusBit.TUNING_DISABLED
+        if self._error:
+            word |= StatusBit.ARITHMETIC_ERROR
+        if snap.tracking and sample is not None and sample.look_angles is not None and not sample.above_horizon:
+            word |= StatusBit.NOT_IN_VIEW
+        if snap.generation != self._computed_generation:
+            word |= StatusBit.NOT_RECOMPUTED
+        return int(word)
+
+    def _calculator_for(self, snap: StateSnapshot) -> LookAngleCalculator | None:
+        if snap.observer is None:
+            return None
+        key = (snap.observer, snap.ut1_utc_s)
+        cached = self._calculator
+        if cached is None or cached[0] != key:
+            cached = (key, LookAngleCalculator(snap.observer, snap.ut1_utc_s))
+            self._calculator = cached
+        return cached[1]
+
+    def _compute(self, snap: StateSnapshot, when: datetime) -> tuple[LookAngles | None, ArithmeticErrorCode]:
+        sat, calc = snap.satellite, self._calculator_for(snap)
+        if sat is None or calc is None:
+            return None, ArithmeticErrorCode.NONE
+        try:
+            return calc.compute(sat.satrec, when), ArithmeticErrorCode.NONE
+        except PropagationError as exc:
+            code, reason = ArithmeticErrorCode.DEGENERATE_ORBIT, exc
+        except OverflowError as exc:
+            code, reason = ArithmeticErrorCode.OVERFLOW, exc
+        except (ValueError, ArithmeticError) as exc:
+            code, reason = ArithmeticErrorCode.DOMAIN, exc
+        log.error("cannot compute %s at %s: %s; no computations until the next enable call",
+                  sat.dde_name, when.isoformat(), reason)
+        self.events.add(when, Direction.INFO, "note", f"arithmetic error {int(code):02X} for {sat.dde_name}: {reason}",
+                        accepted=False)
+        return None, code
+
+    def tick(self, when: datetime | None = None) -> TickSample:
+        """Compute and hand out one sample for ``when`` (default: the clock's now).  Never raises for bad data."""
+        when = self.clock.now() if when is None else when
+        snap = self.state.snapshot()
+        sat = snap.satellite
+        angles: LookAngles | None = None
+        if not self._error:
+            angles, error = self._compute(snap, when)
+            if error:
+                with self._lock:
+                    self._error = error
+        above = angles is not None and snap.horizon.is_above(angles.azimuth_deg, angles.elevation_deg)
+        text = ""
+        if angles is not None and sat is not None and snap.dde_output:
+            text = format_nova(sat.dde_name, angles.azimuth_deg, angles.elevation_deg, angles.range_rate_km_s, above)
+        with self._lock:
+            if self.state.generation == snap.generation:
+                self._computed_generation = snap.generation
+            self._text = text
+            sample = TickSample(when, snap.catalog_number, sat.dde_name if sat else None, angles, above,
+                                snap.dde_output, snap.tracking, text, 0, snap.radio_tuning, self._error)
+            sample = replace(sample, status=self._status(snap, sample))
+            self._last = sample
+            listeners = list(self._listeners)
+        for listener in listeners:
+            try:
+                listener(sample)
+            except Exception:
+                log.exception("tick listener %r failed", listener)
+        return sample
+
