@@ -94,17 +94,13 @@ def fetch_url(url: str, timeout_s: float = 20.0, progress: ProgressCallback | No
 
 
 def _looks_binary(data: bytes) -> bool:
+    """NUL bytes, or text that is mostly not UTF-8 or full of control characters."""
     head = data[:65536]
     if b"\0" in head:
         return True
-    try:
-        head.decode("utf-8")
-        return False
-    except UnicodeDecodeError as exc:
-        if exc.start >= len(head) - 4:  # a character cut at the end of the sample
-            return False
-    controls = sum(1 for b in head if b < 9 or 13 < b < 32 or b == 127)
-    return controls > len(head) // 100
+    text = head.decode("utf-8", errors="replace")
+    odd = sum(1 for c in text if c == "\ufffd" or (c < " " and c not in "\t\n\r\f") or c == "\x7f")
+    return odd > len(text) // 20
 
 
 def parse_source(data: bytes, source: str) -> LoadResult:
