@@ -142,8 +142,8 @@ def run_list(args: argparse.Namespace) -> int:
     _say(f"{len(catalog)} satellites: {counts['stored']} from the {where}, {counts['file']} from [elements] files, "
          f"{counts['bundled']} from the bundled set")
     if counts["bundled"]:
-        _say(f"the bundled element set is in use ([elements] use_bundled = false in {config_file(config)} turns it off); "
-             "`nfwserver elements update FILE|URL` stores current sets")
+        _say(f"the bundled element set is in use ([elements] use_bundled = false in {config_file(config)} "
+             "turns it off); `nfwserver elements update FILE|URL` stores current sets")
     return 0
 
 

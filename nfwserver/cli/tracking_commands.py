@@ -1,7 +1,12 @@
 """``nfwserver ephemeris``, ``passes`` and ``visible``: InstantTrack's tables on the command line.
 
 Output columns are stable (other tools read them).  CSV: a header row, times ISO-8601 UTC with
-milliseconds and ``Z``, numbers with at least six decimals.
+milliseconds and ``Z``, numbers with at least six decimals.  ``passes`` ends each row with
+``in_progress`` (``Y`` for a pass already under way at the start; its AOS lies before the start).
+
+Every option defaults to the configured station (:mod:`nfwserver.cli.tracking_options`) and the
+time to now.  ``visible`` and ``passes`` leave out objects whose positions cannot be trusted at the
+time asked (:mod:`nfwserver.tracking.screening`) and name the stale element sets on stderr.
 """
 
 from __future__ import annotations

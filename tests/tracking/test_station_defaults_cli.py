@@ -133,3 +133,21 @@ def test_without_an_observer_the_default_is_named_with_the_file_to_edit(tmp_path
     config.write_text(f'[elements]\nfiles = ["{DATA / "visual.txt"}"]\nuse_bundled = false\nstore = "none"\n')
     assert main(["visible", "--config", str(config)]) == 0
     assert f"set [observer] location in {config}" in capsys.readouterr().err
+
+
+def test_after_config_init_and_a_location_the_commands_need_no_arguments(capsys) -> None:
+    """The issue's acceptance: `config init`, set `location`, then passes/visible/ephemeris --sat ISS."""
+    from nfwserver.config import default_config_path
+
+    assert main(["config", "init"]) == 0
+    path = default_config_path()
+    text = path.read_text()
+    assert '# location = "JO02ae"' in text
+    path.write_text(text.replace('# location = "JO02ae"', f'location = "{LOCATOR}"'))
+    capsys.readouterr()
+    for argv in (["passes"], ["visible"], ["ephemeris", "--sat", "ISS", "--duration", "120"]):
+        assert main(argv) == 0, argv
+        out, err = capsys.readouterr()
+        assert out.splitlines()[0].startswith(("catalog_number", "time_utc")) and "no observer" not in err
+    assert main(["ephemeris", "--sat", "AO-91", "--duration", "0", "--format", "csv"]) == 0
+    assert len(_rows(capsys)) == 1
