@@ -9,7 +9,10 @@ an update leaves the previous file whole.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from datetime import datetime, timedelta
 from pathlib import Path
+
+from sgp4.api import jday
 
 from nfwserver.storage import atomic_write_text
 from nfwserver.tracking.catalog import Catalog, UpdateSummary
@@ -20,6 +23,27 @@ def default_store_path() -> Path:
     from platformdirs import user_data_dir
 
     return Path(user_data_dir("nfwserver", appauthor=False)) / "elements.txt"
+
+
+@dataclass
+class PruneSummary:
+    """What :meth:`ElementStore.prune` removed and how many sets remain."""
+
+    decayed: list[ElementSet] = field(default_factory=list)  #: InstantTrack's CRASH
+    old: list[ElementSet] = field(default_factory=list)  #: InstantTrack's OLD
+    kept: int = 0
+
+
+def has_decayed(es: ElementSet, at: datetime) -> bool:
+    """True when the object has come down by ``at``: mean perigee below the surface, or SGP4
+    refusing to propagate the set to ``at`` (its decay and eccentricity checks)."""
+    jd, fr = jday(at.year, at.month, at.day, at.hour, at.minute, at.second + at.microsecond / 1e6)
+    error, _, _ = es.satrec.sgp4(jd, fr)
+    if error != 0:
+        return True
+    from nfwserver.tracking.catalog import Satellite
+
+    return Satellite(es, "").is_decayed
 
 
 @dataclass
@@ -50,3 +74,23 @@ class ElementStore:
             text = "".join(sat.elements.tle_text() for sat in catalog)
             atomic_write_text(self.path, text)
         return catalog, summary
+
+    def prune(self, now: datetime, max_age_days: float) -> PruneSummary:
+        """Remove decayed objects and sets whose epoch is more than ``max_age_days`` before ``now``.
+
+        The file is rewritten atomically, and only when something was removed.
+        """
+        summary = PruneSummary()
+        oldest = now - timedelta(days=max_age_days)
+        kept: list[ElementSet] = []
+        for es in self.load():
+            if has_decayed(es, now):
+                summary.decayed.append(es)
+            elif es.epoch < oldest:
+                summary.old.append(es)
+            else:
+                kept.append(es)
+        summary.kept = len(kept)
+        if summary.decayed or summary.old:
+            atomic_write_text(self.path, "".join(es.tle_text() for es in kept))
+        return summary

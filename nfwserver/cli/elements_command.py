@@ -1,81 +1,165 @@
-"""``nfwserver elements``: update the stored catalog from files and URLs, and list it."""
+"""``nfwserver elements``: update, list and prune the stored catalog (InstantTrack UPDATE, OLD, CRASH).
+
+Every action works on the store ``nfwserver run`` reads: ``--store FILE`` if given, else
+``[elements] store`` of the configuration (``--config FILE``, else the user's file, else the user
+data directory).  Data on stdout, one sentence per problem on stderr, progress on stderr.
+"""
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 from datetime import datetime, timezone
 
+from nfwserver.cli.arguments import element_source_value, number_in
+from nfwserver.cli.tracking_options import config_file
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    p = subparsers.add_parser("elements", help="update or list the stored element catalog",
-                              description="Manage the stored element catalog (InstantTrack UPDATE semantics).")
+    p = subparsers.add_parser("elements", help="update, list or prune the stored element catalog",
+                              description="Manage the stored element catalog (InstantTrack UPDATE, OLD and CRASH).")
     sub = p.add_subparsers(dest="elements_action", metavar="ACTION", required=True)
     up = sub.add_parser("update", help="merge element files or URLs into the stored catalog (newer epochs only)")
-    up.add_argument("sources", nargs="*", metavar="FILE|URL",
-                    help="element files or http(s) URLs (default: the sources in the configuration)")
-    up.add_argument("--store", metavar="FILE", help="stored catalog file (default: user data directory)")
-    up.add_argument("--config", metavar="FILE", help="configuration file")
-    up.add_argument("--timeout", type=float, default=20.0, metavar="SECONDS", help="per-URL timeout")
+    up.add_argument("sources", nargs="*", type=element_source_value, metavar="FILE|URL",
+                    help="element files or http(s) URLs (default: [elements] files and urls of the configuration)")
+    up.add_argument("--timeout", type=number_in(0, 3600, low_open=True, unit="s"), default=20.0,
+                    metavar="SECONDS", help="per-URL timeout")
     up.set_defaults(func=run_update)
-    ls = sub.add_parser("list", help="list the stored catalog")
-    ls.add_argument("--store", metavar="FILE")
+    ls = sub.add_parser("list", help="list the catalog the station uses (stored + files + bundled)")
     ls.set_defaults(func=run_list)
+    pr = sub.add_parser("prune", help="remove decayed objects and old sets from the stored catalog",
+                        description="InstantTrack's CRASH and OLD: remove objects that have decayed and sets whose "
+                        "epoch is more than --days before now; the store is rewritten atomically.")
+    pr.add_argument("--days", type=number_in(0, 36600, low_open=True, unit="days"), default=30.0,
+                    help="remove sets older than this many days (default 30)")
+    pr.set_defaults(func=run_prune)
+    for action in (up, ls, pr):
+        action.add_argument("--store", metavar="FILE", help="stored catalog file (default: [elements] store)")
+        action.add_argument("--config", metavar="FILE", help="configuration file (default: the user's)")
 
 
-def run_update(args: argparse.Namespace) -> int:
-    from rich.progress import Progress
-
-    from nfwserver.app.element_sources import fetch_all
-    from nfwserver.app.element_store import ElementStore
+def _config(args: argparse.Namespace):
     from nfwserver.cli import CliError
     from nfwserver.config import ConfigError, load_config
 
-    sources = list(args.sources)
+    try:
+        config = load_config(args.config)
+    except ConfigError as exc:
+        raise CliError(f"configuration refused: {exc}") from None
+    if args.store:
+        config = dataclasses.replace(config, elements=dataclasses.replace(config.elements, store=args.store))
+    return config
+
+
+def _store(config):
+    from nfwserver.app.station_catalog import configured_store
+    from nfwserver.cli import CliError
+
+    store = configured_store(config)
+    if store is None:
+        raise CliError(f'no stored catalog: [elements] store is "none" in {config_file(config)}; give --store FILE')
+    return store
+
+
+def _say(message: str) -> None:
+    print(f"nfwserver: {message}", file=sys.stderr)
+
+
+def run_update(args: argparse.Namespace) -> int:
+    from rich.console import Console
+    from rich.progress import BarColumn, DownloadColumn, Progress, TextColumn
+
+    from nfwserver.app.element_sources import SourceError, read_source
+    from nfwserver.cli import CliError
+
+    config = _config(args)
+    store = _store(config)
+    sources = list(args.sources) or [*config.elements.files, *config.elements.urls]
     if not sources:
-        try:
-            config = load_config(args.config)
-        except ConfigError as exc:
-            raise CliError(f"configuration refused: {exc}") from None
-        sources = [*config.elements.files, *config.elements.urls]
-        if not sources:
-            raise CliError("no sources given and none configured ([elements] files or urls)")
+        raise CliError(f"no sources given and none configured ([elements] files or urls in {config_file(config)})")
     sets, rejected, failed = [], [], []
-    with Progress(transient=True, console=None) as progress:
-        task = progress.add_task("fetching elements", total=len(sources))
+    columns = (TextColumn("{task.description}"), BarColumn(), DownloadColumn(), TextColumn("{task.fields[sets]} sets"))
+    console = Console(stderr=True)
+    with Progress(*columns, console=console, transient=True, disable=not console.is_terminal) as progress:
         for source in sources:
-            is_url = source.lower().startswith(("http://", "https://"))
-            result = fetch_all(urls=(source,) if is_url else (), files=() if is_url else (source,),
-                               use_bundled=False, timeout_s=args.timeout)
-            sets += result.sets
-            rejected += result.rejected
-            failed += result.failed
-            progress.advance(task)
-    store = ElementStore(args.store)
+            task = progress.add_task(source[-40:], total=None, sets=0)
+
+            def moved(done: int, total: int | None, task=task) -> None:
+                progress.update(task, completed=done, total=total)
+
+            try:
+                loaded = read_source(source, args.timeout, moved)
+            except SourceError as exc:
+                failed.append(str(exc))
+                progress.remove_task(task)
+                continue
+            progress.update(task, sets=len(loaded.sets))
+            sets += loaded.sets
+            rejected += loaded.rejected
+    for message in failed:
+        _say(message)
+    for r in rejected:
+        _say(f"rejected: {r}")
+    if not sets:  # every source failed, and each has been reported
+        return 1
     try:
         catalog, summary = store.update(sets)
     except OSError as exc:
-        raise CliError(f"cannot write {store.path}: {exc}") from None
-    out = sys.stdout
-    out.write(f"{len(sets)} sets read from {len(sources)} source(s); stored catalog {store.path}: {len(catalog)} "
-              f"satellites\n")
-    out.write(f"added {len(summary.added)}, updated {len(summary.updated)}, not newer {len(summary.not_newer)}, "
-              f"rejected {len(rejected)}\n")
-    for r in rejected:
-        print(f"rejected: {r}", file=sys.stderr)
-    for f in failed:
-        print(f"unavailable: {f}", file=sys.stderr)
-    return 1 if failed and not sets else 0
+        raise CliError(f"cannot write {store.path}: {exc.strerror or exc}") from None
+    print(f"{len(sets)} sets read from {len(sources) - len(failed)} of {len(sources)} source(s); "
+          f"stored catalog {store.path}: {len(catalog)} satellites")
+    print(f"added {len(summary.added)}, updated {len(summary.updated)}, not newer {len(summary.not_newer)}, "
+          f"rejected {len(rejected)}")
+    return 1 if failed else 0
 
 
 def run_list(args: argparse.Namespace) -> int:
-    from nfwserver.app.element_store import ElementStore
-    from nfwserver.tracking.catalog import Catalog
+    from nfwserver.app.element_sources import BUNDLED_SOURCE
+    from nfwserver.app.station_catalog import configured_store, load_station_catalog
 
-    store = ElementStore(args.store)
-    catalog = Catalog(store.load())
+    config = _config(args)
+    store = configured_store(config)
+    catalog, fetched = load_station_catalog(config)
+    for problem in fetched.failed:
+        _say(f"element source unavailable: {problem}")
     now = datetime.now(timezone.utc)
-    print(f"{'catalog':>7}  {'dde name':12}  {'age d':>6}  name")
+    stored_source = str(store.path) if store is not None else None
+    counts = {"stored": 0, "bundled": 0, "file": 0}
+    lines = [f"{'catalog':>7}  {'dde name':12}  {'age d':>6}  {'source':7}  name\n"]
     for sat in catalog:
-        print(f"{sat.catalog_number:>7}  {sat.dde_name:12}  {sat.age_days(now):6.1f}  {sat.name}")
+        source = sat.elements.source
+        kind = "stored" if source == stored_source else "bundled" if source == BUNDLED_SOURCE else "file"
+        counts[kind] += 1
+        lines.append(f"{sat.catalog_number:>7}  {sat.dde_name:12}  {sat.age_days(now):6.1f}  {kind:7}  {sat.name}\n")
+    try:
+        sys.stdout.write("".join(lines))
+        sys.stdout.flush()
+    except BrokenPipeError:  # the reader went away (e.g. piped into head)
+        sys.stderr.close()
+        return 0
+    where = f"stored catalog {store.path}" if store is not None else 'no stored catalog ([elements] store = "none")'
+    _say(f"{len(catalog)} satellites: {counts['stored']} from the {where}, {counts['file']} from [elements] files, "
+         f"{counts['bundled']} from the bundled set")
+    if counts["bundled"]:
+        _say(f"the bundled element set is in use ([elements] use_bundled = false in {config_file(config)} "
+             "turns it off); `nfwserver elements update FILE|URL` stores current sets")
+    return 0
+
+
+def run_prune(args: argparse.Namespace) -> int:
+    from nfwserver.cli import CliError
+
+    config = _config(args)
+    store = _store(config)
+    if not store.path.exists():
+        raise CliError(f"the stored catalog {store.path} does not exist yet (`nfwserver elements update` creates it)")
+    try:
+        summary = store.prune(datetime.now(timezone.utc), args.days)
+    except OSError as exc:
+        raise CliError(f"cannot write {store.path}: {exc.strerror or exc}") from None
+    for es in summary.decayed:
+        _say(f"removed {es.catalog_number} {es.name}: decayed")
+    print(f"removed {len(summary.decayed)} decayed and {len(summary.old)} older than {args.days:g} days; "
+          f"{summary.kept} sets remain in {store.path}")
     return 0

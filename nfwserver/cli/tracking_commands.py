@@ -1,7 +1,12 @@
 """``nfwserver ephemeris``, ``passes`` and ``visible``: InstantTrack's tables on the command line.
 
 Output columns are stable (other tools read them).  CSV: a header row, times ISO-8601 UTC with
-milliseconds and ``Z``, numbers with at least six decimals.
+milliseconds and ``Z``, numbers with at least six decimals.  ``passes`` ends each row with
+``in_progress`` (``Y`` for a pass already under way at the start; its AOS lies before the start).
+
+Every option defaults to the configured station (:mod:`nfwserver.cli.tracking_options`) and the
+time to now.  ``visible`` and ``passes`` leave out objects whose positions cannot be trusted at the
+time asked (:mod:`nfwserver.tracking.screening`) and name the stale element sets on stderr.
 """
 
 from __future__ import annotations
@@ -13,51 +18,75 @@ from datetime import datetime, timedelta
 
 import numpy as np
 
-from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs, parse_time
+from nfwserver.cli.arguments import number_in, satellite_value, time_value
+from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs, warn
 from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError, look_angles_array
 from nfwserver.tracking.passes import find_passes
+from nfwserver.tracking.screening import MAX_PLAUSIBLE_RANGE_KM, STALE_AFTER_DAYS, screen_satellites, stale_satellites
 from nfwserver.tracking.timescale import julian_date
 
 EPHEMERIS_COLUMNS = ["time_utc", "azimuth_deg", "elevation_deg", "range_km", "range_rate_km_s", "above_horizon"]
 PASS_COLUMNS = ["catalog_number", "name", "aos_utc", "tca_utc", "los_utc", "max_elevation_deg",
-                "aos_azimuth_deg", "los_azimuth_deg", "duration_s"]
+                "aos_azimuth_deg", "los_azimuth_deg", "duration_s", "in_progress"]
 VISIBLE_COLUMNS = ["catalog_number", "name", "azimuth_deg", "elevation_deg", "range_km", "range_rate_km_s"]
+TIME_HELP = "'now' (default), relative (+2h, -30m, +90s, +1d) or ISO-8601 (UTC when no zone is given)"
+MAX_DURATION_S = 366 * 86400.0
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser("ephemeris", help="position table of one satellite",
-                              description="Look angles of one satellite at regular steps (InstantTrack's table).")
+                              description="Look angles of one satellite at regular steps (InstantTrack's table). "
+                              "Defaults: the configured observer, horizon, catalog and satellite, from now.")
     add_tracking_options(p)
-    p.add_argument("--sat", required=True, help="catalog number (or DDE/element name)")
-    p.add_argument("--start", required=True, help="ISO-8601 start (UTC when no zone is given)")
-    p.add_argument("--duration", type=float, default=3600.0, metavar="SECONDS")
-    p.add_argument("--step", type=float, default=60.0, metavar="SECONDS")
-    p.set_defaults(func=run_ephemeris)
+    p.add_argument("--sat", type=satellite_value, help="catalog number or name (default: [server] satellite)")
+    p.add_argument("--start", type=time_value, default="now", help=TIME_HELP)
+    p.add_argument("--duration", type=number_in(0, MAX_DURATION_S, unit="s"), default=3600.0, metavar="SECONDS")
+    p.add_argument("--step", type=number_in(0, MAX_DURATION_S, low_open=True, unit="s"), default=60.0,
+                   metavar="SECONDS")
+    p.set_defaults(func=run_ephemeris, usage_error=p.error)
 
     p = subparsers.add_parser("passes", help="AOS/TCA/LOS of satellites over a window",
-                              description="Passes over the horizon table; all satellites when no --sat is given.")
+                              description="Passes over the horizon table; all satellites when no --sat is given. "
+                              "A pass already in progress at the start is marked (in_progress Y).")
     add_tracking_options(p)
-    p.add_argument("--sat", action="append", default=[], help="catalog number or name; repeatable")
-    p.add_argument("--start", required=True, help="ISO-8601 start (UTC when no zone is given)")
-    p.add_argument("--hours", type=float, default=24.0)
-    p.add_argument("--workers", type=int, default=1, metavar="N",
+    p.add_argument("--sat", type=satellite_value, action="append", default=[],
+                   help="catalog number or name; repeatable")
+    p.add_argument("--start", type=time_value, default="now", help=TIME_HELP)
+    p.add_argument("--hours", type=number_in(0, 744, low_open=True, unit="h"), default=24.0)
+    p.add_argument("--workers", type=number_in(1, 64, integer=True), default=1, metavar="N",
                    help="worker processes for large catalogs (POSIX; default 1)")
     p.set_defaults(func=run_passes)
 
     p = subparsers.add_parser("visible", help="satellites above the horizon table at an instant",
                               description="Every satellite above the horizon table at --at, with its look angles.")
     add_tracking_options(p)
-    p.add_argument("--at", required=True, help="ISO-8601 instant (UTC when no zone is given)")
+    p.add_argument("--at", type=time_value, default="now", help=TIME_HELP)
     p.set_defaults(func=run_visible)
 
 
-def _time_arg(text: str, flag: str) -> datetime:
+def _pick(catalog, text: str):
+    """The satellite ``text`` names (catalog number, DDE or element name); CliError when absent."""
     from nfwserver.cli import CliError
 
-    try:
-        return parse_time(text)
-    except ValueError as exc:
-        raise CliError(f"{flag}: {exc}") from None
+    sat = catalog.find(text)
+    if sat is None:
+        raise CliError(f"satellite {text} is not in the catalog")
+    return sat
+
+
+def _screen(sats: list, inputs, at: datetime) -> list:
+    """The satellites whose positions at ``at`` are usable; the rest and stale sets are reported."""
+    screened = screen_satellites(sats, inputs.observer, at, inputs.ut1_utc)
+    if screened.unusable:
+        names = ", ".join(s.dde_name for s in screened.unusable[:5]) + (", ..." if len(screened.unusable) > 5 else "")
+        warn(f"skipped {len(screened.unusable)} object(s) whose position at {format_time(at)} cannot be computed "
+             f"or is implausibly far (decayed or elements far outside their validity): {names}")
+    stale = stale_satellites(screened.usable, at)
+    if stale:
+        names = ", ".join(s.dde_name for s in stale[:5]) + (", ..." if len(stale) > 5 else "")
+        warn(f"{len(stale)} element set(s) are more than {STALE_AFTER_DAYS:g} days older than {format_time(at)}, "
+             f"so their positions drift ({names}); `nfwserver elements update` fetches newer ones")
+    return screened.usable
 
 
 def _writer(fmt: str, columns: list[str]):
@@ -87,13 +116,14 @@ def _num(value: float | None, decimals: int, fmt: str) -> str:
 def run_ephemeris(args: argparse.Namespace) -> int:
     from nfwserver.cli import CliError
 
-    start = _time_arg(args.start, "--start")
-    if not args.step > 0 or not args.duration >= 0 or args.duration / args.step > 10_000_000:
-        raise CliError("--step must be positive and --duration / --step at most 10,000,000")
+    start = args.start
+    if args.duration / args.step > 10_000_000:
+        args.usage_error("--duration / --step gives more than 10,000,000 rows: use a larger --step")
     inputs = load_tracking_inputs(args)
-    sat = inputs.catalog.find(str(args.sat))
-    if sat is None:
-        raise CliError(f"satellite {args.sat} is not in the element files")
+    if args.sat is None and inputs.satellite is None:
+        raise CliError("no --sat given and no [server] satellite configured")
+    sat = _pick(inputs.catalog, str(args.sat if args.sat is not None else inputs.satellite))
+    _screen([sat], inputs, start)
     calc = LookAngleCalculator(inputs.observer, inputs.ut1_utc)
     write, flush = _writer(args.format, EPHEMERIS_COLUMNS)
     count = int(args.duration // args.step) + 1
@@ -112,23 +142,10 @@ def run_ephemeris(args: argparse.Namespace) -> int:
 
 
 def run_passes(args: argparse.Namespace) -> int:
-    from nfwserver.cli import CliError
-
-    start = _time_arg(args.start, "--start")
-    if not 0 < args.hours <= 24 * 31:
-        raise CliError("--hours must be between 0 and 744")
+    start = args.start
     inputs = load_tracking_inputs(args)
-    if args.sat:
-        sats = []
-        for text in args.sat:
-            sat = inputs.catalog.find(text)
-            if sat is None:
-                raise CliError(f"satellite {text} is not in the element files")
-            sats.append(sat)
-    else:
-        sats = inputs.catalog.satellites()
-    if not 1 <= args.workers <= 64:
-        raise CliError("--workers must be between 1 and 64")
+    sats = [_pick(inputs.catalog, text) for text in args.sat] if args.sat else inputs.catalog.satellites()
+    sats = _screen(sats, inputs, start)
     passes = find_passes(sats, inputs.observer, start, start + timedelta(hours=args.hours),
                          horizon=inputs.horizon, ut1_utc=inputs.ut1_utc, workers=args.workers)
     write, flush = _writer(args.format, PASS_COLUMNS)
@@ -137,21 +154,26 @@ def run_passes(args: argparse.Namespace) -> int:
         write([str(p.catalog_number), sat.name or sat.dde_name,
                format_time(p.aos) if p.aos else "", format_time(p.tca), format_time(p.los) if p.los else "",
                _num(p.max_elevation_deg, 1, args.format), _num(p.aos_azimuth_deg, 1, args.format),
-               _num(p.los_azimuth_deg, 1, args.format), _num(p.duration_s, 0, args.format)])
+               _num(p.los_azimuth_deg, 1, args.format), _num(p.duration_s, 0, args.format),
+               "Y" if p.aos_before_start else "N"])
     flush()
     return 0
 
 
 def run_visible(args: argparse.Namespace) -> int:
-    at = _time_arg(args.at, "--at")
+    at = args.at
     inputs = load_tracking_inputs(args)
-    sats = inputs.catalog.satellites()
+    sats = _screen(inputs.catalog.satellites(), inputs, at)
+    if not sats:
+        _writer(args.format, VISIBLE_COLUMNS)[1]()
+        return 0
     jd, fr = julian_date(at)
     arr = look_angles_array([s.satrec for s in sats], inputs.observer, np.array([jd]), np.array([fr]),
                             inputs.ut1_utc)
     az, el = arr.azimuth_deg[:, 0], arr.elevation_deg[:, 0]
     with np.errstate(invalid="ignore"):
-        up = np.flatnonzero(el > inputs.horizon.min_elevation_array(np.nan_to_num(az)))
+        up = np.flatnonzero((el > inputs.horizon.min_elevation_array(np.nan_to_num(az)))
+                            & (arr.range_km[:, 0] <= MAX_PLAUSIBLE_RANGE_KM))
     write, flush = _writer(args.format, VISIBLE_COLUMNS)
     for i in up[np.argsort(-el[up])]:
         sat = sats[i]

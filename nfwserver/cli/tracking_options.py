@@ -1,4 +1,11 @@
-"""Options shared by every command that computes positions: elements, observer, horizon, UT1-UTC."""
+"""Options shared by every command that computes positions: configuration, elements, observer, horizon.
+
+Every option defaults to the configured station (DESIGN.md §9): the observer and horizon from the
+configuration (``--config FILE``, else the user's file, else the built-in defaults) and the same
+catalog ``nfwserver run`` tracks (:func:`nfwserver.app.station_catalog.load_station_catalog`).
+Flags only override.  The configured horizon table describes the obstructions around the
+configured station, so it applies only when ``--observer`` is not given (``--horizon`` always wins).
+"""
 
 from __future__ import annotations
 
@@ -8,8 +15,8 @@ import sys
 from dataclasses import dataclass
 from datetime import datetime, timezone
 
+from nfwserver.cli.arguments import number_in, observer_value, parse_time_text
 from nfwserver.tracking.catalog import Catalog
-from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.horizon import HorizonTable, load_horizon
 from nfwserver.tracking.observer import Observer, parse_observer
 
@@ -24,29 +31,35 @@ class TrackingInputs:
     observer: Observer
     horizon: HorizonTable
     ut1_utc: float
+    satellite: int | None = None  #: the configured AutoTracking satellite (``[server] satellite``)
 
 
 def add_tracking_options(parser: argparse.ArgumentParser, output_format: bool = True) -> None:
-    """Add ``--elements``, ``--observer``, ``--horizon``, ``--ut1-utc`` (and ``--format``)."""
-    parser.add_argument("--elements", action="append", metavar="FILE", required=True,
-                        help="element file (TLE, AMSAT verbose, OMM JSON/CSV); repeatable")
-    parser.add_argument("--observer", required=True, metavar="LAT,LON[,ALT_M]|LOCATOR",
-                        help="station: e.g. 52.2,0.12,20 or 33.87S,151.21E or JO02ae")
-    parser.add_argument("--horizon", metavar="FILE", help="horizon table: 'azimuth elevation' per line")
-    parser.add_argument("--ut1-utc", type=float, default=0.0, metavar="SECONDS",
-                        help="UT1-UTC in seconds (IERS Bulletin A; default 0)")
+    """Add ``--config``, ``--elements``, ``--observer``, ``--horizon``, ``--ut1-utc`` (and ``--format``)."""
+    if "--config" not in parser._option_string_actions:
+        parser.add_argument("--config", metavar="FILE",
+                            help="configuration file (default: the user's); gives the default observer, "
+                                 "horizon and catalog")
+    parser.add_argument("--elements", action="append", metavar="FILE",
+                        help="element file (TLE, AMSAT verbose, OMM JSON/CSV) to use instead of the station's "
+                             "catalog; repeatable")
+    parser.add_argument("--observer", type=observer_value, metavar="LAT,LON[,ALT_M]|LOCATOR",
+                        help="station instead of the configured one: e.g. 52.2,0.12,20 or 33.87S,151.21E or JO02ae")
+    parser.add_argument("--horizon", metavar="FILE",
+                        help="horizon table, 'azimuth elevation' per line (default: the configured one, "
+                             "unless --observer is given)")
+    parser.add_argument("--ut1-utc", type=number_in(-1.0, 1.0, unit="s"), default=None, metavar="SECONDS",
+                        help="UT1-UTC in seconds (IERS Bulletin A; default: the configuration's, else 0)")
     if output_format:
         parser.add_argument("--format", choices=("table", "csv"), default="table", help="output format")
 
 
 def parse_time(text: str) -> datetime:
-    """ISO-8601 time; without a zone it is UTC.  Raises :class:`ValueError` with a clear sentence."""
-    raw = text.strip()
-    try:
-        when = datetime.fromisoformat(raw[:-1] + "+00:00" if raw.endswith(("Z", "z")) else raw)
-    except ValueError:
-        raise ValueError(f"{text!r} is not an ISO-8601 time (e.g. 2026-05-08T12:00:00Z)") from None
-    return when.replace(tzinfo=timezone.utc) if when.tzinfo is None else when.astimezone(timezone.utc)
+    """``now``, a relative time (``+2h``, ``-30m``) or ISO-8601 (UTC without a zone).
+
+    Raises :class:`ValueError` with a clear sentence.
+    """
+    return parse_time_text(text)
 
 
 def format_time(when: datetime) -> str:
@@ -54,32 +67,90 @@ def format_time(when: datetime) -> str:
     return when.astimezone(timezone.utc).strftime("%Y-%m-%dT%H:%M:%S.") + f"{when.microsecond // 1000:03d}Z"
 
 
+def warn(message: str) -> None:
+    """One diagnostic line on stderr."""
+    print(f"nfwserver: {message}", file=sys.stderr)
+
+
+def config_file(config) -> str:
+    """The configuration file ``config`` came from, or the file the user would create."""
+    if not config.source.startswith("<"):
+        return config.source
+    from nfwserver.config import default_config_path
+
+    return str(default_config_path())
+
+
+def _load_config(args: argparse.Namespace):
+    from nfwserver.cli import CliError
+    from nfwserver.config import ConfigError, load_config
+
+    try:
+        return load_config(getattr(args, "config", None))
+    except ConfigError as exc:
+        raise CliError(f"configuration refused: {exc}") from None
+
+
+def _catalog_from_files(paths: list[str], dde_names: dict[int, str]) -> Catalog:
+    from nfwserver.cli import CliError
+    from nfwserver.tracking.elements import load_element_file
+
+    sets = []
+    for path in paths:
+        result = load_element_file(path)
+        for rejection in result.rejected:
+            warn(f"skipped element set: {rejection}")
+        sets.extend(result.sets)
+    if not sets:
+        raise CliError("no usable element sets in " + ", ".join(paths))
+    return Catalog(sets, dde_names=dde_names)
+
+
+def _station_catalog(config) -> Catalog:
+    from nfwserver.app.station_catalog import configured_store, load_station_catalog
+    from nfwserver.cli import CliError
+
+    catalog, fetched = load_station_catalog(config)
+    for problem in fetched.failed:
+        warn(f"element source unavailable: {problem}")
+    if not len(catalog):
+        store = configured_store(config)
+        where = f"the stored catalog {store.path} is empty" if store is not None else "no stored catalog"
+        raise CliError(f"no element sets: {where}, no [elements] files are configured and the bundled set is "
+                       f"off in {config_file(config)}; run `nfwserver elements update FILE|URL` or give --elements")
+    return catalog
+
+
 def load_tracking_inputs(args: argparse.Namespace) -> TrackingInputs:
-    """Resolve the options; rejected element sets are reported on stderr.
+    """Resolve the options against the configuration; rejected element sets are reported on stderr.
 
     Raises :class:`nfwserver.cli.CliError` when nothing usable remains.
     """
     from nfwserver.cli import CliError
 
-    try:
-        observer = parse_observer(args.observer)
-    except ValueError as exc:
-        raise CliError(f"--observer: {exc}") from None
+    config = _load_config(args)
+    observer = getattr(args, "observer", None)
+    if isinstance(observer, str):  # a parser that did not use observer_value
+        try:
+            observer = parse_observer(observer)
+        except ValueError as exc:
+            raise CliError(f"--observer: {exc}") from None
     horizon = HorizonTable()
     if getattr(args, "horizon", None):
         try:
             horizon = load_horizon(args.horizon)
         except (OSError, ValueError) as exc:
             raise CliError(f"--horizon: {exc}") from None
-    ut1_utc = float(getattr(args, "ut1_utc", 0.0) or 0.0)
-    if not -1.0 <= ut1_utc <= 1.0:
-        raise CliError(f"--ut1-utc {ut1_utc} s is outside -1..1 s")
-    sets = []
-    for path in args.elements:
-        result = load_element_file(path)
-        for rejection in result.rejected:
-            print(f"nfwserver: skipped element set: {rejection}", file=sys.stderr)
-        sets.extend(result.sets)
-    if not sets:
-        raise CliError("no usable element sets in " + ", ".join(args.elements))
-    return TrackingInputs(Catalog(sets), observer, horizon, ut1_utc)
+    elif observer is None:
+        horizon = config.horizon
+    if observer is None:
+        observer = config.observer
+        if not config.observer_configured:
+            warn(f"no observer configured: using {observer}; set [observer] location in {config_file(config)} "
+                 "(`nfwserver config init` writes a starting file) or give --observer")
+    ut1_utc = getattr(args, "ut1_utc", None)
+    if ut1_utc is None:
+        ut1_utc = config.server.ut1_utc_s
+    elements = getattr(args, "elements", None)
+    catalog = _catalog_from_files(elements, config.dde_names) if elements else _station_catalog(config)
+    return TrackingInputs(catalog, observer, horizon, float(ut1_utc), config.server.satellite)

@@ -18,6 +18,12 @@ characters.  Within a catalog, names are unique: satellites are taken in ascendi
 number and each receives its first candidate no lower-numbered satellite holds (the last
 candidate contains the catalog number, so it is always free).  A user's override always wins and
 is never given to another satellite.
+
+Well-known satellites (:data:`WELL_KNOWN_NAMES`: every bundled satellite and every one with a
+built-in radio channel) keep the name clients know them by whatever their element sets call
+them: CelesTrak names AO-91 ``RADFXSAT (FOX-1B)`` and other sources give RS-44 the name of its
+rocket stage, yet a client configured for ``AO-91`` or ``RS-44`` must keep receiving that name
+after an element update.  Only a user's override comes before them.
 """
 
 from __future__ import annotations
@@ -44,6 +50,19 @@ def sanitize(text: str) -> str:
         if sep and head and any(c.isdigit() for c in tail) and len(tail) <= MAX_LENGTH - 4:
             return head[: MAX_LENGTH - len(tail) - 1].rstrip("-") + "-" + tail
     return text[:MAX_LENGTH].rstrip("-")
+
+
+#: Stable DDE names by catalog number, the names amateur operators and their clients use.
+WELL_KNOWN_NAMES: dict[int, str] = {
+    7530: "AO-7", 14129: "AO-10", 14781: "UO-11", 20442: "LO-19", 22825: "AO-27", 22826: "IO-26",
+    24278: "FO-29", 25544: "ISS", 26931: "NO-44", 27607: "SO-50", 27844: "CO-55", 27848: "CO-57",
+    32785: "CO-65", 32791: "CO-66", 35932: "SWISSCUBE", 39440: "LO-74", 39444: "AO-73", 40069: "METEOR-M-2",
+    40908: "LILACSAT-2", 40967: "AO-85", 41847: "CAS-2T", 43013: "NOAA-20", 43017: "AO-91", 43770: "AO-95",
+    43803: "JO-97", 44387: "METEOR-M2-2", 44879: "CAS-6", 44909: "RS-44", 48274: "CSS", 50466: "CAS-9",
+    53109: "IO-117", 54234: "NOAA-21", 57166: "METEOR-M2-3", 59051: "METEOR-M2-4", 61781: "AO-123",
+    63213: "TEVEL2-4", 63214: "TEVEL2-5", 63215: "TEVEL2-6", 63217: "TEVEL2-1", 63218: "TEVEL2-3",
+    63219: "TEVEL2-2", 63237: "TEVEL2-9", 63238: "TEVEL2-7", 63239: "TEVEL2-8",
+}
 
 
 def validate_dde_name(name: str) -> str:
@@ -89,12 +108,18 @@ def dde_name_for(element_name: str, catalog_number: int) -> str:
 
 
 def assign_dde_names(names: dict[int, str], overrides: dict[int, str] | None = None) -> dict[int, str]:
-    """Unique DDE names for ``{catalog_number: element_name}``, overrides first (module docstring)."""
+    """Unique DDE names for ``{catalog_number: element_name}``: overrides first, then the
+    well-known names, then derived names (module docstring)."""
     overrides = overrides or {}
     taken = {n.upper() for n in overrides.values()}
     result = dict(overrides)
     for catnr in sorted(names):
-        if catnr in overrides:
+        known = WELL_KNOWN_NAMES.get(catnr)
+        if catnr not in result and known is not None and known.upper() not in taken:
+            taken.add(known.upper())
+            result[catnr] = known
+    for catnr in sorted(names):
+        if catnr in result:
             continue
         for cand in name_candidates(names[catnr], catnr):
             if cand.upper() not in taken:

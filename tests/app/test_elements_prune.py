@@ -1,0 +1,98 @@
+"""``nfwserver elements prune`` (InstantTrack OLD and CRASH), the bundled set and stable DDE names."""
+
+from __future__ import annotations
+
+import dataclasses
+from datetime import datetime, timedelta, timezone
+
+import pytest
+
+from nfwserver.app.element_sources import bundled_elements
+from nfwserver.app.element_store import ElementStore
+from nfwserver.cli import main
+from nfwserver.tracking.catalog import Catalog
+from nfwserver.tracking.elements import ElementSet, load_element_file, load_elements
+from nfwserver.tracking.tle import parse_tle
+from tests.conftest import DATA
+
+NOW = datetime.now(timezone.utc)
+
+
+def _set(catnr: int, age_days: float, name: str, **changes) -> str:
+    """ISS's elements under another number and name, with the epoch ``age_days`` before now."""
+    iss = next(s for s in load_element_file(DATA / "visual.txt").sets if s.catalog_number == 25544)
+    fields = dataclasses.replace(parse_tle(iss.line1, iss.line2), catalog_number=catnr,
+                                 epoch=NOW - timedelta(days=age_days), **changes)
+    return ElementSet.from_fields(name, fields).tle_text()
+
+
+@pytest.fixture
+def store(tmp_path):
+    path = tmp_path / "stored.txt"
+    # 17.5 rev/day puts the semi-major axis at about 6220 km, below the Earth's 6378 km radius.
+    path.write_text(_set(90001, 1, "FRESH") + _set(90002, 40, "OLD") + _set(90003, 10, "OLD-ISH")
+                    + _set(90004, 1, "FALLEN", mean_motion_rev_per_day=17.5))
+    return path
+
+
+def test_prune_removes_decayed_and_old_sets(store, capsys) -> None:
+    assert main(["elements", "prune", "--store", str(store)]) == 0
+    out, err = capsys.readouterr()
+    assert out == f"removed 1 decayed and 1 older than 30 days; 2 sets remain in {store}\n"
+    assert "90004 FALLEN: decayed" in err
+    assert sorted(s.catalog_number for s in ElementStore(store).load()) == [90001, 90003]
+    assert sorted(p.name for p in store.parent.iterdir()) == ["stored.txt"]  # no temporary file left
+
+
+def test_prune_age_is_configurable_and_the_configured_store_is_used(store, tmp_path, capsys) -> None:
+    config = tmp_path / "c.toml"
+    config.write_text(f'[elements]\nstore = "{store.name}"\n')
+    assert main(["elements", "prune", "--config", str(config), "--days", "5"]) == 0
+    assert "removed 1 decayed and 2 older than 5 days; 1 sets remain" in capsys.readouterr().out
+    assert [s.name for s in ElementStore(store).load()] == ["FRESH"]
+    before = store.read_bytes()
+    assert main(["elements", "prune", "--config", str(config), "--days", "5"]) == 0
+    assert store.read_bytes() == before
+
+
+@pytest.mark.parametrize("days", ["0", "-3", "abc"])
+def test_prune_bad_days_is_a_usage_error(store, days, capsys) -> None:
+    with pytest.raises(SystemExit) as exit_info:
+        main(["elements", "prune", "--store", str(store), f"--days={days}"])
+    assert exit_info.value.code == 2 and "--days" in capsys.readouterr().err
+
+
+def test_prune_of_a_missing_store_is_one_sentence(tmp_path, capsys) -> None:
+    assert main(["elements", "prune", "--store", str(tmp_path / "none.txt")]) == 1
+    assert "does not exist yet" in capsys.readouterr().err
+
+
+def test_bundled_set_holds_every_satellite_with_a_built_in_channel() -> None:
+    from nfwserver.radio.defaults import DEFAULT_CHANNELS
+
+    result = bundled_elements()
+    assert not result.rejected and result.bundled == len(result.sets)
+    assert set(DEFAULT_CHANNELS) <= {s.catalog_number for s in result.sets}
+
+
+def test_well_known_dde_names_survive_an_element_update() -> None:
+    catalog = Catalog(bundled_elements().sets)
+    before = {s.catalog_number: s.dde_name for s in catalog}
+    assert before[43017] == "AO-91" and before[44909] == "RS-44" and before[25544] == "ISS"
+    # The same satellites as other sources name them: CelesTrak's active group, a rocket-stage name for
+    # RS-44, and a newer ISS module listed before the station itself.
+    renamed = load_elements(_set(44909, 0, "BREEZE-KM R/B") + _set(43017, 0, "RADFXSAT (FOX-1B)")
+                            + _set(25544, 0, "ISS (NAUKA)") + _set(7530, 0, "OSCAR 7")).sets
+    summary = catalog.update([*renamed, *load_element_file(DATA / "active.txt").sets])
+    assert {44909, 43017, 25544, 7530} <= set(summary.updated)
+    after = {s.catalog_number: s.dde_name for s in catalog if s.catalog_number in before}
+    assert after == before
+    names = [s.dde_name.upper() for s in catalog]
+    assert len(names) == len(set(names))
+
+
+def test_a_user_override_still_wins_over_a_well_known_name() -> None:
+    catalog = Catalog(bundled_elements().sets, dde_names={43017: "FOX1B", 40967: "AO-91"})
+    assert catalog.get(43017).dde_name == "FOX1B" and catalog.get(40967).dde_name == "AO-91"
+    catalog = Catalog(bundled_elements().sets, dde_names={40967: "RS-44"})
+    assert catalog.get(40967).dde_name == "RS-44" and catalog.get(44909).dde_name != "RS-44"

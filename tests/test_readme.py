@@ -1,0 +1,68 @@
+"""The README's commands work as written: the test command as root and through sudo, the simulate example."""
+
+from __future__ import annotations
+
+import os
+import re
+import shlex
+import stat
+import subprocess
+
+import pytest
+
+from nfwserver.cli import main
+from tests.conftest import ROOT
+
+README = (ROOT / "README.md").read_text(encoding="utf-8")
+
+
+def _block_after(heading: str) -> str:
+    """The first ```sh block after the line containing ``heading``, continuation lines joined."""
+    tail = README[README.index(heading):]
+    body = re.search(r"```sh\n(.*?)```", tail, re.S)
+    assert body is not None
+    return body.group(1).replace("\\\n", " ").strip()
+
+
+def _tool(directory, name: str, script: str) -> None:
+    path = directory / name
+    path.write_text("#!/bin/sh\n" + script)
+    path.chmod(path.stat().st_mode | stat.S_IXUSR)
+
+
+@pytest.mark.parametrize(("uid", "expected_prefix"), [("0", ""), ("1000", "sudo ")])
+def test_the_test_command_needs_sudo_only_when_not_root(tmp_path, uid, expected_prefix) -> None:
+    """Run the README line with the system tools it calls recorded instead of run (no network here)."""
+    command = _block_after("Install and run the tests")
+    log = tmp_path / "calls.log"
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    record = f'echo "${{0##*/}} $*" >> "{log}"\n'
+    _tool(bin_dir, "id", f'[ "$1" = "-u" ] && echo {uid}\n')
+    for name in ("apt-get", "python3"):
+        _tool(bin_dir, name, record)
+    if uid != "0":
+        _tool(bin_dir, "sudo", record + '"$@"\n')  # a real sudo runs the command; so does this one
+    sh = next(p for p in ("/bin/sh", "/usr/bin/sh") if os.path.exists(p))
+    env = {"PATH": f"{bin_dir}:/nonexistent", "HOME": str(tmp_path)}
+    done = subprocess.run([sh, "-c", command], env=env, capture_output=True, text=True, timeout=30,
+                          cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    calls = log.read_text().splitlines()
+    apt = [c for c in calls if "apt-get install" in c]
+    assert apt and apt[0].startswith(f"{expected_prefix}apt-get install -y libhamlib-utils")
+    assert calls[-1] == "python3 -m pytest -n 2"
+    assert not any(c.startswith("sudo python3") for c in calls)
+
+
+def test_the_simulate_example_uses_files_that_exist(monkeypatch, capsys) -> None:
+    command = next(line for line in _block_after("To see exactly what a client").splitlines()
+                   if line.startswith("nfwserver simulate"))
+    argv = shlex.split(command)[1:]
+    files = [argv[i + 1] for i, word in enumerate(argv) if word in ("--elements", "--horizon", "--config")]
+    assert files and all((ROOT / f).is_file() for f in files)
+    monkeypatch.chdir(ROOT)
+    assert main(argv) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].split("\t")[1].startswith("ISS AZ:")
+    assert lines[-1].split("\t")[1].startswith("SO-50 AZ:")
