@@ -3,8 +3,9 @@
 An axis is declared stalled when
 
 - the backend itself says so (the simulated rotor's injected stall, :class:`StallReporting`);
-- it needs moving (more than ``tolerance_deg`` from where it was sent) and has not come closer by
-  ``tolerance_deg`` within ``timeout_s`` of clock time (a jammed rotor that reports nothing); or
+- it needs moving (more than ``deadband_deg`` from where it was sent: real controllers stop a degree
+  or two short, and that is arrival, not a stall) and has not moved ``tolerance_deg`` towards the
+  target within ``timeout_s`` of clock time (a jammed rotor that reports nothing); or
 - the backend refused ``error_limit`` calls in a row (``RPRT -n`` from rotctld): then both axes,
   as the daemon does not say which one failed.
 
@@ -38,7 +39,8 @@ class _Progress:
 @dataclass
 class StallWatch:
     timeout_s: float | None = 15.0  #: None: no no-movement detection (e.g. a virtual clock with a real rotor)
-    tolerance_deg: float = 1.0
+    tolerance_deg: float = 1.0  #: movement towards the target that counts as progress
+    deadband_deg: float = 3.0  #: closer than this to the target, an axis needs no moving
     error_limit: int = 3
     stalled: list[bool] = field(default_factory=lambda: [False, False])  #: [azimuth, elevation]
     errors: int = 0  #: backend refusals in a row
@@ -75,7 +77,7 @@ class StallWatch:
         newly = []
         for i in range(axes):
             p = self._progress[i]
-            if abs(sent[i] - position[i]) <= self.tolerance_deg or p.reference is None or p.since is None:
+            if abs(sent[i] - position[i]) <= self.deadband_deg or p.reference is None or p.since is None:
                 self._progress[i] = _Progress(position[i], now)
                 continue
             moved = position[i] - p.reference

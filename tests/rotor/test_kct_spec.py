@@ -209,3 +209,16 @@ def test_function_06_reports_the_segment_in_force_in_repetitive_mode() -> None:
     assert read.images[2] == b"\xff\xff" + struct.pack("<HH", 45, 270) + b"SEG45     " + bytes(7)
     clock.advance(30 * 60)  # minute 1 of the next cycle: the last segment is still in force
     assert driver.get_table(0, 10).in_force == 2
+
+
+def test_a_rotor_resting_just_short_of_its_target_is_not_stalled() -> None:
+    # Real controllers stop a degree or two short; that is arrival, not "stalled & disabled".
+    clock = VirtualClock(T0)
+    rotor = SimulatedRotor(clock, RotorGeometry(), start=(98.0, 30.0))
+    driver = KctDriver(clock, rotor, rotor.geometry, stall_timeout_s=10.0)
+    driver.set_target(30, 100)
+    rotor.az_speed = 0.0  # it will not move the last 2 degrees
+    for _ in range(30):
+        clock.advance(1)
+        driver.service()
+    assert not driver.status().bits & KctStatusBit.AZ_STALLED
