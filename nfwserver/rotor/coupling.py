@@ -39,7 +39,7 @@ from datetime import datetime, timedelta
 from nfwserver.dde.session import TickSample
 from nfwserver.rotor.flip import FLIP_MODES, PassPlan, flip, plan_pass
 from nfwserver.rotor.geometry import unwrap
-from nfwserver.rotor.kct_annunciator import Announcement
+from nfwserver.rotor.kct_annunciator import Announcement, describe
 from nfwserver.rotor.kct_driver import KctDriver
 from nfwserver.tick_worker import TickWorker
 
@@ -114,9 +114,8 @@ class RotorCoupling(TickWorker):
     def _announced(self, item: Announcement) -> None:
         if self.on_event is None:
             return
-        what = {"AOS": "AOS warble", "LOS": "LOS warble", "text": "Morse", "alarm": "ALARM"}.get(item.kind, item.kind)
         try:
-            self.on_event(f"{what} {item.text}".rstrip())
+            self.on_event(describe(item))
         except Exception:
             log.exception("rotor event listener failed")
 

@@ -51,6 +51,13 @@ class Announcement:
     text: str
 
 
+def describe(item: Announcement) -> str:
+    """One line for logs and the console: ``AOS warble``, ``LOS warble (AO-13)``, ``Morse: CQ``, ``ALARM: ...``."""
+    if item.kind in ("AOS", "LOS"):
+        return f"{item.kind} warble" + (f" ({item.text})" if item.text else "")
+    return f"{'Morse' if item.kind == 'text' else item.kind.upper()}: {item.text}"
+
+
 def _recognised(code: int) -> bool:
     ch = chr(code)
     return ch.isascii() and (ch.isalnum() or ch in MORSE_PUNCTUATION)
@@ -103,7 +110,7 @@ class Annunciator:
         if kind == "alarm":
             log.warning("rotor driver: %s", text)
         else:
-            log.info("annunciator: %s%s", kind if kind != "text" else "", f" {text}" if text else " warble")
+            log.info("annunciator: %s", describe(item))
         for listener in list(self.listeners):
             try:
                 listener(item)

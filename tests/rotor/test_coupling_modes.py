@@ -131,3 +131,14 @@ def test_functions_7f_and_7e_at_run_time() -> None:
         coupling.set_flip_mode("sideways")
     with pytest.raises(ValueError):
         RotorCoupling(driver, lambda t: None, lambda t: None, flip_mode="inverted")
+
+
+def test_driver_announcements_reach_the_console_events() -> None:
+    # KCT 10h: "A 0FFh byte will generate the rising warble used for AOS notification."
+    geometry = RotorGeometry.preset("overlap-450")
+    clock, server, rotor, driver, coupling, events = _with_events(ISS_PASS.aos + timedelta(seconds=60), geometry)
+    driver.announce(b"QRV\xff")
+    rotor.az_stalled = True
+    run_virtual(server, clock, 1)
+    assert events[:2] == ["Morse: QRV", "AOS warble"]
+    assert any(e.startswith("ALARM: azimuth rotor stalled") for e in events)
