@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from nfwserver.clock import Clock
 from nfwserver.config.schema import RadioConfig, RotorConfig
+from nfwserver.core.events import Direction
 from nfwserver.core.station_core import StationCore
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.radio.rigctld_backend import RigctldBackend
@@ -37,6 +38,7 @@ def make_rotor(rc: RotorConfig, core: StationCore, clock: Clock) -> RotorCouplin
         driver, tracks.predict, tracks.pass_track, rc.threshold_deg, rc.speed_deg_s, rc.max_lead_s,
         rc.after_los, rc.flip,
         on_position=lambda az, el: core.report_antenna_position(az, el, "rotor"),
+        on_event=lambda text: core.events.add(clock.now(), Direction.INFO, "note", text, client="rotor"),
     )
 
 

@@ -21,8 +21,8 @@ from nfwserver.app.config_watcher import ConfigWatcher
 from nfwserver.app.devices import make_radio, make_rotor
 from nfwserver.app.element_refresher import ElementRefresher
 from nfwserver.app.element_sources import FetchResult, fetch_all
-from nfwserver.app.element_store import ElementStore
 from nfwserver.app.session_state import SessionSaver, SessionState, StateFile
+from nfwserver.app.station_catalog import configured_store, load_station_catalog
 from nfwserver.clock import Clock
 from nfwserver.config.schema import Config
 from nfwserver.core.events import Direction
@@ -55,8 +55,7 @@ class Station:
         srv = config.server
         self.core = StationCore(Catalog(dde_names=config.dde_names), config.observer, clock, horizon=config.horizon,
                                 ut1_utc=srv.ut1_utc_s, rate_hz=srv.rate_hz, channels=config.channels)
-        self.store = ElementStore(None if config.elements.store == "default" else config.elements.store) \
-            if config.elements.store else None
+        self.store = configured_store(config)
         self.state_file = StateFile(None if config.state_file == "default" else config.state_file) \
             if config.state_file else None
         self._given_transport = transport
@@ -156,13 +155,10 @@ class Station:
 
     def _load_catalog(self) -> None:
         """Stored catalog, element files and the bundled sets (no network: URLs come on the refresher)."""
-        cfg = self.config.elements
-        stored = self.store.load() if self.store is not None else []
-        fetched = fetch_all(cfg.files, (), cfg.use_bundled)
+        loaded, fetched = load_station_catalog(self.config)
         self._report(fetched)
         catalog = self.core.state.catalog
-        catalog.update(stored)
-        catalog.update(fetched.sets)
+        catalog.update(sat.elements for sat in loaded)
         self.core.state.catalog_changed()
         if not len(catalog):
             log.warning("no element sets loaded: nothing can be tracked until some are added")

@@ -1,12 +1,23 @@
-"""What a dialect formats: one tick's view of the selected satellite, with its radio channel."""
+"""What a dialect formats: one tick's view of the selected satellite, with its radio channel.
+
+Units: angles degrees (azimuth 0..360 clockwise from north, elevation above the geodetic horizontal),
+range km, range rate km/s (positive receding), frequencies Hz (Doppler-corrected), sub-satellite
+point geodetic WGS84 (longitude east-positive -180..180, altitude km above the ellipsoid).
+Formatters write numbers with Python's formatting, so the decimal point is always ``.`` whatever
+the machine's locale.
+"""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from datetime import datetime, tzinfo
 
 from nfwserver.core.sample import TickSample
 from nfwserver.radio.transponder import Channel
+from nfwserver.tracking.derived import geodetic_from_itrs
+from nfwserver.tracking.timescale import SECONDS_PER_DAY, gmst1982, julian_date
 
 
 @dataclass(frozen=True)
@@ -24,11 +35,35 @@ class DialectView:
     downlink_mode: str | None
     uplink_mode: str | None
     phase: float | None = None  #: mean anomaly in 256ths of an orbit
+    range_km: float | None = None
+    time: datetime | None = None  #: the instant the values are for, aware UTC
+    local_time: datetime | None = None  #: the same instant in the station's local time zone
+    subpoint: tuple[float, float, float] | None = None  #: (latitude, east longitude, altitude km)
+
+
+def sub_satellite_point(satrec: object, when: datetime, ut1_utc: float = 0.0) -> tuple[float, float, float] | None:
+    """(geodetic latitude deg, east longitude deg -180..180, altitude km) under the satellite, or None.
+
+    SGP4's TEME position rotated by Greenwich mean sidereal time (IAU 1982, as SGP4 itself assumes),
+    polar motion neglected (metres).
+    """
+    jd, fr = julian_date(when)
+    err, r, _ = satrec.sgp4(jd, fr)  # type: ignore[attr-defined]
+    if err:
+        return None
+    theta, _ = gmst1982(jd, fr + ut1_utc / SECONDS_PER_DAY)
+    c, s = math.cos(theta), math.sin(theta)
+    lat, lon, alt = geodetic_from_itrs(c * r[0] + s * r[1], -s * r[0] + c * r[1], r[2])
+    return lat, (lon + 180.0) % 360.0 - 180.0, alt
 
 
 def view_from_sample(sample: TickSample, element_name: str, channel: Channel | None,
-                     phase: float | None = None) -> DialectView | None:
-    """The view for a tick, or None when there is no position."""
+                     phase: float | None = None, subpoint: tuple[float, float, float] | None = None,
+                     local_zone: tzinfo | None = None) -> DialectView | None:
+    """The view for a tick, or None when there is no position.
+
+    ``local_zone`` is the station's time zone for local times; None means the machine's own.
+    """
     la = sample.look_angles
     if la is None or sample.dde_name is None:
         return None
@@ -38,15 +73,27 @@ def view_from_sample(sample: TickSample, element_name: str, channel: Channel | N
         rx, tx = int(round(rx_f)), (int(round(tx_f)) if tx_f is not None else None)
     return DialectView(element_name, sample.dde_name, la.azimuth_deg, la.elevation_deg, la.range_rate_km_s,
                        sample.above_horizon, rx, tx, channel.downlink_mode if channel else None,
-                       channel.uplink_mode if channel and channel.uplink_hz else None, phase)
+                       channel.uplink_mode if channel and channel.uplink_hz else None, phase,
+                       la.range_km, sample.time, sample.time.astimezone(local_zone), subpoint)
+
+
+Formatter = Callable[[DialectView | None], str]  #: None: no satellite selected or no position
 
 
 @dataclass(frozen=True)
 class Dialect:
-    """A tracker's DDE names and string format."""
+    """A tracker's DDE names and string formats: ``format`` for every item unless ``item_formats`` names it."""
 
     name: str
     service: str
     topic: str
     items: tuple[str, ...]
-    format: Callable[[DialectView | None], str]  #: None: no satellite selected or no position
+    format: Formatter
+    item_formats: tuple[tuple[str, Formatter], ...] = ()
+
+    def formatter(self, item: str) -> Formatter:
+        """The formatter for ``item`` (compared without regard to case, as DDEML does)."""
+        for name, fmt in self.item_formats:
+            if name.upper() == item.upper():
+                return fmt
+        return self.format

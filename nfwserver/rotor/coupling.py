@@ -2,16 +2,27 @@
 
 On every tick with ``TRACK ON``, :meth:`RotorCoupling.process`:
 
-- at AOS, plans the whole pass once (:func:`nfwserver.rotor.flip.plan_pass`): normal or flipped
-  pointing and the azimuth branch that keeps the pass inside the rotor's range; it never changes
-  the plan mid-pass;
+- at AOS, plans the whole pass once (:func:`nfwserver.rotor.flip.plan_pass`) in the flip mode
+  (``"auto"``, ``"on"``, ``"off"``; :meth:`RotorCoupling.set_flip_mode` changes it at run time and
+  re-plans a pass in progress): normal or flipped pointing and the azimuth branch that keeps the pass
+  inside the rotor's range;
 - while the satellite is up, aims ahead of it by the rotor's travel time (so the antennas are where
-  the satellite will be when they arrive) and sends a new target only when it moved by at least
-  ``threshold_deg`` (relays wear out);
+  the satellite will be when they arrive; never ahead below the horizon) and sends a new target only
+  when it moved by at least ``threshold_deg`` (relays wear out).  A target the rotor cannot reach is
+  ignored by the driver, never clamped; the first one in a pass is reported as an event;
 - after LOS, parks (the driver's parking timer, or at once when the delay is 0) or pre-positions
   to the next pass's AOS, as configured;
 - lets the driver run its clock duties and reads the rotor back, reporting the sky position the
   antennas point at through ``on_position`` (the server's ``report_antenna_position``).
+
+**Table loads stop autotracking** (OrbitDRV: "if OrbitDRV passes through a Table Load (AH=7) call to
+RotorDRV, OrbitDRV disables itself.  The assumption is that if the user is loading KCT tables, he
+doesn't want OrbitDRV to control the antennas anymore.").  Any Add-entry call made while autotracking
+-- accepted or refused by the driver, as OrbitDRV disables itself on passing the call through --
+suspends autotracking: no more targets, no parking, until autotracking is enabled again, by a new
+``TRACK ON`` (a tick with track_on after one without) or :meth:`RotorCoupling.resume`.  The driver
+keeps running its table.  Both changes, and the driver's announcements (AOS/LOS warbles, stall
+alarms), are reported through ``on_event(text)`` for the console and the event log, and logged.
 
 It takes plain callables for the tracking engine, so it does not depend on the DDE core:
 ``predict(when) -> (az, el)`` and ``pass_track(when) -> [(when, az, el), ...]`` for the pass in
@@ -27,16 +38,19 @@ from datetime import datetime, timedelta
 
 from nfwserver.core.sample import TickSample
 from nfwserver.core.tick_worker import TickWorker
-from nfwserver.rotor.flip import PassPlan, flip, plan_pass
+from nfwserver.rotor.flip import FLIP_MODES, PassPlan, flip, plan_pass
 from nfwserver.rotor.geometry import unwrap
+from nfwserver.rotor.kct_annunciator import Announcement, describe
 from nfwserver.rotor.kct_driver import KctDriver
+
+__all__ = ["AFTER_LOS", "FLIP_MODES", "RotorCoupling", "angular_distance", "sky_from_rotor"]
 
 log = logging.getLogger(__name__)
 
 Predict = Callable[[datetime], tuple[float, float] | None]
 PassTrack = Callable[[datetime], Sequence[tuple[datetime, float, float]] | None]
 AFTER_LOS = ("park", "next-aos", "stay")
-FLIP_MODES = ("auto", "off")
+TABLE_LOAD_REASON = "a KCT time/target table entry was loaded (function 7)"
 
 
 def angular_distance(az1: float, el1: float, az2: float, el2: float) -> float:
@@ -60,7 +74,8 @@ class RotorCoupling(TickWorker):
 
     def __init__(self, driver: KctDriver, predict: Predict, pass_track: PassTrack, threshold_deg: float = 2.0,
                  speed_deg_s: float = 6.0, max_lead_s: float = 10.0, after_los: str = "park", flip_mode: str = "auto",
-                 on_position: Callable[[float, float], None] | None = None) -> None:
+                 on_position: Callable[[float, float], None] | None = None,
+                 on_event: Callable[[str], None] | None = None) -> None:
         super().__init__()
         if after_los not in AFTER_LOS or flip_mode not in FLIP_MODES:
             raise ValueError(f"after_los must be one of {AFTER_LOS} and flip_mode one of {FLIP_MODES}")
@@ -75,23 +90,81 @@ class RotorCoupling(TickWorker):
         self.after_los = after_los
         self.flip_mode = flip_mode
         self.on_position = on_position
+        self.on_event = on_event
         self.plan: PassPlan | None = None
-        self.flip_state = False
+        self.flip_state = flip_mode == "on"  #: inverted pointing now (what FlipAnts' 7E reports)
+        self.suspended: str | None = None  #: why autotracking is suspended, or None
         self._sent: tuple[float, float] | None = None  # sky (az, el) of the last target sent
+        self._tracking = False  # autotracking was active on the last tick
+        self._track_on_seen = False
+        self._replan = False
+        self._unreachable_reported = False
+        driver.table_load_listeners.append(self._table_loaded)
+        driver.annunciator.listeners.append(self._announced)
+
+    # -- events and run-time controls ----------------------------------------------------
+    def _event(self, text: str, level: int = logging.INFO) -> None:
+        log.log(level, "rotor: %s", text)
+        if self.on_event is not None:
+            try:
+                self.on_event(text)
+            except Exception:
+                log.exception("rotor event listener failed")
+
+    def _announced(self, item: Announcement) -> None:
+        if self.on_event is None:
+            return
+        try:
+            self.on_event(describe(item))
+        except Exception:
+            log.exception("rotor event listener failed")
+
+    def _table_loaded(self) -> None:
+        if self._tracking and self.suspended is None:
+            self.suspended = TABLE_LOAD_REASON
+            self._tracking = False
+            self._event(f"autotracking disabled: {TABLE_LOAD_REASON}; TRACK ON enables it again", logging.WARNING)
+
+    def resume(self) -> None:
+        """Enable autotracking again after a table load (the console's / TCP ``TRACK ON`` may call this)."""
+        if self.suspended is not None:
+            self.suspended = None
+            self._replan = True
+            self._event("autotracking enabled again")
+
+    def set_flip_mode(self, mode: str) -> None:
+        """``"auto"``, ``"on"`` or ``"off"`` from now on; a pass in progress is re-planned at the next tick."""
+        if mode not in FLIP_MODES:
+            raise ValueError(f"flip mode must be one of {FLIP_MODES}, not {mode!r}")
+        self.flip_mode = mode
+        self._replan = True
+        if mode != "auto":
+            self.flip_state = mode == "on"
+        note = ""
+        if mode == "on" and not self.driver.geometry.can_flip:
+            note = (f"; this rotor's elevation stops at {self.driver.geometry.el_max:g} deg, so inverted targets "
+                    "are out of reach and will be ignored")
+        self._event(f"flip mode {mode}{note}", logging.WARNING if note else logging.INFO)
+
+    def set_flip(self, al: int) -> bool:
+        """FlipAnts function 7F: AL=00 normal, AL=01 inverted; other values are reserved (ignored, False)."""
+        if al not in (0, 1):
+            return False
+        self.set_flip_mode("on" if al == 1 else "off")
+        return True
+
+    def flip_status(self) -> int:
+        """FlipAnts function 7E: 00 if antenna tracking mode is normal, 01 if inverted."""
+        return 1 if self.flip_state else 0
 
     # -- planning --------------------------------------------------------------------------
     def _plan(self, track: Sequence[tuple[datetime, float, float]]) -> PassPlan:
-        geometry = self.driver.geometry
         sky = [(az, el) for _, az, el in track]
         pos = self.driver.rotor_position()
-        current = pos[0] if pos is not None else None
-        if self.flip_mode == "off":
-            plan = plan_pass(type(geometry)(geometry.az_min, geometry.az_max, geometry.el_min,
-                                            min(geometry.el_max, 90.0)), sky, current)
-        else:
-            plan = plan_pass(geometry, sky, current)
+        plan = plan_pass(self.driver.geometry, sky, pos[0] if pos is not None else None, self.flip_mode)
         if not plan.fits:
-            log.warning("this pass does not fit the rotor's range in any mode; following it as far as the stops allow")
+            log.warning("this pass does not fit the rotor's range in flip mode %s; targets beyond the stops "
+                        "will be ignored", self.flip_mode)
         if sky:
             azs = [flip(az, el)[0] if plan.flipped else az for az, el in sky]
             self.driver.set_reference_azimuth(unwrap(azs)[0] + plan.offset_deg if plan.fits else azs[0])
@@ -102,6 +175,7 @@ class RotorCoupling(TickWorker):
         self.plan = self._plan(track)
         self.flip_state = self.plan.flipped
         self._sent = None
+        self._unreachable_reported = False
         self.driver.stop_parking_timer()
         log.info("AOS: pass planned %s", "flipped" if self.plan.flipped else "normal")
 
@@ -118,31 +192,46 @@ class RotorCoupling(TickWorker):
             if track:
                 plan = self._plan(track)
                 _, az, el = track[0]
-                az_k, el_k = flip(az, el) if plan.flipped else (az, max(el, 0.0))
+                el = max(el, 0.0)  # AOS lies on the horizon
+                az_k, el_k = flip(az, el) if plan.flipped else (az, el)
                 self.driver.set_target(el_k, az_k)
 
     # -- per tick --------------------------------------------------------------------------
     def process(self, sample: TickSample) -> None:
         """One tick's work (the worker's step; tests call it directly)."""
+        if sample.tracking and not self._track_on_seen:
+            self.resume()  # a new TRACK ON enables autotracking again
+        self._track_on_seen = sample.tracking
+        self._tracking = sample.tracking and self.suspended is None
         la = sample.look_angles
-        if sample.tracking and la is not None:
+        if self._tracking and la is not None:
             if sample.above_horizon:
-                if self.plan is None:
+                if self.plan is None or self._replan:
+                    self._replan = False
                     self._start_pass(sample.time)
                 az, el = self._aim(sample.time, la.azimuth_deg, la.elevation_deg)
                 if self._sent is None or angular_distance(az, el, *self._sent) >= self.threshold_deg:
-                    az_k, el_k = flip(az, el) if self.plan and self.plan.flipped else (az % 360.0, el)
-                    if self.driver.set_target(el_k, az_k):
-                        self._sent = (az, el)
+                    self._send(az, el)
             elif self.plan is not None:
                 self._end_pass(sample.time)
+        elif not self._tracking:
+            self.plan = None
         self.driver.service()
         pos = self.driver.rotor_position()
         if pos is not None and self.on_position is not None:
             self.on_position(*sky_from_rotor(*pos))
 
+    def _send(self, az: float, el: float) -> None:
+        az_k, el_k = flip(az, el) if self.plan and self.plan.flipped else (az % 360.0, el)
+        if self.driver.set_target(el_k, az_k):
+            self._sent = (az, el)
+        elif not self._unreachable_reported:
+            self._unreachable_reported = True
+            self._event(f"target az {az_k:.1f} el {el_k:.1f} is out of this rotor's reach: ignored, not clamped "
+                        "(the antennas stay where they were)", logging.WARNING)
+
     def _aim(self, when: datetime, az: float, el: float) -> tuple[float, float]:
-        """Where to point: the satellite's position one rotor travel time ahead."""
+        """Where to point: the satellite's position one rotor travel time ahead (never below the horizon)."""
         pos = self.driver.rotor_position()
         if pos is None or self.max_lead_s == 0:
             return az, el
@@ -151,7 +240,9 @@ class RotorCoupling(TickWorker):
         if lead < 0.5:
             return az, el
         ahead = self.predict(when + timedelta(seconds=lead))
-        return ahead if ahead is not None else (az, el)
+        if ahead is None or ahead[1] < 0.0 <= el:
+            return az, el
+        return ahead
 
     def stop(self) -> None:
         super().stop()

@@ -5,10 +5,16 @@ Inverted ("flipped") pointing reaches the sky position (az, el) by turning the a
 would carry a north-stop rotor across its stop (say from 350 to 10 degrees) crosses south in
 the flipped frame instead, so the rotor follows it without the 360-degree swing.
 
-The decision is taken once, at AOS, for the whole pass (switching mid-pass would swing the
-antennas round while the satellite is up): normal pointing if the pass fits the rotor's range,
-flipped if only that fits and the elevation rotor can go past 90 degrees, otherwise normal
-pointing with the track cut at the stop (reported as not fitting).
+The mode is FlipAnts' function 7F (AL=00 normal, AL=01 inverted) or, beyond FlipAnts, ``auto``:
+
+- ``"off"``: normal pointing always;
+- ``"on"``: inverted pointing always, as FlipDRV does once switched on.  On a rotor whose elevation
+  stops at 90 degrees every inverted target is out of reach, and the driver ignores it (FlipAnts
+  caution 1: "Your antennas must be capable of moving 180 degrees in elevation");
+- ``"auto"``: decided once, at AOS, for the whole pass (switching mid-pass would swing the antennas
+  round while the satellite is up): normal pointing if the pass fits the rotor's range, flipped if
+  only that fits and the elevation rotor can go past 90 degrees, otherwise normal pointing as far
+  as the stops allow (reported as not fitting).
 """
 
 from __future__ import annotations
@@ -17,6 +23,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from nfwserver.rotor.geometry import RotorGeometry, fit_track
+
+#: ``[rotor] flip`` values: per pass, forced inverted (FlipAnts 7F AL=01), forced normal (7F AL=00).
+FLIP_MODES = ("auto", "on", "off")
 
 
 def flip(az_deg: float, el_deg: float) -> tuple[float, float]:
@@ -43,21 +52,27 @@ class PassPlan:
             rotor_az = previous_rotor_az + step
             if not geometry.az_min - 1e-9 <= rotor_az <= geometry.az_max + 1e-9:
                 rotor_az = geometry.nearest_rotor_azimuth(az, previous_rotor_az)
-        return rotor_az, geometry.clamp_elevation(el)
+        return rotor_az, el
 
 
 def plan_pass(geometry: RotorGeometry, track: Sequence[tuple[float, float]],
-              current_rotor_az: float | None = None) -> PassPlan:
+              current_rotor_az: float | None = None, mode: str = "auto") -> PassPlan:
     """Choose normal or flipped pointing for a pass given as sky (az, el) samples from AOS to LOS.
 
-    ``current_rotor_az`` (rotor frame) picks, among equivalent azimuth branches, the one closest to
-    where the rotor is, so the move to AOS is shortest.
+    ``mode`` is one of :data:`FLIP_MODES` (module docstring).  ``current_rotor_az`` (rotor frame)
+    picks, among equivalent azimuth branches, the one closest to where the rotor is, so the move to
+    AOS is shortest.
     """
-    normal = fit_track(geometry, [az for az, _ in track], current_rotor_az)
-    if normal is not None:
-        return PassPlan(False, normal, True)
-    if geometry.can_flip:
+    if mode not in FLIP_MODES:
+        raise ValueError(f"flip mode must be one of {FLIP_MODES}, not {mode!r}")
+    if mode != "on":
+        normal = fit_track(geometry, [az for az, _ in track], current_rotor_az)
+        if normal is not None:
+            return PassPlan(False, normal, True)
+    if mode == "on" or (mode == "auto" and geometry.can_flip):
         flipped = fit_track(geometry, [flip(az, el)[0] for az, el in track], current_rotor_az)
-        if flipped is not None:
+        if flipped is not None and geometry.can_flip:
             return PassPlan(True, flipped, True)
+        if mode == "on":
+            return PassPlan(True, flipped or 0.0, False)
     return PassPlan(False, 0.0, False)

@@ -2,59 +2,51 @@
 
 Each service call of the KCT driver document is a method with an English name (the original
 function number is in its docstring).  Angles follow the KCT conventions: azimuth 0..359,
-elevation -90..269 (beyond 90 the antennas are tilted over the top).  A call given an invalid
-value is ignored as a whole, as the original driver did; methods return False in that case.
+elevation -90..269 (beyond 90 the antennas are tilted over the top).
 
-The driver runs on an injected clock: :meth:`KctDriver.service` does what the original did on
-each clock interrupt -- time/target table processing (entries whose time has come become the
-target; entries that expired while waiting are dropped), the parking timer, AOS/LOS
-announcements -- and sends the resulting target to the rotor backend, mapped into the rotor's
-azimuth range continuously from its last position (so a 359 -> 1 step never becomes a 358-degree
-swing on a rotor that can keep turning), with the slew offsets added.
+Invalid and unreachable targets are **ignored, never clamped**.  The document: "If either value is
+invalid the entire command will be ignored."  FlipAnts (caution 2): "Your rotor driver program must
+ignore any angles that your antennas are not physically capable of ... Your driver must know not to
+try to comply."  A target outside -90..269 / 0..359, or one this rotor cannot reach (slew offsets
+added), leaves the previous target and command as they were; the call returns False and one
+rate-limited warning says why.  (Clamped, (el 150, az 280) on a 0..90 elevation rotor would become
+(280, 90): a different direction from the sky position (100, 30) it means.)
+
+:meth:`KctDriver.service` does what the clock interrupt did -- time/target table processing
+(:mod:`~nfwserver.rotor.kct_table_store`), the parking timer, AOS/LOS announcements
+(:mod:`~nfwserver.rotor.kct_annunciator`) -- sends the target mapped into the rotor's azimuth range
+continuously from its last position (a 359 -> 1 step never becomes a 358-degree swing), slew
+added, and reads the rotor back, watching for a stall (:mod:`~nfwserver.rotor.stall`): a stalled
+axis sets status bit 10h (azimuth) or 20h (elevation), is stopped and held ("stalled & has been
+disabled") until the Enable call (function 9, AL=1) re-arms it.  Loading the table (function 7) is
+told to ``table_load_listeners``: autotracking (:mod:`~nfwserver.rotor.coupling`) then lets go.
 """
 
 from __future__ import annotations
 
-import enum
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 
 from nfwserver.clock import Clock
 from nfwserver.rotor.backend import RotorBackend, RotorError, RotorUnavailable
 from nfwserver.rotor.geometry import RotorGeometry
+from nfwserver.rotor.kct_annunciator import Announcement, Annunciator
+from nfwserver.rotor.kct_parking import Parking, ParkingParameters
 from nfwserver.rotor.kct_status import DriverStatus, KctStatusBit
-from nfwserver.rotor.kct_table import MAX_CYCLE_MINUTES, NormalEntry, RepetitiveEntry, TableEntryError, decode_entry
+from nfwserver.rotor.kct_table import NormalEntry, RepetitiveEntry
+from nfwserver.rotor.kct_table_store import ADD_FULL, ADD_INVALID, ADD_OK, TableMode, TableRead, TimeTargetTable
+from nfwserver.rotor.rate_limited_log import RateLimitedLog
+from nfwserver.rotor.stall import AXES, StallReporting, StallWatch
+
+__all__ = ["ADD_FULL", "ADD_INVALID", "ADD_OK", "Announcement", "KctDriver", "ParkingParameters", "TableMode"]
 
 log = logging.getLogger(__name__)
 
-ADD_OK, ADD_INVALID, ADD_FULL = 0, 1, 2
 #: The version number function 0A reports.
 DRIVER_VERSION = 0x0100
 #: A table entry more than this late when reached is dropped instead of executed (seconds).
 STALE_ENTRY_S = 30.0
-
-
-class TableMode(enum.IntEnum):
-    NORMAL = 0
-    REPETITIVE = 1
-
-
-@dataclass(frozen=True)
-class Announcement:
-    """What the original sent in Morse: AOS/LOS warbles and text."""
-
-    time: datetime
-    kind: str  #: "AOS", "LOS" or "text"
-    text: str
-
-
-@dataclass(frozen=True)
-class ParkingParameters:
-    delay_minutes: int  #: 0..60; 0 disables parking
-    azimuth_deg: int  #: 0..359
-    elevation_deg: int  #: 0..90
 
 
 def _valid_target(el: float, az: float) -> bool:
@@ -66,32 +58,40 @@ class KctDriver:
 
     def __init__(self, clock: Clock, backend: RotorBackend, geometry: RotorGeometry | None = None,
                  elevation_installed: bool = True, utc_offset_hours: int = 0, table_capacity: int = 1000,
-                 on_announcement: Callable[[Announcement], None] | None = None) -> None:
+                 on_announcement: Callable[[Announcement], None] | None = None,
+                 stall_timeout_s: float | None = 15.0) -> None:
         self.clock = clock
         self.backend = backend
         self.geometry = geometry or RotorGeometry()
         self.elevation_installed = elevation_installed
         self.utc_offset_hours = utc_offset_hours
-        self.table_capacity = table_capacity
-        self.on_announcement = on_announcement
-        self.announcements: list[Announcement] = []
+        self.table = TimeTargetTable(table_capacity)
+        self.annunciator = Annunciator(clock.now)
+        if on_announcement is not None:
+            self.annunciator.listeners.append(on_announcement)
+        self.stall = StallWatch(timeout_s=stall_timeout_s)
+        self.table_load_listeners: list[Callable[[], None]] = []
+        self._diagnostics = RateLimitedLog(log, clock.monotonic)
         self._slew = (0, 0)  # (el, az)
         self._target: tuple[float, float] | None = None  # (el, az) KCT frame
         self._enabled = True
         self._satellite_id = ""
-        self._mode = TableMode.NORMAL
-        self._cycle_minutes = 0
-        self._cycle_start: datetime | None = None
-        self._table: list[NormalEntry | RepetitiveEntry] = []
         self._processing = True
-        self._parking = ParkingParameters(0, 0, 0)
-        self._park_timer_started: datetime | None = None
+        self.parking = Parking()
         self._rotor_az: float | None = None  # last commanded rotor-frame azimuth (continuity reference)
         self._sent: tuple[float, float] | None = None
         self._card_absent = False
         self._position: tuple[float, float] | None = None  # rotor frame, last read back
-        self._morse_enabled = True
         self._popups = 0
+
+    @property
+    def announcements(self) -> list[Announcement]:
+        """What the annunciator sent, oldest first (bounded)."""
+        return self.annunciator.history
+
+    @property
+    def _axes(self) -> int:
+        return 2 if self.elevation_installed else 1
 
     # -- function 0 ----------------------------------------------------------------------
     def status(self) -> DriverStatus:
@@ -101,6 +101,10 @@ class KctDriver:
             bits |= KctStatusBit.CARD_ABSENT
         if not self._enabled:
             bits |= KctStatusBit.DISABLED
+        if self.stall.stalled[0]:
+            bits |= KctStatusBit.AZ_STALLED
+        if self.stall.stalled[1]:
+            bits |= KctStatusBit.EL_STALLED
         pos = self._position
         if pos is not None and self._sent is not None:
             daz, delev = self._sent[0] - pos[0], self._sent[1] - pos[1]
@@ -138,9 +142,24 @@ class KctDriver:
         tgt_el, tgt_az = self._target if self._target is not None else (None, None)
         return cur_el, cur_az, tgt_el, tgt_az
 
+    def reachable(self, elevation_deg: float, azimuth_deg: float) -> bool:
+        """Whether this rotor can point at the KCT target (el, az) with the current slew offsets."""
+        return _valid_target(elevation_deg, azimuth_deg) and self._command_for(elevation_deg, azimuth_deg) is not None
+
     def set_target(self, elevation_deg: float, azimuth_deg: float) -> bool:
-        """Function 4: point at (el, az); el -90..269, az 0..359 (fractions allowed).  Invalid: ignored."""
+        """Function 4: point at (el, az); el -90..269, az 0..359 (fractions allowed).
+
+        An invalid or unreachable target is ignored as a whole (module docstring); returns False then.
+        """
         if not _valid_target(elevation_deg, azimuth_deg):
+            self._diagnostics.warning("invalid", "set target el %.1f az %.1f: outside el -90..269 / az 0..359; "
+                                      "ignored", elevation_deg, azimuth_deg)
+            return False
+        if self._command_for(elevation_deg, azimuth_deg) is None:
+            self._diagnostics.warning("unreachable", "set target el %.1f az %.1f: this rotor cannot reach it "
+                                      "(az %g..%g, el %g..%g, slew el %+d az %+d); ignored, not clamped",
+                                      elevation_deg, azimuth_deg, self.geometry.az_min, self.geometry.az_max,
+                                      self.geometry.el_min, self.geometry.el_max, *self._slew)
             return False
         self._target = (float(elevation_deg), float(azimuth_deg))
         self._push()
@@ -153,46 +172,34 @@ class KctDriver:
     # -- table functions -----------------------------------------------------------------
     def clear_table(self) -> None:
         """Function 5."""
-        self._table.clear()
+        self.table.clear()
 
-    def get_table(self, first: int, count: int) -> tuple[TableMode, list[NormalEntry | RepetitiveEntry]]:
-        """Function 6: up to ``count`` records from relative record ``first`` (none if out of range)."""
-        if first < 0 or count <= 0 or first >= len(self._table):
-            return self._mode, []
-        return self._mode, list(self._table[first : first + count])
+    def get_table(self, first: int, count: int) -> TableRead:
+        """Function 6: up to ``count`` records from relative record ``first`` as 23-byte images, the mode,
+        and (repetitive mode) the relative number of the entry in force."""
+        return self.table.read(first, count, self.clock.now())
 
     def add_entry(self, entry: NormalEntry | RepetitiveEntry | bytes) -> int:
-        """Function 7: 0 = added, 1 = invalid parameter, 2 = table full."""
-        try:
-            if isinstance(entry, bytes | bytearray):
-                entry = decode_entry(bytes(entry))
-            entry.validate()
-        except TableEntryError:
-            return ADD_INVALID
-        if isinstance(entry, RepetitiveEntry) != (self._mode is TableMode.REPETITIVE):
-            return ADD_INVALID
-        if len(self._table) >= self.table_capacity:
-            return ADD_FULL
-        self._table.append(entry)
-        if isinstance(entry, NormalEntry):
-            self._table.sort(key=lambda e: e.time)  # type: ignore[union-attr]
-        else:
-            self._table.sort(key=lambda e: e.start_minute)  # type: ignore[union-attr]
-        return ADD_OK
+        """Function 7: 0 = added, 1 = invalid parameter, 2 = table full.  Tells ``table_load_listeners``."""
+        result = self.table.add(entry)
+        for listener in list(self.table_load_listeners):
+            try:
+                listener()
+            except Exception:
+                log.exception("table-load listener failed")
+        return result
 
     def driver_time(self) -> datetime:
         """Function 8: the driver's UTC date and time."""
         return self.clock.now().astimezone(timezone.utc)
 
     def enable(self, on: bool) -> None:
-        """Function 9: disable stops movements at once; enable resumes."""
+        """Function 9: disable stops movements at once; enable resumes and re-arms stalled axes."""
         self._enabled = on
         if not on:
-            try:
-                self.backend.stop()
-            except RotorError as exc:
-                log.warning("rotor stop failed: %s", exc)
+            self._stop_rotor()
         else:
+            self.stall.reset()
             self._push(force=True)
 
     @property
@@ -205,23 +212,21 @@ class KctDriver:
 
     def set_table_mode(self, mode: TableMode, cycle_minutes: int = 0) -> bool:
         """Function 0C: normal or repetitive mode (cycle 1..10080 minutes); clears the table."""
-        if mode is TableMode.REPETITIVE and not 1 <= cycle_minutes <= MAX_CYCLE_MINUTES:
-            return False
-        self._mode = mode
-        self._cycle_minutes = cycle_minutes if mode is TableMode.REPETITIVE else 0
-        self._cycle_start = self.clock.now() if mode is TableMode.REPETITIVE else None
-        self._table.clear()
-        return True
+        return self.table.set_mode(mode, cycle_minutes, self.clock.now())
 
     def table_size(self) -> int:
-        """Function 0D: the number of table entries the driver can hold."""
-        return self.table_capacity
+        """Function 0D: the number of entries in the table (see :mod:`nfwserver.rotor.kct_table_store`)."""
+        return len(self.table)
+
+    @property
+    def table_capacity(self) -> int:
+        return self.table.capacity
 
     def table_info(self) -> tuple[TableMode, str | tuple[int, int]]:
         """Function 0E: mode, and the satellite id (normal) or (cycle period, current minute) (repetitive)."""
-        if self._mode is TableMode.REPETITIVE:
-            return self._mode, (self._cycle_minutes, self._cycle_minute())
-        return self._mode, self._satellite_id
+        if self.table.mode is TableMode.REPETITIVE:
+            return self.table.mode, (self.table.cycle_minutes, self.table.cycle_minute(self.clock.now()))
+        return self.table.mode, self._satellite_id
 
     def set_table_processing(self, on: bool) -> bool:
         """Function 0F: enable/disable table processing; returns the previous setting."""
@@ -229,26 +234,21 @@ class KctDriver:
         return previous
 
     def register_popup(self, program_mask: int) -> tuple[bool, int]:
-        """Function 0A: a TSR notes its installation; returns (already loaded, driver version).
-
-        The original reserved this for its own pop-ups; it is kept for completeness.
-        """
-        loaded = bool(self._popups & program_mask)
-        self._popups |= program_mask
+        """Function 0A: a TSR notes its installation; returns (already loaded, driver version)."""
+        loaded, self._popups = bool(self._popups & program_mask), self._popups | program_mask
         return loaded, DRIVER_VERSION
 
-    def announce(self, text: str) -> None:
-        """Function 10: text for the annunciator (0xFF/0xFE characters mean AOS/LOS warbles)."""
-        if self._morse_enabled:
-            self._announce("text", " ".join(text.replace("\xff", " ").replace("\xfe", " ").split()))
+    def announce(self, text: bytes | str) -> list[Announcement]:
+        """Function 10: an ASCIIZ string for the annunciator (rules in :mod:`nfwserver.rotor.kct_annunciator`)."""
+        return self.annunciator.send(text)
 
     def morse_enabled(self) -> bool:
         """Function 11, subfunction FF: is the annunciator enabled?"""
-        return self._morse_enabled
+        return self.annunciator.enabled
 
     def set_morse(self, enabled: bool) -> bool:
         """Function 11, subfunctions 00 (disable, dropping queued text) and 01-FE (enable); returns the prior state."""
-        prior, self._morse_enabled = self._morse_enabled, enabled
+        prior, self.annunciator.enabled = self.annunciator.enabled, enabled
         return prior
 
     def announce_status(self) -> str:
@@ -261,94 +261,60 @@ class KctDriver:
         if tgt_az is not None:
             parts.append(f"TGT {tgt_az:.0f} {tgt_el:.0f}")
         text = " ".join(parts)
-        self._announce("text", text)
+        self.annunciator.emit("text", text)
         return text
 
     def delete_rest_of_pass(self) -> None:
         """Function 13: drop table entries up to and including the end of the current pass."""
-        if not self._table or self._mode is not TableMode.NORMAL:
-            return
-        cut = len(self._table)
-        for i, entry in enumerate(self._table):
-            assert isinstance(entry, NormalEntry)
-            if i > 0 and entry.first_of_pass:  # the next pass starts here: keep it
-                cut = i
-                break
-            if entry.last_of_pass:
-                cut = i + 1
-                break
-        del self._table[:cut]
+        self.table.delete_rest_of_pass()
 
     # -- parking (function 14) -------------------------------------------------------------
     def parking_parameters(self) -> ParkingParameters:
-        return self._parking
+        return self.parking.parameters
 
     def set_parking(self, delay_minutes: int, azimuth_deg: int, elevation_deg: int) -> bool:
-        if not (0 <= delay_minutes <= 60 and 0 <= azimuth_deg <= 359 and 0 <= elevation_deg <= 90):
-            return False
-        self._parking = ParkingParameters(delay_minutes, azimuth_deg, elevation_deg)
-        self._park_timer_started = None
-        return True
+        return self.parking.set(delay_minutes, azimuth_deg, elevation_deg)
 
     def start_parking_timer(self) -> None:
-        if self._parking.delay_minutes > 0:
-            self._park_timer_started = self.clock.now()
+        self.parking.start(self.clock.now())
 
     def stop_parking_timer(self) -> None:
-        self._park_timer_started = None
+        self.parking.stop()
 
     # -- the clock interrupt ---------------------------------------------------------------
-    def _cycle_minute(self) -> int:
-        if self._cycle_start is None or self._cycle_minutes <= 0:
-            return 0
-        elapsed = (self.clock.now() - self._cycle_start).total_seconds() / 60.0
-        return int(elapsed) % self._cycle_minutes
-
-    def _announce(self, kind: str, text: str) -> None:
-        item = Announcement(self.clock.now(), kind, text)
-        self.announcements.append(item)
-        del self.announcements[:-200]
-        if self.on_announcement is not None:
-            try:
-                self.on_announcement(item)
-            except Exception:
-                log.exception("announcement listener failed")
-
     def service(self) -> None:
         """Run what the clock interrupt ran, then read the rotor position back."""
         now = self.clock.now()
-        if self._processing and self._table:
-            if self._mode is TableMode.NORMAL:
-                due: NormalEntry | None = None
-                while self._table and self._table[0].time <= now:  # type: ignore[union-attr]
-                    entry = self._table.pop(0)
-                    assert isinstance(entry, NormalEntry)
-                    if entry.first_of_pass:
-                        self._satellite_id = entry.satellite_id
-                        self._announce("AOS", entry.satellite_id)
-                        self.stop_parking_timer()
-                    if entry.last_of_pass:
-                        self._announce("LOS", entry.satellite_id)
-                        self.start_parking_timer()
-                    if now - entry.time <= timedelta(seconds=STALE_ENTRY_S):
-                        due = entry
-                if due is not None:
-                    self.set_target(due.elevation_deg, due.azimuth_deg)
+        if self._processing and self.table.entries:
+            if self.table.mode is TableMode.NORMAL:
+                self._process_normal(now)
             else:
-                minute = self._cycle_minute()
-                segment = None
-                for entry in self._table:
-                    if isinstance(entry, RepetitiveEntry) and entry.start_minute <= minute:
-                        segment = entry
-                if segment is not None:
+                index = self.table.in_force(now)
+                segment = self.table.entries[index] if index is not None else None
+                if isinstance(segment, RepetitiveEntry):
                     el = self._target[0] if self._target else 0.0
                     if self._target is None or self._target[1] != segment.azimuth_deg:
                         self.set_target(el, segment.azimuth_deg)
-        parking = self._park_timer_started is not None and self._parking.delay_minutes > 0
-        if parking and now - self._park_timer_started >= timedelta(minutes=self._parking.delay_minutes):
-            self._park_timer_started = None
-            self.set_target(self._parking.elevation_deg, self._parking.azimuth_deg)
+        if self.parking.due(now):
+            self.set_target(self.parking.parameters.elevation_deg, self.parking.parameters.azimuth_deg)
         self.read_position()
+
+    def _process_normal(self, now: datetime) -> None:
+        due: NormalEntry | None = None
+        for entry in self.table.pop_due(now):
+            if entry.first_of_pass:
+                self._satellite_id = entry.satellite_id
+                if self.annunciator.enabled:
+                    self.annunciator.emit("AOS", entry.satellite_id)
+                self.stop_parking_timer()
+            if entry.last_of_pass:
+                if self.annunciator.enabled:
+                    self.annunciator.emit("LOS", entry.satellite_id)
+                self.start_parking_timer()
+            if now - entry.time <= timedelta(seconds=STALE_ENTRY_S):
+                due = entry
+        if due is not None:
+            self.set_target(due.elevation_deg, due.azimuth_deg)
 
     def read_position(self) -> tuple[float, float] | None:
         """Read the rotor back (rotor frame); None when it cannot be reached."""
@@ -359,9 +325,15 @@ class KctDriver:
             self._card_absent = True
             return None
         except RotorError as exc:
-            log.warning("rotor position read failed: %s", exc)
+            self._diagnostics.warning("read", "rotor position read failed: %s", exc)
+            self._stalled(self.stall.backend_error(self._axes), f"the rotor refused {self.stall.errors} calls in a row")
             return None
-        if self._sent is None and self._card_absent is False and self._target is not None:
+        self.stall.backend_ok()
+        if isinstance(self.backend, StallReporting):
+            self._stalled(self.stall.reported(self.backend.stalled_axes()), "the rotor reports it")
+        moving = self.stall.observe(self.clock.monotonic(), self._sent, self._position, self._axes)
+        self._stalled(moving, f"no movement toward the target for {self.stall.timeout_s} s")
+        if self._sent is None and self._target is not None:
             self._push(force=True)  # the rotor came back: send the target again
         return self._position
 
@@ -369,18 +341,46 @@ class KctDriver:
         """Last read-back position, rotor frame."""
         return self._position
 
+    def _stalled(self, axes: list[int], why: str) -> None:
+        if not axes:
+            return
+        names = " and ".join(AXES[i] for i in axes)
+        self.annunciator.emit("alarm", f"{names} rotor stalled ({why}); disabled until the driver is enabled again")
+        self._stop_rotor()
+
+    def _stop_rotor(self) -> None:
+        try:
+            self.backend.stop()
+        except RotorError as exc:
+            log.warning("rotor stop failed: %s", exc)
+
+    def _command_for(self, el: float, az: float) -> tuple[float, float] | None:
+        """Rotor-frame (az, el) for a KCT target with the slew added, or None if the rotor cannot reach it."""
+        g = self.geometry
+        rotor_el = el + self._slew[0]
+        sky_az = (az + self._slew[1]) % 360.0
+        if not g.el_min - 1e-9 <= rotor_el <= g.el_max + 1e-9 or not g.rotor_azimuths(sky_az):
+            return None
+        reference = self._rotor_az if self._rotor_az is not None else (self._position[0] if self._position else None)
+        return g.nearest_rotor_azimuth(sky_az, reference), rotor_el
+
     def _push(self, force: bool = False) -> None:
         if self._target is None or not self._enabled:
             return
-        el, az = self._target
-        el = self.geometry.clamp_elevation(el + self._slew[0])
-        reference = self._rotor_az if self._rotor_az is not None else (self._position[0] if self._position else None)
-        rotor_az = self.geometry.nearest_rotor_azimuth((az + self._slew[1]) % 360.0, reference)
-        command = (rotor_az, el)
+        command = self._command_for(*self._target)
+        if command is None:  # the slew offsets moved it out of reach
+            self._diagnostics.warning("slewed", "target with slew el %+d az %+d is out of this rotor's reach; "
+                                      "not sent", *self._slew)
+            return
+        stalled, pos = self.stall.stalled, self._position
+        if all(stalled[: self._axes]) or (any(stalled) and pos is None):
+            return
+        rotor_az, rotor_el = (pos[0] if stalled[0] else command[0]), (pos[1] if stalled[1] else command[1])
+        command = (rotor_az, rotor_el)
         if command == self._sent and not force:
             return
         try:
-            self.backend.set_position(rotor_az, el)
+            self.backend.set_position(rotor_az, rotor_el)
         except RotorUnavailable as exc:
             if not self._card_absent:
                 log.warning("rotor unavailable: %s", exc)
@@ -388,8 +388,10 @@ class KctDriver:
             self._sent = None
             return
         except RotorError as exc:
-            log.error("rotor refused (%.1f, %.1f): %s", rotor_az, el, exc)
+            self._diagnostics.warning("refused", "rotor refused (%.1f, %.1f): %s", rotor_az, rotor_el, exc)
+            self._stalled(self.stall.backend_error(self._axes), f"the rotor refused {self.stall.errors} calls in a row")
             return
+        self.stall.backend_ok()
         self._card_absent = False
         self._sent = command
         self._rotor_az = rotor_az

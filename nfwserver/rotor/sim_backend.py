@@ -2,7 +2,8 @@
 
 Position is computed from the clock when asked (no thread): each axis moves from where it was at
 the last command towards the target at its speed (degrees per second).  Injected faults: a stalled
-axis stops moving (and reports it), an absent card makes every call fail with
+axis stops moving and reports it (:meth:`SimulatedRotor.stalled_axes`); an axis with speed 0 stops
+moving without reporting anything (a jammed rotor with no stall sensing); an absent card makes every call fail with
 :class:`RotorUnavailable`.
 """
 
@@ -54,6 +55,10 @@ class SimulatedRotor:
         self._check()
         self._advance()
         return self._az, self._el
+
+    def stalled_axes(self) -> tuple[bool, bool]:
+        """(azimuth, elevation) stalled: the injected faults, as a controller that senses a stall reports them."""
+        return self.az_stalled, self.el_stalled
 
     @property
     def target(self) -> tuple[float, float]:

@@ -80,3 +80,16 @@ def test_bad_geometries() -> None:
         RotorGeometry(0, 90)
     with pytest.raises(ValueError):
         RotorGeometry.preset("sideways")
+
+
+def test_forced_flip_modes() -> None:
+    track = [(100.0 + 5 * k, 10.0 + 3 * k) for k in range(10)]  # fits any rotor normally
+    assert not plan_pass(RotorGeometry.preset("north-stop+flip"), track, mode="auto").flipped
+    forced = plan_pass(RotorGeometry.preset("north-stop+flip"), track, mode="on")
+    assert forced.flipped and forced.fits
+    no_tilt = plan_pass(RotorGeometry.preset("north-stop"), track, mode="on")
+    assert no_tilt.flipped and not no_tilt.fits  # inverted targets beyond 90 deg: the driver will ignore them
+    across_north = [(300.0 + 10 * k, 10.0 + 4 * k) for k in range(12)]
+    assert not plan_pass(RotorGeometry.preset("north-stop+flip"), across_north, mode="off").flipped
+    with pytest.raises(ValueError):
+        plan_pass(RotorGeometry.preset("north-stop"), track, mode="maybe")

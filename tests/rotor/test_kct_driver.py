@@ -80,7 +80,7 @@ def test_table_runs_on_the_clock_and_drops_expired_entries(rig) -> None:
     assert driver.add_entry(b"\x00" * 23) == ADD_INVALID
     driver.service()
     assert driver.positions()[2:] == (None, None)  # stale entries dropped, nothing executed
-    assert driver.get_table(0, 10)[1] == entries[1:]
+    assert driver.get_table(0, 10).entries() == entries[1:]
     clock.advance(10)
     driver.service()
     assert driver.positions()[2:] == (0.0, 200.0)
@@ -89,7 +89,8 @@ def test_table_runs_on_the_clock_and_drops_expired_entries(rig) -> None:
     driver.service()
     assert driver.positions()[2:] == (0.0, 220.0)  # the 20 s entry was passed over by the 30 s one
     assert [a.kind for a in driver.announcements] == ["AOS", "LOS"]
-    assert driver.get_table(0, 10) == (TableMode.NORMAL, [])
+    read = driver.get_table(0, 10)
+    assert (read.mode, read.count, read.in_force) == (TableMode.NORMAL, 0, None)
 
 
 def test_processing_off_freezes_the_table(rig) -> None:
@@ -98,7 +99,7 @@ def test_processing_off_freezes_the_table(rig) -> None:
     assert driver.set_table_processing(False) is True
     clock.advance(2)
     driver.service()
-    assert len(driver.get_table(0, 5)[1]) == 1
+    assert driver.get_table(0, 5).count == 1
     assert driver.set_table_processing(True) is False
 
 
@@ -111,7 +112,7 @@ def test_delete_rest_of_pass(rig) -> None:
     for e in pass_a + pass_b:
         driver.add_entry(e)
     driver.delete_rest_of_pass()
-    assert driver.get_table(0, 10)[1] == pass_b
+    assert driver.get_table(0, 10).entries() == pass_b
 
 
 def test_repetitive_mode_and_cycle(rig) -> None:
@@ -154,13 +155,12 @@ def test_parking_after_the_delay(rig) -> None:
 def test_announcements_time_and_identifier(rig) -> None:
     clock, _, driver = rig
     heard = []
-    driver.on_announcement = heard.append
-    driver.announce("hello\xff   world")
-    assert heard[0].text == "hello world" and heard[0].time == T0
+    driver.annunciator.listeners.append(heard.append)
+    driver.announce("hello   world")
+    assert heard[0].text == "HELLO WORLD" and heard[0].time == T0
     assert driver.driver_time() == T0
     driver.set_satellite_id("SAUDISAT-1C")
     assert driver.table_info() == (TableMode.NORMAL, "SAUDISAT")
-    assert driver.table_size() == 5
 
 
 def test_annunciator_popups_and_status_in_morse(rig) -> None:

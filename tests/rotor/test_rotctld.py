@@ -30,7 +30,8 @@ def _tracking(daemon: HamlibDaemon, geometry: RotorGeometry, start, **kwargs):
     clock = VirtualClock(start)
     server = StationCore(CATALOG, OBSERVER, clock, satellite=CATNR, rate_hz=5)
     backend = RotctldBackend(clock, geometry, port=daemon.port, timeout_s=0.5)
-    driver = KctDriver(clock, backend, geometry)
+    # The virtual clock runs far faster than the real daemon's rotor turns: no no-movement stall watch.
+    driver = KctDriver(clock, backend, geometry, stall_timeout_s=None)
     tracks = SatelliteTracks(server.state)
     coupling = RotorCoupling(driver, tracks.predict, tracks.pass_track, threshold_deg=2.0, **kwargs)
     server.subscribe(coupling.process)
