@@ -259,15 +259,11 @@ def _channels(setting: Setting, value: Any, base: Path | None) -> dict[int, Chan
     return channels
 
 
-def _optional_text(setting: Setting, value: Any, base: Path | None) -> str:
-    return _text(setting, value, base)
-
-
 CONVERTERS: dict[str, Converter] = {
     "bool": _bool, "int": _int, "number": _number, "choice": _choice, "text": _text, "texts": _texts,
     "choices": _choices, "catnr": _catnr, "catnrs": _catnrs, "host": _host, "networks": _networks,
     "urls": _urls, "file": _file, "files": _files, "store": _store, "location": _location,
-    "points": _points, "names": _names, "channels": _channels, "device": _optional_text,
+    "points": _points, "names": _names, "channels": _channels, "device": _text,
 }
 
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import difflib
 import ipaddress
 import sys
-from dataclasses import fields, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -43,7 +43,6 @@ APP_NAME = "nfwserver"
 #: Config fields holding a section record, by field name.
 _RECORDS = {"elements": ElementsConfig, "server": ServerConfig, "radio": RadioConfig, "rotor": RotorConfig,
             "dialects": DialectsConfig, "tcp": TcpConfig, "easycomm": EasyCommConfig}
-_RECORD_FIELDS = {name: {f.name for f in fields(cls)} for name, cls in _RECORDS.items()}
 
 
 class ConfigError(ValueError):
@@ -164,8 +163,7 @@ class _Reading:
         if "radio" not in self.dirty and step is not None and knob is not None and knob < step:
             self.problems.append(f"[radio] knob_tolerance_hz: {knob:g} must be at least step_hz ({step:g})")
         if ("easycomm" not in self.dirty and self.get("easycomm", "enabled")
-                and not self.given("easycomm", "device")
-                and not any(p.startswith("[easycomm] device") for p in self.problems)):
+                and ("easycomm", "device") not in self.present):
             self.problems.append("[easycomm] device: required when enabled (e.g. \"/dev/ttyUSB0\")")
 
     def warnings(self, config: Config) -> tuple[str, ...]:
