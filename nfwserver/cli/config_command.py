@@ -31,33 +31,37 @@ def run_path(args: argparse.Namespace) -> int:
 def run_init(args: argparse.Namespace) -> int:
     from nfwserver.cli import CliError
     from nfwserver.config import default_config_path
-    from nfwserver.config.loader import TEMPLATE
+    from nfwserver.config.render import template
     from nfwserver.storage import atomic_write_text
 
     path = Path(args.config) if args.config else default_config_path()
     if path.exists() and not args.force:
         raise CliError(f"{path} already exists (use --force to overwrite)")
-    atomic_write_text(path, TEMPLATE)
+    atomic_write_text(path, template())
     print(path)
     return 0
 
 
 def run_show(args: argparse.Namespace) -> int:
+    """Every key with its effective value; "default" stores resolved to the paths actually used."""
+    from nfwserver.app.element_store import default_store_path
+    from nfwserver.app.session_state import default_state_path
     from nfwserver.cli import CliError
     from nfwserver.config import ConfigError, load_config
+    from nfwserver.config.render import show
 
     try:
         config = load_config(args.config)
     except ConfigError as exc:
         raise CliError(f"configuration refused: {exc}") from None
-    out = sys.stdout
-    out.write(f"source: {config.source}\n")
-    out.write(f"observer: {config.observer}{'' if config.observer_configured else ' (default)'}\n")
-    out.write(f"horizon: {config.horizon.points or 'flat 0 deg'}\n")
-    out.write(f"elements: bundled={config.elements.use_bundled} files={list(config.elements.files)} "
-              f"urls={list(config.elements.urls)} refresh_hours={config.elements.refresh_hours:g}\n")
-    s = config.server
-    out.write(f"server: rate {s.rate_hz:g} Hz, services {list(s.services)}, topic {s.topic}, items {list(s.items)}, "
-              f"satellite {s.satellite}, UT1-UTC {s.ut1_utc_s:g} s\n")
-    out.write(f"DDE names: {config.dde_names or 'derived'}; favourites: {list(config.favourites)}\n")
+    notes = {}
+    if config.elements.store == "default":
+        notes["elements.store"] = f"default: {default_store_path()}"
+    elif config.elements.store is None:
+        notes["elements.store"] = "no stored catalog"
+    if config.state_file == "default":
+        notes["server.state_file"] = f"default: {default_state_path()}"
+    elif config.state_file is None:
+        notes["server.state_file"] = "not kept"
+    sys.stdout.write(show(config, notes))
     return 0

@@ -1,9 +1,15 @@
-"""The validated configuration, as plain records (units in the field names)."""
+"""The validated configuration, as plain records (units in the field names).
+
+Every default comes from the configuration table (:mod:`nfwserver.config.table`) through
+:func:`~nfwserver.config.table.default`; ``Config()`` is exactly what an empty file means.
+"""
 
 from __future__ import annotations
 
+import ipaddress
 from dataclasses import dataclass, field
 
+from nfwserver.config.table import default
 from nfwserver.radio.transponder import Channel
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer
@@ -14,56 +20,91 @@ DEFAULT_OBSERVER = Observer(51.4779, -0.0015, 46.0)
 
 @dataclass(frozen=True)
 class ElementsConfig:
-    files: tuple[str, ...] = ()  #: element files, read at start and on every refresh
-    urls: tuple[str, ...] = ()  #: element URLs (http/https)
-    refresh_hours: float = 24.0  #: 0 disables the periodic refresh
-    use_bundled: bool = True  #: include the bundled amateur and weather satellites
-    store: str | None = "default"  #: stored catalog file (``elements update``); "default": user data dir; None: off
+    files: tuple[str, ...] = default("elements", "files")  #: element files, read at start and on every refresh
+    urls: tuple[str, ...] = default("elements", "urls")  #: element URLs (http/https)
+    refresh_hours: float = default("elements", "refresh_hours")  #: 0 disables the periodic refresh
+    use_bundled: bool = default("elements", "use_bundled")  #: include the bundled amateur and weather satellites
+    #: stored catalog file (``elements update``); "default": user data dir; None: off
+    store: str | None = default("elements", "store")
 
 
 @dataclass(frozen=True)
 class ServerConfig:
-    rate_hz: float = 5.0
-    services: tuple[str, ...] = ("NFW32", "NFW_SERVER")
-    topic: str = "NFW_DATA"
-    items: tuple[str, ...] = ("NFW_SERVER", "NFW_DATA")
-    satellite: int | None = 25544  #: AutoTracking satellite at start (catalog number)
-    ut1_utc_s: float = 0.0
+    rate_hz: float = default("server", "rate_hz")
+    services: tuple[str, ...] = default("server", "services")
+    topic: str = default("server", "topic")
+    items: tuple[str, ...] = default("server", "items")
+    satellite: int | None = default("server", "satellite")  #: AutoTracking satellite at start (catalog number)
+    ut1_utc_s: float = default("server", "ut1_utc_s")
+    tune: bool = default("server", "tune")  #: DDE output on at start (as a ``TUNE ON`` poke)
+    track: bool = default("server", "track")  #: autotracking on at start (as a ``TRACK ON`` poke)
 
 
 @dataclass(frozen=True)
 class RadioConfig:
-    backend: str = "none"  #: "none" or "rigctld"
-    host: str = "127.0.0.1"
-    port: int = 4532
-    step_hz: float = 10.0
-    knob_tolerance_hz: float = 100.0
-    enabled: bool = False  #: Doppler tuning on at start (switchable at run time)
+    backend: str = default("radio", "backend")  #: "none" or "rigctld"
+    host: str = default("radio", "host")
+    port: int = default("radio", "port")
+    step_hz: float = default("radio", "step_hz")
+    knob_tolerance_hz: float = default("radio", "knob_tolerance_hz")
+    enabled: bool = default("radio", "enabled")  #: Doppler tuning on at start (switchable at run time)
 
 
 @dataclass(frozen=True)
 class RotorConfig:
-    backend: str = "none"  #: "none", "sim" or "rotctld"
-    host: str = "127.0.0.1"
-    port: int = 4533
-    geometry: str = "north-stop"  #: a RotorGeometry preset, optionally "+flip"
-    threshold_deg: float = 2.0
-    speed_deg_s: float = 6.0
-    max_lead_s: float = 10.0
-    after_los: str = "park"  #: "park", "next-aos" or "stay"
-    flip: str = "auto"  #: "auto" or "off"
-    park_azimuth_deg: int = 0
-    park_elevation_deg: int = 0
-    park_delay_minutes: int = 0
+    backend: str = default("rotor", "backend")  #: "none", "sim" or "rotctld"
+    host: str = default("rotor", "host")
+    port: int = default("rotor", "port")
+    geometry: str = default("rotor", "geometry")  #: a RotorGeometry preset, optionally "+flip"
+    threshold_deg: float = default("rotor", "threshold_deg")
+    speed_deg_s: float = default("rotor", "speed_deg_s")
+    max_lead_s: float = default("rotor", "max_lead_s")
+    after_los: str = default("rotor", "after_los")  #: "park", "next-aos" or "stay"
+    flip: str = default("rotor", "flip")  #: "auto", "on" (always inverted) or "off" (never)
+    park_azimuth_deg: int = default("rotor", "park_azimuth_deg")
+    park_elevation_deg: int = default("rotor", "park_elevation_deg")
+    park_delay_minutes: int = default("rotor", "park_delay_minutes")
 
 
 @dataclass(frozen=True)
 class DialectsConfig:
-    dde: tuple[str, ...] = ()  #: other trackers' DDE interfaces to serve: "orbitron", "wxtrack", "satpc32"
-    predict_udp: bool = False  #: PREDICT's UDP protocol
-    predict_host: str = "127.0.0.1"
-    predict_port: int = 1210
-    callsign: str = "NFWSERVER"
+    dde: tuple[str, ...] = default("dialects", "dde")  #: "orbitron", "wxtrack", "satpc32"
+    predict_udp: bool = default("dialects", "predict_udp")  #: PREDICT's UDP protocol
+    predict_host: str = default("dialects", "predict_host")
+    predict_port: int = default("dialects", "predict_port")
+    callsign: str = default("dialects", "callsign")
+
+
+@dataclass(frozen=True)
+class TcpConfig:
+    """Nova's TCP server."""
+
+    enabled: bool = default("tcp", "enabled")
+    host: str = default("tcp", "host")  #: address listened on
+    port: int = default("tcp", "port")
+    #: networks allowed to connect, normalised by :mod:`ipaddress` ("127.0.0.1/32", "10.0.0.0/8", "::1/128")
+    allow: tuple[str, ...] = default("tcp", "allow")
+
+    def allows(self, address: str) -> bool:
+        """True when the peer ``address`` (an IP address string) lies in one of the ``allow`` networks."""
+        try:
+            ip = ipaddress.ip_address(address.split("%", 1)[0])
+        except ValueError:
+            return False
+        if isinstance(ip, ipaddress.IPv6Address) and ip.ipv4_mapped is not None:
+            ip = ip.ipv4_mapped
+        return any(ip in ipaddress.ip_network(net) for net in self.allow)
+
+
+@dataclass(frozen=True)
+class EasyCommConfig:
+    """EasyComm I serial output."""
+
+    enabled: bool = default("easycomm", "enabled")
+    device: str | None = default("easycomm", "device")  #: e.g. "/dev/ttyUSB0"; always set when enabled
+    baud: int = default("easycomm", "baud")
+    rate_hz: float = default("easycomm", "rate_hz")  #: lines per second
+    uplink: str = default("easycomm", "uplink")  #: "range-rate" (Nova) or "doppler"
 
 
 @dataclass(frozen=True)
@@ -73,11 +114,19 @@ class Config:
     horizon: HorizonTable = field(default_factory=HorizonTable)
     elements: ElementsConfig = field(default_factory=ElementsConfig)
     server: ServerConfig = field(default_factory=ServerConfig)
-    dde_names: dict[int, str] = field(default_factory=dict)  #: catalog number -> DDE name override
-    favourites: tuple[int, ...] = ()  #: satellites whose passes the console lists
+    dde_names: dict[int, str] = field(default_factory=lambda: default("satellites", "names"))
+    favourites: tuple[int, ...] = default("satellites", "favourites")  #: satellites whose passes the console lists
     radio: RadioConfig = field(default_factory=RadioConfig)
     rotor: RotorConfig = field(default_factory=RotorConfig)
     dialects: DialectsConfig = field(default_factory=DialectsConfig)
-    state_file: str | None = "default"  #: session state file; "default": user state dir; None: not kept
-    channels: dict[int, Channel] = field(default_factory=dict)  #: catalog number -> radio channel
-    source: str = "<built-in defaults>"
+    #: session state file; "default": user state dir; None: not kept
+    state_file: str | None = default("server", "state_file")
+    #: catalog number -> radio channel (the built-in ones plus the configured ones)
+    channels: dict[int, Channel] = field(default_factory=lambda: default("satellites", "channels"))
+    source: str = "<built-in defaults>"  #: the file read, or "<built-in defaults>" / "<config>"
+    tcp: TcpConfig = field(default_factory=TcpConfig)
+    easycomm: EasyCommConfig = field(default_factory=EasyCommConfig)
+    horizon_file: str | None = None  #: the horizon file read, if the horizon came from one
+    path: str | None = None  #: the configuration file actually read; None when none was
+    #: accepted but worth saying at start (e.g. a listener reachable from other hosts); the caller logs them
+    warnings: tuple[str, ...] = ()
