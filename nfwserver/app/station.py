@@ -190,9 +190,9 @@ class Station:
                      srv.satellite, saved.satellite)
         if choice is not None and not self.core.select_satellite(choice, source="config"):
             log.warning("configured satellite %s is not in the loaded elements", choice)
-        if getattr(srv, "tune", False):
+        if srv.tune:
             self.core.set_tune(True, source="config")
-        if getattr(srv, "track", False):
+        if srv.track:
             self.core.set_track(True, source="config")
         if self.config.radio.enabled:
             self.core.set_radio_tuning(True, source="config")
@@ -202,6 +202,8 @@ class Station:
         """Load, bind and start everything; raises OSError when a listener cannot bind (nothing keeps running)."""
         if self._started:
             return
+        for warning in self.config.warnings:
+            log.warning("%s", warning)
         self._load_catalog()
         self._restore_session()
         if self.predict is not None:
