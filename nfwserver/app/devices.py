@@ -38,8 +38,13 @@ def make_rotor(rc: RotorConfig, core: StationCore, clock: Clock) -> RotorCouplin
         driver, tracks.predict, tracks.pass_track, rc.threshold_deg, rc.speed_deg_s, rc.max_lead_s,
         rc.after_los, rc.flip,
         on_position=lambda az, el: core.report_antenna_position(az, el, "rotor"),
-        on_event=lambda text: core.events.add(clock.now(), Direction.INFO, "note", text, client="rotor"),
+        on_event=lambda text: _note(core, text),
     )
+
+
+def _note(core: StationCore, text: str) -> None:
+    """A rotor event (announcement, stall, refused target) in the station's event stream."""
+    core.events.add(core.clock.now(), Direction.INFO, "note", text, client="rotor")
 
 
 def make_radio(rc: RadioConfig, core: StationCore, clock: Clock) -> RadioCoupling | None:

@@ -2,7 +2,7 @@
 
 Each command module exposes ``register(subparsers)``, which adds its sub-parser and sets
 ``func`` (a callable taking the parsed namespace and returning the exit code) as a default.
-Conventions (DESIGN.md §9): data on stdout, diagnostics on stderr; exit 0 on success, 2 for
+Conventions (README, "Command line"): data on stdout, diagnostics on stderr; exit 0 on success, 2 for
 usage errors, 1 for runtime errors, with one clear sentence and no traceback for bad input.
 """
 

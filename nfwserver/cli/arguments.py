@@ -1,6 +1,6 @@
 """Argument-list helpers and ``type=`` callables shared by the command modules.
 
-A bad argument *value* is a usage error (exit 2, DESIGN.md §9): every callable here raises
+A bad argument *value* is a usage error (exit 2, as the README says): every callable here raises
 :class:`argparse.ArgumentTypeError` with one sentence, which argparse prints after the usage line.
 """
 

@@ -151,6 +151,8 @@ def run_passes(args: argparse.Namespace) -> int:
     write, flush = _writer(args.format, PASS_COLUMNS)
     for p in passes:
         sat = inputs.catalog.get(p.catalog_number)
+        if sat is None:  # passes are only found for catalog satellites
+            continue
         write([str(p.catalog_number), sat.name or sat.dde_name,
                format_time(p.aos) if p.aos else "", format_time(p.tca), format_time(p.los) if p.los else "",
                _num(p.max_elevation_deg, 1, args.format), _num(p.aos_azimuth_deg, 1, args.format),

@@ -1,6 +1,6 @@
 """Options shared by every command that computes positions: configuration, elements, observer, horizon.
 
-Every option defaults to the configured station (DESIGN.md §9): the observer and horizon from the
+Every option defaults to the configured station (README, "Command line"): the observer and horizon from the
 configuration (``--config FILE``, else the user's file, else the built-in defaults) and the same
 catalog ``nfwserver run`` tracks (:func:`nfwserver.app.station_catalog.load_station_catalog`).
 Flags only override.  The configured horizon table describes the obstructions around the

@@ -152,6 +152,7 @@ class Tracker:
         sat, calc = snap.satellite, self._calculator_for(snap)
         if sat is None or calc is None:
             return None, ArithmeticErrorCode.NONE
+        reason: Exception
         try:
             return calc.compute(sat.satrec, when), ArithmeticErrorCode.NONE
         except PropagationError as exc:

@@ -10,7 +10,7 @@ loops:
 - every tick that published a string posts an advise on each served item;
 - pokes and executes are Nova commands, handed to :meth:`StationCore.command`.
 
-Names served (DESIGN.md §3): services ``NFW32`` and ``NFW_SERVER``, topic ``NFW_DATA``, items
+Names served (docs/COMPATIBILITY.md): services ``NFW32`` and ``NFW_SERVER``, topic ``NFW_DATA``, items
 ``NFW_SERVER`` and ``NFW_DATA``; compared case-insensitively; configurable.
 
 Threading: transport callbacks arrive on the transport's thread, ticks on the publisher's.  The

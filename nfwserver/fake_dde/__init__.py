@@ -1,4 +1,9 @@
-"""An in-process DDEML: the DDE transport for Linux, for tests, and for checking your own client logic.
+"""An in-process DDEML: the production DDE transport on Linux (and anywhere without Windows DDE),
+the stand-in for Windows DDEML in tests, and a way to check your own client logic.
+
+It lives in its own package (the layout the project's owner asked for), but it is not test-only code:
+``nfwserver run`` serves on it whenever real DDEML is unavailable, and the console and
+``nfwserver simulate`` are its clients.
 
 It keeps DDEML's rules so code that works here works against Windows DDE:
 
@@ -20,7 +25,8 @@ It keeps DDEML's rules so code that works here works against Windows DDE:
 Example::
 
     system = FakeDdeSystem()
-    server = NovaServer(..., transport=system.server_transport())
+    core = StationCore(catalog, observer, clock, satellite=25544)
+    NovaDdeService(core).attach(system.server_transport())
     conv = system.connect("NFW32", "NFW_DATA")
     conv.poke("NFW_SERVER", "TUNE ON")
     conv.start_advise("NFW_SERVER")          # hot link

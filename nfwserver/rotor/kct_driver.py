@@ -375,7 +375,8 @@ class KctDriver:
         stalled, pos = self.stall.stalled, self._position
         if all(stalled[: self._axes]) or (any(stalled) and pos is None):
             return
-        rotor_az, rotor_el = (pos[0] if stalled[0] else command[0]), (pos[1] if stalled[1] else command[1])
+        rotor_az = pos[0] if stalled[0] and pos is not None else command[0]
+        rotor_el = pos[1] if stalled[1] and pos is not None else command[1]
         command = (rotor_az, rotor_el)
         if command == self._sent and not force:
             return
