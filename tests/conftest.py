@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import http.server
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -60,3 +62,22 @@ def advance_until(clock, predicate, step_s: float = 0.2, limit_s: float = 600.0,
         advanced += step_s
         time.sleep(0.002)
     return True
+
+
+@pytest.fixture
+def http_server() -> Iterator[str]:
+    """Serves tests/data and a garbage file on 127.0.0.1 (ephemeral port)."""
+
+    class Handler(http.server.SimpleHTTPRequestHandler):
+        def __init__(self, *a, **k):
+            super().__init__(*a, directory=str(DATA), **k)
+
+        def log_message(self, *args):  # keep test output clean
+            pass
+
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    yield f"http://127.0.0.1:{server.server_address[1]}"
+    server.shutdown()
+    server.server_close()

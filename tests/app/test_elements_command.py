@@ -12,7 +12,6 @@ from nfwserver.app.element_store import ElementStore
 from nfwserver.cli import main
 from nfwserver.tracking.elements import ElementSet, load_element_file
 from nfwserver.tracking.tle import parse_tle
-from tests.app.test_station import http_server  # noqa: F401  (fixture)
 from tests.conftest import DATA
 
 

@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import http.server
-import threading
-from collections.abc import Iterator
 from datetime import datetime, timezone
 
 import pytest
@@ -17,25 +14,6 @@ from nfwserver.config import parse_config
 from nfwserver.config.schema import Config
 from nfwserver.fake_dde import FakeDdeSystem
 from tests.conftest import DATA
-
-
-@pytest.fixture
-def http_server() -> Iterator[str]:
-    """Serves tests/data and a garbage file on 127.0.0.1 (ephemeral port)."""
-
-    class Handler(http.server.SimpleHTTPRequestHandler):
-        def __init__(self, *a, **k):
-            super().__init__(*a, directory=str(DATA), **k)
-
-        def log_message(self, *args):  # keep test output clean
-            pass
-
-    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Handler)
-    thread = threading.Thread(target=server.serve_forever, daemon=True)
-    thread.start()
-    yield f"http://127.0.0.1:{server.server_address[1]}"
-    server.shutdown()
-    server.server_close()
 
 
 def test_bundled_elements_hold_the_popular_satellites() -> None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 
@@ -21,6 +22,8 @@ from nfwserver.tracking.passes import find_passes
 from tests.conftest import DATA
 
 ISS = 25544
+#: Nova's string as the spec describes it (name, AZ one decimal, EL signed, RR ten decimals, AH Y/N).
+NOVA = re.compile(r"^(\S{1,12}) AZ:(\d{1,3}\.\d) EL:(-?\d{1,2}\.\d) RR:(-?\d+\.\d{10}) AH:([YN])$")
 OBSERVER = Observer(52.2053, 0.1218, 20.0)
 CATALOG = Catalog(load_element_file(DATA / "visual.txt").sets)
 DAY = datetime(2026, 5, 8, tzinfo=timezone.utc)

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import re
-
 import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
@@ -12,9 +10,7 @@ from nfwserver.core.events import Direction
 from nfwserver.core.nova_protocol import PokeError, parse_poke
 from nfwserver.dde.clipboard import CF_TEXT, CF_UNICODETEXT
 from nfwserver.fake_dde import DMLERR_NOTPROCESSED, DdeError
-from tests.dde.conftest import ISS, make_station
-
-NOVA = re.compile(r"^(\S{1,12}) AZ:(\d{1,3}\.\d) EL:(-?\d{1,2}\.\d) RR:(-?\d+\.\d{10}) AH:([YN])$")
+from tests.dde.conftest import ISS, NOVA, make_station
 
 
 def test_wisp_style_polling_client_repokes_tune_on_until_data_flows(station) -> None:

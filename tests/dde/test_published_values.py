@@ -8,8 +8,7 @@ import numpy as np
 
 from nfwserver.core.sample import TickSample
 from nfwserver.tracking.horizon import HorizonTable
-from tests.dde.conftest import CATALOG, ISS, ISS_PASS, OBSERVER, make_station
-from tests.dde.test_clients import NOVA
+from tests.dde.conftest import CATALOG, ISS, ISS_PASS, NOVA, OBSERVER, make_station
 from tests.tracking.skyfield_oracle import skyfield_look_angles
 
 HORIZON = HorizonTable([(0, 10), (90, 25), (180, 5), (270, 15)])

@@ -11,12 +11,12 @@ from nfwserver.rotor.coupling import RotorCoupling
 from nfwserver.rotor.geometry import RotorGeometry
 from nfwserver.rotor.kct_table import NormalEntry
 from tests.dde.conftest import ISS_PASS
-from tests.rotor.test_autotracking import _pass_crossing_north, _station
+from tests.rotor.conftest import pass_crossing_north, rotor_station
 
 
 def _with_events(start, geometry, **kwargs):
     events: list[str] = []
-    clock, server, rotor, driver, coupling, _ = _station(start, geometry, on_event=events.append, **kwargs)
+    clock, server, rotor, driver, coupling, _ = rotor_station(start, geometry, on_event=events.append, **kwargs)
     return clock, server, rotor, driver, coupling, events
 
 
@@ -91,7 +91,7 @@ def test_flip_on_inverts_every_target_even_when_the_pass_fits_normally() -> None
 
 
 def test_flip_off_never_inverts_even_where_auto_would() -> None:
-    catnr, crossing = _pass_crossing_north()
+    catnr, crossing = pass_crossing_north()
     geometry = RotorGeometry.preset("north-stop+flip")
     clock, server, rotor, driver, coupling, _ = _with_events(crossing.aos - timedelta(seconds=30), geometry,
                                                              satellite=catnr, flip_mode="off", after_los="stay")

@@ -20,10 +20,10 @@ from nfwserver.rotor.rotctld_backend import RotctldBackend
 from nfwserver.rotor.tracks import SatelliteTracks
 from tests.dde.conftest import CATALOG, OBSERVER, state_for
 from tests.hamlib_daemons import HamlibDaemon
-from tests.rotor.test_autotracking import _pass_crossing_north
+from tests.rotor.conftest import pass_crossing_north
 
 pytestmark = pytest.mark.hamlib
-CATNR, CROSSING = _pass_crossing_north()
+CATNR, CROSSING = pass_crossing_north()
 
 
 def _tracking(daemon: HamlibDaemon, geometry: RotorGeometry, start, **kwargs):
