@@ -6,6 +6,7 @@ still load, so a dead web site never stops the server.
 
 from __future__ import annotations
 
+import http.client
 import logging
 import urllib.error
 import urllib.request
@@ -35,12 +36,16 @@ def bundled_elements() -> FetchResult:
 
 
 def fetch_url(url: str, timeout_s: float = 20.0) -> bytes:
-    """GET ``url`` (http/https only); raises OSError/ValueError with a clear message."""
+    """GET ``url`` (http/https only); raises OSError/ValueError (or, for a broken HTTP reply,
+    ``http.client.HTTPException``) with a clear message."""
     if not url.lower().startswith(("http://", "https://")):
         raise ValueError(f"{url!r} is not an http(s) URL")
     request = urllib.request.Request(url, headers={"User-Agent": "nfwserver"})
     with urllib.request.urlopen(request, timeout=timeout_s) as response:  # noqa: S310 - scheme checked above
         data = response.read(MAX_DOWNLOAD_BYTES + 1)
+        missing = getattr(response, "length", None)
+    if len(data) <= MAX_DOWNLOAD_BYTES and missing:
+        raise OSError(f"the connection closed {missing} bytes before the announced end")
     if len(data) > MAX_DOWNLOAD_BYTES:
         raise ValueError(f"{url} is larger than {MAX_DOWNLOAD_BYTES // 2**20} MiB")
     return data
@@ -59,9 +64,10 @@ def fetch_all(files: tuple[str, ...] = (), urls: tuple[str, ...] = (), use_bundl
     for url in urls:
         try:
             data = fetch_url(url, timeout_s)
-        except (OSError, ValueError, urllib.error.URLError) as exc:
-            result.failed.append(f"{url}: {exc}")
-            log.warning("cannot fetch elements from %s: %s", url, exc)
+        except (OSError, ValueError, urllib.error.URLError, http.client.HTTPException) as exc:
+            why = repr(str(exc) or type(exc).__name__)[1:-1]  # one line, whatever the server sent
+            result.failed.append(f"{url}: {why}")
+            log.warning("cannot fetch elements from %s: %s", url, why)
             continue
         loaded = load_elements(data, source=url)
         result.sets += loaded.sets
