@@ -1,11 +1,14 @@
 """Radio backend for Hamlib's ``rigctld``: receive on VFO A (``F``/``f``), transmit on the split VFO (``I``/``i``).
 
 Frequencies are validated here (100 kHz .. 300 GHz, integers) because the dummy rig and some
-real ones accept anything.  Connection handling, timeouts and back-off are
+real ones accept anything; frequencies read back are checked the same way, and a bad one counts
+as a device fault.  Connection handling, timeouts and back-off are
 :class:`nfwserver.hamlib.connection.HamlibConnection`'s.
 """
 
 from __future__ import annotations
+
+import math
 
 from nfwserver.clock import Clock
 from nfwserver.hamlib.connection import HamlibConnection, HamlibError, HamlibUnavailable
@@ -37,11 +40,16 @@ class RigctldBackend:
             raise RadioError(str(exc)) from None
 
     def _get_hz(self, command: str) -> int:
+        """A frequency read back (Hz); non-finite or outside 100 kHz..300 GHz is a device fault."""
         (line,) = self._do(command, 1)
         try:
-            return int(float(line))
+            value = float(line)
         except ValueError:
-            raise RadioError(f"rigctld answered {line!r} to '{command}'") from None
+            value = math.nan
+        if not MIN_FREQUENCY_HZ <= value <= MAX_FREQUENCY_HZ:
+            raise RadioError(str(self.connection.fault(f"{line[:20]!r} to '{command}' is not a frequency "
+                                                       "within 100 kHz..300 GHz")))
+        return int(value)
 
     def set_rx_frequency(self, hz: int) -> None:
         self._do(f"F {_check_hz(hz)}")

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 
 from nfwserver.clock import Clock
+from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.rotor.backend import RotorBackend, RotorError, RotorUnavailable
 from nfwserver.rotor.geometry import RotorGeometry
 from nfwserver.rotor.kct_status import DriverStatus, KctStatusBit
@@ -75,6 +76,7 @@ class KctDriver:
         self.table_capacity = table_capacity
         self.on_announcement = on_announcement
         self.announcements: list[Announcement] = []
+        self.warnings = RateLimitedLog(log, clock)  #: repeated device warnings: first, then a count a minute
         self._slew = (0, 0)  # (el, az)
         self._target: tuple[float, float] | None = None  # (el, az) KCT frame
         self._enabled = True
@@ -191,7 +193,7 @@ class KctDriver:
             try:
                 self.backend.stop()
             except RotorError as exc:
-                log.warning("rotor stop failed: %s", exc)
+                self.warnings.warning("rotor stop failed", "rotor stop failed: %s", exc)
         else:
             self._push(force=True)
 
@@ -355,11 +357,12 @@ class KctDriver:
         try:
             self._position = self.backend.get_position()
             self._card_absent = False
+            self.warnings.clear("rotor position read failed")
         except RotorUnavailable:
             self._card_absent = True
             return None
         except RotorError as exc:
-            log.warning("rotor position read failed: %s", exc)
+            self.warnings.warning("rotor position read failed", "rotor position read failed: %s", exc)
             return None
         if self._sent is None and self._card_absent is False and self._target is not None:
             self._push(force=True)  # the rotor came back: send the target again
@@ -388,7 +391,7 @@ class KctDriver:
             self._sent = None
             return
         except RotorError as exc:
-            log.error("rotor refused (%.1f, %.1f): %s", rotor_az, el, exc)
+            self.warnings.error("rotor refused", "rotor refused (%.1f, %.1f): %s", rotor_az, el, exc)
             return
         self._card_absent = False
         self._sent = command
