@@ -13,9 +13,8 @@ import math
 from nfwserver.clock import Clock
 from nfwserver.hamlib.connection import HamlibConnection, HamlibError, HamlibUnavailable
 from nfwserver.radio.backend import RadioError, RadioUnavailable
+from nfwserver.radio.modes import HAMLIB_MODES
 from nfwserver.radio.transponder import MAX_FREQUENCY_HZ, MIN_FREQUENCY_HZ
-
-_MODES = {"USB", "LSB", "CW", "CWR", "RTTY", "RTTYR", "AM", "FM", "WFM", "PKTUSB", "PKTLSB", "PKTFM", "FMN"}
 
 
 def _check_hz(hz: int) -> int:
@@ -68,8 +67,8 @@ class RigctldBackend:
 
     def set_modes(self, rx_mode: str, tx_mode: str | None) -> None:
         for mode in (rx_mode, tx_mode):
-            if mode is not None and mode.upper() not in _MODES:
-                raise RadioError(f"mode {mode!r} is not one of {', '.join(sorted(_MODES))}")
+            if mode is not None and mode.upper() not in HAMLIB_MODES:
+                raise RadioError(f"mode {mode!r} is not a Hamlib mode")
         self._do(f"M {rx_mode.upper()} 0")
         if tx_mode is not None:
             self._do(f"X {tx_mode.upper()} 0")
