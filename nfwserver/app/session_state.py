@@ -1,7 +1,8 @@
 """The session state kept across restarts: the AutoTracking satellite.
 
-Saved as a small JSON file, atomically (:mod:`nfwserver.storage`), whenever it changes; a missing,
-unreadable or malformed file just means "no saved state".
+Saved as a small JSON file, atomically (:mod:`nfwserver.storage`, keeping the file's permissions),
+whenever it changes; a missing, unreadable or malformed file just means "no saved state".  Temporaries
+left by a process killed mid-save are removed when the state file is opened.
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ import logging
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from nfwserver.storage import atomic_write_text
+from nfwserver.storage import atomic_write_text, remove_stale_temporaries
 
 log = logging.getLogger(__name__)
 
@@ -31,6 +32,8 @@ class StateFile:
     def __init__(self, path: str | Path | None = None) -> None:
         self.path = Path(path) if path is not None else default_state_path()
         self._last: SessionState | None = None
+        for stale in remove_stale_temporaries(self.path):
+            log.info("removed %s, left by an interrupted save", stale.name)
 
     def load(self) -> SessionState:
         try:
