@@ -65,7 +65,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"nfwserver: satellite {args.sat} is not in the element files; nothing is published",
               file=sys.stderr)
     # Refusals are reported below with their time; keep the server's own warning out of the way.
-    logging.getLogger("nfwserver.dde.server").setLevel(logging.ERROR)
+    server_log = logging.getLogger("nfwserver.dde.server")
+    previous_level = server_log.level
+    server_log.setLevel(logging.ERROR)  # restored below: the command may run inside another program
     system = FakeDdeSystem(received_capacity=16)
     server.attach(system.server_transport())
     client = system.connect("NFW32", "NFW_DATA", client_name="simulate")
@@ -105,4 +107,5 @@ def run(args: argparse.Namespace) -> int:
         return 0
     finally:
         server.detach()
+        server_log.setLevel(previous_level)
     return 0

@@ -73,7 +73,9 @@ def test_sigkill_during_state_saves_leaves_the_last_saved_state_and_no_temporary
         else:
             time.sleep(delay)
         os.kill(proc.pid, signal.SIGKILL)
-        confirmed = [first] + [int(line) for line in proc.communicate(timeout=10)[0].split()]
+        confirmed = [first] + [int(line) for line in proc.stdout.read().split()]  # EOF: the saver is dead
+        proc.stdout.close()
+        proc.wait(10)
         saved = json.loads(state.read_text())["satellite"]
         assert confirmed[-1] <= saved <= confirmed[-1] + 1
         assert StateFile(state).load().satellite == saved  # opening it removes the killed writer's temporary

@@ -12,6 +12,8 @@ import socket
 import unicodedata
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from nfwserver.app.element_store import ElementStore
 from nfwserver.clock import VirtualClock
@@ -154,3 +156,22 @@ def test_get_sat_keeps_fifteen_fields_for_a_name_with_a_newline() -> None:
     finally:
         server.stop()
     assert reply.startswith("EVIL NAME [1m\n") and len(reply.split("\n")) == 16  # 15 fields + final newline
+
+
+_NUMBERS = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(-10**40, 10**40),
+                     st.sampled_from(["1e999", "-1e999", "nan", "", "x", "0x10", "1_000"]))
+
+
+@settings(max_examples=400)
+@given(st.dictionaries(st.sampled_from(sorted(GOOD)), st.one_of(_NUMBERS, st.text(max_size=30)), max_size=6),
+       st.text(max_size=60))
+def test_fuzzed_omm_records_never_raise_and_what_is_accepted_reads_back(changes: dict, name: str) -> None:
+    record = {**GOOD, **changes, "OBJECT_NAME": name}
+    result = load_elements(json.dumps([record, NEIGHBOUR]), "fuzz")
+    assert 43017 in {s.catalog_number for s in result.sets}
+    assert len(result.sets) + len(result.rejected) == 2 and all(r.reason for r in result.rejected)
+    for es in result.sets:
+        assert _safe(es.name) and len(es.name) <= 40
+        (again,) = load_elements(es.tle_text()).sets  # what is accepted can be stored and read back
+        stored_name = es.name or str(es.catalog_number)  # a nameless set is stored under its number
+        assert (again.name, again.line1, again.line2, again.epoch) == (stored_name, es.line1, es.line2, es.epoch)
