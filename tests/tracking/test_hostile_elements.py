@@ -175,3 +175,16 @@ def test_fuzzed_omm_records_never_raise_and_what_is_accepted_reads_back(changes:
         (again,) = load_elements(es.tle_text()).sets  # what is accepted can be stored and read back
         stored_name = es.name or str(es.catalog_number)  # a nameless set is stored under its number
         assert (again.name, again.line1, again.line2, again.epoch) == (stored_name, es.line1, es.line2, es.epoch)
+
+
+def test_passes_never_prints_a_control_character_from_an_element_file(tmp_path, capsys) -> None:
+    from nfwserver.cli import main
+
+    path = tmp_path / "evil.txt"
+    path.write_text("ISS\x1b[2J\x1b]0;owned\x07 (ZARYA)\n"
+                    "1 25544U 98067A   24001.50000000  .00016717  00000-0  30328-3 0  9993\n"
+                    "2 25544  51.6416 247.4627 0006703 130.5360 325.0288 15.49815330431950\n")
+    assert main(["passes", "--elements", str(path), "--observer", "52.2,0.12", "--start", "2024-01-01T12:00Z",
+                 "--hours", "24"]) == 0
+    out = capsys.readouterr().out
+    assert "ISS [2J ]0;owned (ZARYA)" in out and "\x1b" not in out and "\x07" not in out
