@@ -55,5 +55,5 @@ def make_radio(rc: RadioConfig, core: StationCore, clock: Clock) -> RadioCouplin
     if first is None:
         return None
     backend = RigctldBackend(clock, rc.host, rc.port)
-    tuner = DopplerTuner(first, backend, rc.step_hz, rc.knob_tolerance_hz)
-    return RadioCoupling(tuner, core.state)
+    tuner = DopplerTuner(first, backend, rc.step_hz, rc.knob_tolerance_hz, clock=clock)
+    return RadioCoupling(tuner, core.state, clock)

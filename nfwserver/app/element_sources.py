@@ -8,6 +8,7 @@ as failed: it is almost always the wrong file or an error page.
 
 from __future__ import annotations
 
+import http.client
 import socket
 import urllib.error
 import urllib.request
@@ -63,7 +64,7 @@ def _network_reason(exc: BaseException, timeout_s: float) -> str:
         return "the host name is unknown"
     if isinstance(exc, OSError) and exc.strerror:
         return exc.strerror[0].lower() + exc.strerror[1:]
-    return str(exc) or type(exc).__name__
+    return repr(str(exc) or type(exc).__name__)[1:-1]  # one line, whatever the server sent
 
 
 def fetch_url(url: str, timeout_s: float = 20.0, progress: ProgressCallback | None = None) -> bytes:
@@ -86,7 +87,9 @@ def fetch_url(url: str, timeout_s: float = 20.0, progress: ProgressCallback | No
                 size += len(chunk)
                 if progress is not None:
                     progress(size, total)
-    except (OSError, ValueError, urllib.error.URLError) as exc:
+            if total is not None and size < total:
+                raise OSError(f"the connection closed {total - size} bytes before the announced end")
+    except (OSError, ValueError, urllib.error.URLError, http.client.HTTPException) as exc:
         raise SourceError(f"cannot fetch {url}: {_network_reason(exc, timeout_s)}") from None
     if size > MAX_DOWNLOAD_BYTES:
         raise SourceError(f"{url} is larger than {MAX_DOWNLOAD_BYTES // 2**20} MiB")

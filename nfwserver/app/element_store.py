@@ -3,20 +3,25 @@
 One text file of 3-line TLEs (canonical lines, so every format that was loaded is stored the same
 way) in the platform's user data directory.  Updates follow InstantTrack's UPDATE rule (a set
 replaces the stored one only when its epoch is newer) and are written atomically: a crash during
-an update leaves the previous file whole.
+an update leaves the previous file whole, and the temporary it leaves is removed the next time a
+store is opened on that file (:func:`nfwserver.storage.remove_stale_temporaries`).  The stored file
+keeps its permissions across updates.
 """
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass, field
 from datetime import datetime, timedelta
 from pathlib import Path
 
 from sgp4.api import jday
 
-from nfwserver.storage import atomic_write_text
+from nfwserver.storage import atomic_write_text, remove_stale_temporaries
 from nfwserver.tracking.catalog import Catalog, UpdateSummary
 from nfwserver.tracking.elements import ElementSet, Rejection, load_element_file
+
+log = logging.getLogger(__name__)
 
 
 def default_store_path() -> Path:
@@ -59,6 +64,8 @@ class ElementStore:
 
     def __init__(self, path: str | Path | None = None) -> None:
         self.path = Path(path) if path is not None else default_store_path()
+        for stale in remove_stale_temporaries(self.path):
+            log.info("removed %s, left by an interrupted update", stale.name)
 
     def load(self) -> list[ElementSet]:
         """The stored sets (none if the file does not exist yet)."""

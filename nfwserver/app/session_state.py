@@ -1,8 +1,9 @@
 """The session state kept across restarts: the AutoTracking satellite.
 
-Saved as a small JSON file, atomically (:mod:`nfwserver.storage`), whenever it changes; a missing,
-unreadable or malformed file just means "no saved state".  The file also records which
-``[server] satellite`` was configured when the choice was made, so an edit of the configuration
+Saved as a small JSON file, atomically (:mod:`nfwserver.storage`, keeping the file's permissions),
+whenever it changes; a missing, unreadable or malformed file just means "no saved state".  Temporaries
+left by a process killed mid-save are removed when the state file is opened.  The file also records
+which ``[server] satellite`` was configured when the choice was made, so an edit of the configuration
 wins over a choice saved before it (the station says so in its log).
 
 :class:`SessionSaver` follows the ticks on its own worker thread: saving (an fsync) never runs on
@@ -18,7 +19,7 @@ from pathlib import Path
 
 from nfwserver.core.sample import TickSample
 from nfwserver.core.tick_worker import TickWorker
-from nfwserver.storage import atomic_write_text
+from nfwserver.storage import atomic_write_text, remove_stale_temporaries
 
 log = logging.getLogger(__name__)
 
@@ -39,6 +40,8 @@ class StateFile:
     def __init__(self, path: str | Path | None = None) -> None:
         self.path = Path(path) if path is not None else default_state_path()
         self._last: SessionState | None = None
+        for stale in remove_stale_temporaries(self.path):
+            log.info("removed %s, left by an interrupted save", stale.name)
 
     def load(self) -> SessionState:
         try:

@@ -1,9 +1,12 @@
 """The event stream: every string that goes in or out of the server, with time and conversation.
 
 Nova showed incoming (F3) and outgoing (F1) strings for diagnosis; the console shows these events.
-The log is bounded (a ring of ``capacity`` events) and fans each event out to subscribers;
-a subscriber that raises is logged and dropped from that one delivery, never breaking the server.
-Texts are stored as received; :func:`nfwserver.core.nova_protocol.escape_for_log` renders them safely.
+The log is bounded in count (a ring of ``capacity`` events) and in size: an event's ``text`` and
+``detail`` keep at most :data:`MAX_EVENT_TEXT` characters, the rest replaced by a note of how many
+were cut, so a flood of 1 MB pokes holds kilobytes, not gigabytes.  Each event is fanned out to
+subscribers; a subscriber that raises is logged and dropped from that one delivery, never breaking
+the server.  Texts are otherwise stored as received; :func:`nfwserver.core.nova_protocol.escape_for_log`
+renders them safely.
 """
 
 from __future__ import annotations
@@ -18,6 +21,16 @@ from dataclasses import dataclass
 from datetime import datetime
 
 log = logging.getLogger(__name__)
+
+#: Characters of an event's text (and detail) kept; Nova's strings and valid pokes are far shorter.
+MAX_EVENT_TEXT = 512
+
+
+def truncate_text(text: str, limit: int = MAX_EVENT_TEXT) -> str:
+    """``text`` itself when short enough, else its first ``limit`` characters and a note of the rest."""
+    if len(text) <= limit:
+        return text
+    return f"{text[:limit]}... [{len(text) - limit} more characters]"
 
 
 class Direction(enum.Enum):
@@ -51,7 +64,9 @@ class EventLog:
         self._seq = itertools.count(1)
 
     def add(self, time: datetime, direction: Direction, kind: str, text: str, **fields: object) -> Event:
-        event = Event(next(self._seq), time, direction, kind, text, **fields)  # type: ignore[arg-type]
+        if isinstance(fields.get("detail"), str):
+            fields["detail"] = truncate_text(fields["detail"])  # type: ignore[arg-type]
+        event = Event(next(self._seq), time, direction, kind, truncate_text(text), **fields)  # type: ignore[arg-type]
         with self._lock:
             self._events.append(event)
             subscribers = list(self._subscribers)

@@ -11,7 +11,9 @@ from __future__ import annotations
 import logging
 import threading
 
+from nfwserver.clock import Clock, SystemClock
 from nfwserver.core.sample import TickSample
+from nfwserver.ratelimited_log import RateLimitedLog
 
 log = logging.getLogger(__name__)
 
@@ -21,7 +23,9 @@ class TickWorker:
 
     worker_name = "nfw-worker"
 
-    def __init__(self) -> None:
+    def __init__(self, clock: Clock | None = None) -> None:
+        #: A failure repeated every tick is logged (with its traceback) once, then counted.
+        self.warnings = RateLimitedLog(log, clock if clock is not None else SystemClock())
         self._pending: TickSample | None = None
         self._wake = threading.Event()
         self._stop = threading.Event()
@@ -44,7 +48,8 @@ class TickWorker:
                 try:
                     self.process(sample)
                 except Exception:  # keep the worker alive whatever happens
-                    log.exception("%s failed on a tick", self.worker_name)
+                    self.warnings.log(logging.ERROR, "tick failed", "%s failed on a tick", self.worker_name,
+                                      exc_info=True)
 
     def start(self) -> None:
         if self._thread is None:

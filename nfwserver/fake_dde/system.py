@@ -4,6 +4,12 @@ Locking: one re-entrant lock per :class:`FakeDdeSystem` serialises transactions,
 serialises them on the server's message loop.  Server handlers are called with that lock held, so
 a handler must not wait on another thread that needs the transport; the nfwserver core never calls
 the transport while holding its own lock.
+
+Bounds, so abandoned or hostile clients cannot exhaust memory or slow the server's tick: each
+service accepts at most ``max_conversations_per_service`` conversations (a further connect is
+refused with ``DMLERR_NO_CONV_ESTABLISHED``, as DDEML refuses when a server cannot take another),
+and each client keeps only its ``received_capacity`` newest deliveries.  Advise loops are indexed
+by (topic, item), so posting an item costs one server call per loop on that item, no more.
 """
 
 from __future__ import annotations
@@ -29,6 +35,9 @@ from nfwserver.fake_dde.errors import (
 log = logging.getLogger(__name__)
 
 MAX_NAME_LENGTH = 255
+#: Default bounds (see the module docstring).
+MAX_CONVERSATIONS_PER_SERVICE = 256
+RECEIVED_CAPACITY = 10_000
 
 
 def _check_name(name: str, what: str) -> str:
@@ -77,13 +86,19 @@ class _Conversation:
 class FakeDdeSystem:
     """One simulated Windows session holding DDE servers and client conversations."""
 
-    def __init__(self, received_capacity: int = 100_000) -> None:
+    def __init__(self, received_capacity: int = RECEIVED_CAPACITY,
+                 max_conversations_per_service: int = MAX_CONVERSATIONS_PER_SERVICE) -> None:
         self._lock = threading.RLock()
         self._services: dict[str, tuple[str, DdeServerHandler]] = {}
         self._conversations: dict[ConversationId, _Conversation] = {}
+        self._per_service: dict[str, int] = {}  #: open conversations by upper-case service name
+        #: advise loops by (upper-case topic, upper-case item): conversation id -> None (ordered set)
+        self._advised: dict[tuple[str, str], dict[ConversationId, None]] = {}
         self._ids = itertools.count(1)
         self._seq = itertools.count(1)
         self.received_capacity = received_capacity
+        self.max_conversations_per_service = max_conversations_per_service
+        self.refused_connects = 0  #: connects refused because a service was full
 
     # -- server side -------------------------------------------------------------------------
     def server_transport(self) -> FakeServerTransport:
@@ -108,15 +123,11 @@ class FakeDdeSystem:
 
     def _post_advise(self, topic: str, item: str) -> int:
         """Serve every advise loop on (topic, item); returns how many loops were served."""
-        topic_key, item_key = topic.upper(), item.upper()
         served = 0
         with self._lock:
-            for conv in list(self._conversations.values()):
-                if conv.topic.upper() != topic_key:
-                    continue
-                for loop in list(conv.loops.values()):
-                    if loop.item.upper() != item_key:
-                        continue
+            for conv_id in list(self._advised.get((topic.upper(), item.upper()), ())):
+                conv = self._conversations[conv_id]
+                for loop in [lp for (key, _), lp in list(conv.loops.items()) if key == item.upper()]:
                     try:
                         data = conv.handler.on_advise_request(conv.conv_id, conv.topic, loop.item, loop.fmt)
                     except Exception:
@@ -141,6 +152,14 @@ class FakeDdeSystem:
             if entry is None:
                 raise DdeError(DMLERR_NO_CONV_ESTABLISHED, f"no server offers service {service!r}")
             handler = entry[1]
+            key = service.upper()
+            if self._per_service.get(key, 0) >= self.max_conversations_per_service:
+                self.refused_connects += 1
+                if self.refused_connects == 1:
+                    log.warning("service %s has %d conversations, its limit; further connects are refused",
+                                entry[0], self.max_conversations_per_service)
+                raise DdeError(DMLERR_NO_CONV_ESTABLISHED, f"service {service!r} already has "
+                               f"{self.max_conversations_per_service} conversations; connect refused")
             try:
                 ok = handler.on_connect(service, topic)
             except Exception:
@@ -151,6 +170,7 @@ class FakeDdeSystem:
             conv_id = next(self._ids)
             client = ClientConversation(self, conv_id, service, topic, client_name)
             self._conversations[conv_id] = _Conversation(conv_id, service, topic, handler, client)
+            self._per_service[key] = self._per_service.get(key, 0) + 1
             try:
                 handler.on_connect_confirm(conv_id, service, topic)
             except Exception:
@@ -215,6 +235,7 @@ class FakeDdeSystem:
             if not ok:
                 raise DdeError(DMLERR_NOTPROCESSED, f"the server refused an advise loop on {item!r}")
             conv.loops[key] = _Loop(item, fmt, hot)
+            self._advised.setdefault((conv.topic.upper(), item.upper()), {})[conv_id] = None
 
     def _stop_advise(self, conv_id: ConversationId, item: str, fmt: int) -> None:
         with self._lock:
@@ -222,6 +243,8 @@ class FakeDdeSystem:
             loop = conv.loops.pop((item.upper(), fmt), None)
             if loop is None:
                 raise DdeError(DMLERR_NOTPROCESSED, f"there is no advise loop on {item!r}")
+            if not any(key == item.upper() for key, _ in conv.loops):
+                self._unindex(conv, item.upper())
             self._call(conv, "advise stop", lambda: conv.handler.on_advise_stop(conv_id, conv.topic, loop.item, fmt))
 
     def _disconnect(self, conv_id: ConversationId) -> None:
@@ -230,8 +253,22 @@ class FakeDdeSystem:
             if conv is not None:
                 self._end(conv, by_server=False)
 
+    def _unindex(self, conv: _Conversation, item_key: str) -> None:
+        index_key = (conv.topic.upper(), item_key)
+        loops = self._advised.get(index_key)
+        if loops is not None:
+            loops.pop(conv.conv_id, None)
+            if not loops:
+                del self._advised[index_key]
+
     def _end(self, conv: _Conversation, by_server: bool) -> None:
-        self._conversations.pop(conv.conv_id, None)
+        if self._conversations.pop(conv.conv_id, None) is not None:
+            key = conv.service.upper()
+            self._per_service[key] -= 1
+            if not self._per_service[key]:
+                del self._per_service[key]
+        for item_key in {key for key, _ in conv.loops}:
+            self._unindex(conv, item_key)
         conv.loops.clear()
         self._call(conv, "disconnect", lambda: conv.handler.on_disconnect(conv.conv_id))
         conv.client._closed()

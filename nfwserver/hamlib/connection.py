@@ -11,6 +11,13 @@ When the daemon dies (EOF, broken pipe, refused connection) the connection is dr
 than the back-off delay (doubling from ``backoff_initial_s`` to ``backoff_max_s``, 1.5 s by default so a
 returning daemon is found again within 2 s; measured on the
 injected clock), so a dead daemon never stalls the caller.
+
+A reply that makes no sense (a line over :data:`MAX_LINE_BYTES`, a value where ``RPRT`` was due, no
+value where one was due, or a value the backend finds non-finite or out of range and reports with
+:meth:`HamlibConnection.fault`) is a *device fault*: it is counted in ``faults``, raised as
+:class:`HamlibError`, and the connection is dropped (reopened on the next call, without back-off)
+because whatever else is in flight can no longer be matched to a command.  Warnings about a
+daemon that keeps failing are rate-limited (:mod:`nfwserver.ratelimited_log`).
 """
 
 from __future__ import annotations
@@ -20,8 +27,12 @@ import socket
 
 from nfwserver.clock import Clock
 from nfwserver.hamlib.errors import describe_rprt
+from nfwserver.ratelimited_log import RateLimitedLog
 
 log = logging.getLogger(__name__)
+
+#: Longest reply line accepted (bytes); Hamlib's replies are a few dozen.
+MAX_LINE_BYTES = 65536
 
 
 class HamlibError(Exception):
@@ -40,7 +51,7 @@ class HamlibConnection:
     """One TCP connection to a Hamlib daemon, reopened on demand."""
 
     def __init__(self, host: str, port: int, clock: Clock, name: str = "hamlib", timeout_s: float = 1.0,
-                 backoff_initial_s: float = 0.25, backoff_max_s: float = 1.5) -> None:
+                 backoff_initial_s: float = 0.25, backoff_max_s: float = 1.5, warn_interval_s: float = 60.0) -> None:
         self.host, self.port, self.clock, self.name = host, port, clock, name
         self.timeout_s = timeout_s
         self.backoff_initial_s, self.backoff_max_s = backoff_initial_s, backoff_max_s
@@ -50,6 +61,8 @@ class HamlibConnection:
         self._retry_at: float | None = None
         self.failures = 0  #: consecutive failures
         self.reconnects = 0
+        self.faults = 0  #: replies rejected as nonsense (device faults), in total
+        self.warnings = RateLimitedLog(log, clock, warn_interval_s)
 
     @property
     def connected(self) -> bool:
@@ -72,7 +85,7 @@ class HamlibConnection:
         self._sock, self._buffer = sock, b""
         if self.failures:
             self.reconnects += 1
-            log.info("%s at %s:%d is back", self.name, self.host, self.port)
+            self.warnings.log(logging.INFO, "back", "%s at %s:%d is back", self.name, self.host, self.port)
         self.failures, self._backoff, self._retry_at = 0, 0.0, None
         return sock
 
@@ -87,7 +100,21 @@ class HamlibConnection:
         self._backoff = min(self.backoff_max_s, max(self.backoff_initial_s, self._backoff * 2.0))
         self._retry_at = self.clock.monotonic() + self._backoff
         if self.failures == 1:
-            log.warning("%s at %s:%d lost (%s); retrying with back-off", self.name, self.host, self.port, why)
+            self.warnings.warning("lost", "%s at %s:%d lost (%s); retrying with back-off", self.name, self.host,
+                                  self.port, why)
+
+    def fault(self, why: str) -> HamlibError:
+        """Count a nonsense reply, drop the connection (it may be out of step) and return the error to raise."""
+        self.faults += 1
+        if self._sock is not None:
+            try:
+                self._sock.close()
+            except OSError:
+                pass
+        self._sock, self._buffer = None, b""
+        self.warnings.warning("fault", "%s at %s:%d sent a reply that makes no sense (%s); reconnecting",
+                              self.name, self.host, self.port, why)
+        return HamlibError(f"{self.name}: {why}")
 
     def _read_line(self, sock: socket.socket) -> str:
         while b"\n" not in self._buffer:
@@ -95,8 +122,8 @@ class HamlibConnection:
             if not chunk:
                 raise ConnectionResetError("the daemon closed the connection")
             self._buffer += chunk
-            if len(self._buffer) > 65536:
-                raise HamlibError("reply too long")
+            if len(self._buffer) > MAX_LINE_BYTES:
+                raise self.fault(f"a reply line longer than {MAX_LINE_BYTES} bytes")
         line, self._buffer = self._buffer.split(b"\n", 1)
         return line.decode("ascii", errors="replace").strip()
 
@@ -113,12 +140,18 @@ class HamlibConnection:
             sock.sendall(command.encode("ascii") + b"\n")
             first = self._read_line(sock)
             if first.startswith("RPRT"):
-                code = int(first.split()[1]) if len(first.split()) > 1 else -8
+                parts = first.split()
+                try:
+                    code = int(parts[1]) if len(parts) > 1 else -8
+                except ValueError:
+                    raise self.fault(f"{first[:40]!r} is not an RPRT line") from None
                 if code < 0:
                     raise HamlibError(f"{self.name}: '{command}' failed: {describe_rprt(code)} (RPRT {code})", code)
+                if reply_lines:
+                    raise self.fault(f"{first!r} instead of a value to '{command}'")
                 return []
             if reply_lines == 0:
-                raise HamlibError(f"{self.name}: unexpected reply {first!r} to '{command}'")
+                raise self.fault(f"unexpected reply {first[:40]!r} to '{command}'")
             lines = [first] + [self._read_line(sock) for _ in range(reply_lines - 1)]
             return lines
         except HamlibError:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import logging
 
+from nfwserver.clock import Clock
 from nfwserver.core.sample import TickSample
 from nfwserver.core.state import StationState
 from nfwserver.core.tick_worker import TickWorker
@@ -26,8 +27,8 @@ class RadioCoupling(TickWorker):
 
     worker_name = "nfw-radio"
 
-    def __init__(self, tuner: DopplerTuner, state: StationState) -> None:
-        super().__init__()
+    def __init__(self, tuner: DopplerTuner, state: StationState, clock: Clock | None = None) -> None:
+        super().__init__(clock)
         self.tuner = tuner
         self.state = state
         self.last_result: TuneResult | None = None

@@ -1,18 +1,20 @@
 """Radio backend for Hamlib's ``rigctld``: receive on VFO A (``F``/``f``), transmit on the split VFO (``I``/``i``).
 
 Frequencies are validated here (100 kHz .. 300 GHz, integers) because the dummy rig and some
-real ones accept anything.  Connection handling, timeouts and back-off are
+real ones accept anything; frequencies read back are checked the same way, and a bad one counts
+as a device fault.  Connection handling, timeouts and back-off are
 :class:`nfwserver.hamlib.connection.HamlibConnection`'s.
 """
 
 from __future__ import annotations
 
+import math
+
 from nfwserver.clock import Clock
 from nfwserver.hamlib.connection import HamlibConnection, HamlibError, HamlibUnavailable
 from nfwserver.radio.backend import RadioError, RadioUnavailable
+from nfwserver.radio.modes import HAMLIB_MODES
 from nfwserver.radio.transponder import MAX_FREQUENCY_HZ, MIN_FREQUENCY_HZ
-
-_MODES = {"USB", "LSB", "CW", "CWR", "RTTY", "RTTYR", "AM", "FM", "WFM", "PKTUSB", "PKTLSB", "PKTFM", "FMN"}
 
 
 def _check_hz(hz: int) -> int:
@@ -37,11 +39,16 @@ class RigctldBackend:
             raise RadioError(str(exc)) from None
 
     def _get_hz(self, command: str) -> int:
+        """A frequency read back (Hz); non-finite or outside 100 kHz..300 GHz is a device fault."""
         (line,) = self._do(command, 1)
         try:
-            return int(float(line))
+            value = float(line)
         except ValueError:
-            raise RadioError(f"rigctld answered {line!r} to '{command}'") from None
+            value = math.nan
+        if not MIN_FREQUENCY_HZ <= value <= MAX_FREQUENCY_HZ:
+            raise RadioError(str(self.connection.fault(f"{line[:20]!r} to '{command}' is not a frequency "
+                                                       "within 100 kHz..300 GHz")))
+        return int(value)
 
     def set_rx_frequency(self, hz: int) -> None:
         self._do(f"F {_check_hz(hz)}")
@@ -60,8 +67,8 @@ class RigctldBackend:
 
     def set_modes(self, rx_mode: str, tx_mode: str | None) -> None:
         for mode in (rx_mode, tx_mode):
-            if mode is not None and mode.upper() not in _MODES:
-                raise RadioError(f"mode {mode!r} is not one of {', '.join(sorted(_MODES))}")
+            if mode is not None and mode.upper() not in HAMLIB_MODES:
+                raise RadioError(f"mode {mode!r} is not a Hamlib mode")
         self._do(f"M {rx_mode.upper()} 0")
         if tx_mode is not None:
             self._do(f"X {tx_mode.upper()} 0")

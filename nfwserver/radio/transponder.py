@@ -15,6 +15,10 @@ oscillator drift, and which side is held constant while the Doppler shift change
 
 ``passband_offset_hz`` moves the operating point inside a linear transponder's passband on the
 downlink side; the uplink moves the other way on an inverting transponder.
+
+A channel checks itself when built and raises :class:`ValueError` with one clear sentence: frequencies
+finite and within 100 kHz..300 GHz, corrections finite and within ±1 MHz, the passband offset finite,
+modes among Hamlib's names (:mod:`nfwserver.radio.modes`; stored upper-case).
 """
 
 from __future__ import annotations
@@ -22,11 +26,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+from nfwserver.radio.modes import check_mode
 from nfwserver.tracking.doppler import SPEED_OF_LIGHT_KM_S
 
 HOLD_SIDES = ("satellite", "uplink", "downlink")
 #: Frequencies accepted for a channel (Hz): 100 kHz to 300 GHz.
 MIN_FREQUENCY_HZ, MAX_FREQUENCY_HZ = 1e5, 3e11
+#: Largest oscillator correction accepted (Hz): satellites drift by kHz, never by MHz.
+MAX_CORRECTION_HZ = 1e6
 
 
 @dataclass(frozen=True)
@@ -51,6 +58,15 @@ class Channel:
                 raise ValueError(f"channel {self.name!r}: {name} {value} is outside 100 kHz..300 GHz")
         if self.hold not in HOLD_SIDES:
             raise ValueError(f"channel {self.name!r}: hold must be one of {', '.join(HOLD_SIDES)}")
+        for name in ("downlink_correction_hz", "uplink_correction_hz"):
+            value = getattr(self, name)
+            if not isinstance(value, (int, float)) or not abs(value) <= MAX_CORRECTION_HZ:
+                raise ValueError(f"channel {self.name!r}: {name} {value} is not a number within "
+                                 f"±{MAX_CORRECTION_HZ:.0f} Hz")
+        if not isinstance(self.passband_offset_hz, (int, float)) or not math.isfinite(self.passband_offset_hz):
+            raise ValueError(f"channel {self.name!r}: passband_offset_hz {self.passband_offset_hz} is not finite")
+        for name in ("downlink_mode", "uplink_mode"):
+            object.__setattr__(self, name, check_mode(getattr(self, name), f"channel {self.name!r}: {name}"))
 
     def with_offset(self, passband_offset_hz: float) -> Channel:
         return replace(self, passband_offset_hz=passband_offset_hz)

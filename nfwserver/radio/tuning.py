@@ -12,7 +12,8 @@ where the operator put it instead of fighting the knob.  On an inverting transpo
 then moves the opposite way.
 
 When the radio is unreachable, nothing is raised to the caller: the state is marked, and after
-the radio returns the split setting, modes and both frequencies are sent again.
+the radio returns the split setting, modes and both frequencies are sent again.  A radio that keeps
+refusing is reported once and then summarised (:mod:`nfwserver.ratelimited_log`), not once per tick.
 """
 
 from __future__ import annotations
@@ -20,8 +21,10 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass
 
+from nfwserver.clock import Clock, SystemClock
 from nfwserver.radio.backend import RadioBackend, RadioError, RadioUnavailable
 from nfwserver.radio.transponder import Channel
+from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.tracking.doppler import SPEED_OF_LIGHT_KM_S
 
 log = logging.getLogger(__name__)
@@ -40,7 +43,7 @@ class DopplerTuner:
     """Tunes ``backend`` for ``channel``; see the module docstring."""
 
     def __init__(self, channel: Channel, backend: RadioBackend, step_hz: float = 10.0,
-                 knob_tolerance_hz: float = 100.0, follow_knob: bool = True) -> None:
+                 knob_tolerance_hz: float = 100.0, follow_knob: bool = True, clock: Clock | None = None) -> None:
         if step_hz <= 0 or knob_tolerance_hz < step_hz:
             raise ValueError("step_hz must be positive and knob_tolerance_hz at least step_hz")
         self.channel = channel
@@ -53,6 +56,8 @@ class DopplerTuner:
         self._last_rx: int | None = None
         self._last_tx: int | None = None
         self._prepared = False
+        #: Repeated refusals are logged once, then counted (real time unless a clock is given).
+        self.warnings = RateLimitedLog(log, clock if clock is not None else SystemClock())
 
     def set_channel(self, channel: Channel) -> None:
         """Switch channel (e.g. another satellite): everything is sent again."""
@@ -103,11 +108,13 @@ class DopplerTuner:
             self._prepared, self._last_rx, self._last_tx = False, None, None
             return None
         except RadioError as exc:
-            log.error("radio refused a command: %s", exc)
+            self.warnings.error("radio refused a command", "radio refused a command: %s", exc)
             self.last_error = str(exc)
             self._prepared, self._last_rx, self._last_tx = False, None, None
             return None
         if not self.available:
             log.info("radio available again; tuning resumed")
+        if self.last_error is not None:
+            self.warnings.clear("radio refused a command")
         self.available, self.last_error = True, None
         return TuneResult(rx_hz, tx_hz, sent_rx, sent_tx, knob)

@@ -76,7 +76,7 @@ class RotorCoupling(TickWorker):
                  speed_deg_s: float = 6.0, max_lead_s: float = 10.0, after_los: str = "park", flip_mode: str = "auto",
                  on_position: Callable[[float, float], None] | None = None,
                  on_event: Callable[[str], None] | None = None) -> None:
-        super().__init__()
+        super().__init__(driver.clock)
         if after_los not in AFTER_LOS or flip_mode not in FLIP_MODES:
             raise ValueError(f"after_los must be one of {AFTER_LOS} and flip_mode one of {FLIP_MODES}")
         if threshold_deg < 0 or speed_deg_s <= 0 or max_lead_s < 0:

@@ -29,6 +29,7 @@ from collections.abc import Callable
 from datetime import datetime, timedelta, timezone
 
 from nfwserver.clock import Clock
+from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.rotor.backend import RotorBackend, RotorError, RotorUnavailable
 from nfwserver.rotor.geometry import RotorGeometry
 from nfwserver.rotor.kct_annunciator import Announcement, Annunciator
@@ -36,7 +37,6 @@ from nfwserver.rotor.kct_parking import Parking, ParkingParameters
 from nfwserver.rotor.kct_status import DriverStatus, KctStatusBit
 from nfwserver.rotor.kct_table import NormalEntry, RepetitiveEntry
 from nfwserver.rotor.kct_table_store import ADD_FULL, ADD_INVALID, ADD_OK, TableMode, TableRead, TimeTargetTable
-from nfwserver.rotor.rate_limited_log import RateLimitedLog
 from nfwserver.rotor.stall import AXES, StallReporting, StallWatch
 
 __all__ = ["ADD_FULL", "ADD_INVALID", "ADD_OK", "Announcement", "KctDriver", "ParkingParameters", "TableMode"]
@@ -71,7 +71,7 @@ class KctDriver:
             self.annunciator.listeners.append(on_announcement)
         self.stall = StallWatch(timeout_s=stall_timeout_s)
         self.table_load_listeners: list[Callable[[], None]] = []
-        self._diagnostics = RateLimitedLog(log, clock.monotonic)
+        self._diagnostics = RateLimitedLog(log, clock)
         self._slew = (0, 0)  # (el, az)
         self._target: tuple[float, float] | None = None  # (el, az) KCT frame
         self._enabled = True

@@ -2,7 +2,8 @@
 
 Angles are sent in the rotor's frame, already mapped into its range (the daemon's own limits, as set
 by ``--set-conf=min_az=..,max_az=..,min_el=..,max_el=..``, must match the configured geometry).
-Connection handling, timeouts and back-off are :class:`nfwserver.hamlib.connection.HamlibConnection`'s.
+Connection handling, timeouts and back-off are :class:`nfwserver.hamlib.connection.HamlibConnection`'s;
+positions read back are checked (finite, within the range) and a bad one counts as a device fault.
 """
 
 from __future__ import annotations
@@ -13,6 +14,9 @@ from nfwserver.clock import Clock
 from nfwserver.hamlib.connection import HamlibConnection, HamlibError, HamlibUnavailable
 from nfwserver.rotor.backend import RotorError, RotorUnavailable
 from nfwserver.rotor.geometry import RotorGeometry
+
+#: How far (degrees) a reported position may lie outside the configured range before it is refused.
+POSITION_SLACK_DEG = 5.0
 
 
 class RotctldBackend:
@@ -38,11 +42,21 @@ class RotctldBackend:
         self._do(f"P {azimuth_deg:.2f} {elevation_deg:.2f}")
 
     def get_position(self) -> tuple[float, float]:
-        az, el = self._do("p", 2)
+        """The rotor's position (rotor frame, degrees); a non-finite or out-of-range reply is a device fault.
+
+        A reply may lie up to :data:`POSITION_SLACK_DEG` outside the configured range (rotors
+        overshoot their stops a little); anything further is refused, as is anything not a number.
+        """
+        az_text, el_text = self._do("p", 2)
         try:
-            return float(az), float(el)
+            az, el = float(az_text), float(el_text)
         except ValueError:
-            raise RotorError(f"rotctld answered {az!r} {el!r} to 'p'") from None
+            az = el = math.nan
+        g, slack = self.geometry, POSITION_SLACK_DEG
+        if not (g.az_min - slack <= az <= g.az_max + slack and g.el_min - slack <= el <= g.el_max + slack):
+            raise RotorError(str(self.connection.fault(f"position {az_text[:20]!r} {el_text[:20]!r} is not a "
+                                                       "finite position within the rotor's range")))
+        return az, el
 
     def stop(self) -> None:
         self._do("S")

@@ -4,21 +4,24 @@ Accepted, in any mixture within one file: NORAD TLEs with or without a name line
 3-line forms; CelesTrak's ``0 NAME`` name lines too), AMSAT verbose sets
 (:mod:`nfwserver.tracking.amsat`), and CCSDS OMM as CelesTrak's JSON (a whole file) or CSV (a
 header row, then one row per set).  Lines belonging to none of them are skipped silently, except
-lines that look like a broken TLE line, which are reported.
+lines that look like a broken TLE line, which are reported.  A file that opens with ``[`` or ``{``
+but is not valid JSON (a TLE file with a ``[group]`` heading, say) is read as text.
 
 Every set becomes an :class:`ElementSet` whose SGP4 model is initialised from canonical TLE lines,
 so a satellite propagates identically whichever format it came in.  Nothing in here raises for
 bad content: each rejected set is a :class:`Rejection` with its line number and one-sentence
-reason.
+reason.  Names are sanitised once, here (:mod:`nfwserver.tracking.element_names`); values a TLE
+cannot hold (non-finite numbers, epochs outside 1957..2056) are rejected
+(:func:`nfwserver.tracking.tle.check_ranges`), so every accepted set can be stored and read back.
 """
 
 from __future__ import annotations
 
 import csv
-import io
 import json
 import os
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
@@ -26,6 +29,7 @@ from pathlib import Path
 from sgp4.api import WGS72, Satrec
 
 from nfwserver.tracking import amsat, omm
+from nfwserver.tracking.element_names import MAX_NAME_LENGTH, sanitize_element_name
 from nfwserver.tracking.tle import TleError, TleFields, format_tle, parse_tle
 
 
@@ -33,7 +37,7 @@ from nfwserver.tracking.tle import TleError, TleFields, format_tle, parse_tle
 class ElementSet:
     """One satellite's mean elements at an epoch, with its initialised SGP4 model."""
 
-    name: str  #: name as given ("ISS (ZARYA)"), stripped; "" when the set had none
+    name: str  #: name as given ("ISS (ZARYA)"), sanitised (element_names); "" when the set had none
     catalog_number: int
     international_designator: str
     epoch: datetime  #: aware UTC
@@ -58,7 +62,7 @@ class ElementSet:
         line1, line2 = lines if lines is not None else format_tle(fields)
         satrec = Satrec.twoline2rv(line1, line2, WGS72)
         return cls(
-            name=name, catalog_number=fields.catalog_number,
+            name=sanitize_element_name(name), catalog_number=fields.catalog_number,
             international_designator=fields.international_designator, epoch=fields.epoch,
             inclination_deg=fields.inclination_deg, raan_deg=fields.raan_deg, eccentricity=fields.eccentricity,
             arg_perigee_deg=fields.arg_perigee_deg, mean_anomaly_deg=fields.mean_anomaly_deg,
@@ -68,8 +72,16 @@ class ElementSet:
         )
 
     def tle_text(self) -> str:
-        """The set as three lines (name, line 1, line 2), newline-terminated."""
-        return f"{self.name or self.catalog_number}\n{self.line1}\n{self.line2}\n"
+        """The set as three lines (name, line 1, line 2), newline-terminated.
+
+        A name that would be read back as something else (a TLE line, an AMSAT or CSV header) is
+        written in CelesTrak's ``0 NAME`` form, which the loader reads as a name.
+        """
+        name = self.name or str(self.catalog_number)
+        if _TLE_LIKE.match(name) or name.startswith(("1 ", "2 ", "0 ")) or amsat.is_satellite_line(name) \
+                or _is_csv_header(name):
+            name = "0 " + name
+        return f"{name}\n{self.line1}\n{self.line2}\n"
 
 
 @dataclass(frozen=True)
@@ -94,7 +106,18 @@ class LoadResult:
 
 # A line that claims to be a TLE line: line number, blank, 5-character catalog field.
 _TLE_LIKE = re.compile(r"^[12] [0-9A-Z ]{4}[0-9]")
-_MAX_NAME = 40
+_MAX_NAME = MAX_NAME_LENGTH
+#: Longest CSV row read (characters); longer rows are rejected before the csv module sees them.
+MAX_CSV_ROW = 4096
+_CSV_COLUMN = re.compile(r"[A-Z_]+")
+
+
+def _is_csv_header(line: str) -> bool:
+    """True for an OMM CSV header row: upper-case column names including NORAD_CAT_ID and MEAN_MOTION."""
+    if "NORAD_CAT_ID" not in line or "MEAN_MOTION" not in line or "," not in line:
+        return False
+    columns = [c.strip().strip('"') for c in line.strip().split(",")]
+    return all(_CSV_COLUMN.fullmatch(c) for c in columns)
 
 
 def _clean_name(line: str) -> str:
@@ -106,7 +129,9 @@ def _clean_name(line: str) -> str:
 
 def _could_be_name(line: str) -> bool:
     text = line.strip()
-    return 0 < len(text) <= _MAX_NAME + 2 and not _TLE_LIKE.match(text) and text.isprintable()
+    if not 0 < len(text) <= _MAX_NAME + 2 or _TLE_LIKE.match(text):
+        return False
+    return text.isprintable() or bool(sanitize_element_name(text))
 
 
 def load_elements(data: str | bytes, source: str = "<text>") -> LoadResult:
@@ -116,8 +141,18 @@ def load_elements(data: str | bytes, source: str = "<text>") -> LoadResult:
         data = data.decode("utf-8", errors="replace")
     stripped = data.lstrip("\ufeff \t\r\n")
     if stripped.startswith(("[", "{")):
-        _load_json(stripped, source, result)
+        problem = _load_json(stripped, source, result)
+        if problem is None:
+            return result
+        _load_text(data, source, result)
+        if not result.sets and not result.rejected:
+            result.rejected.append(problem)
         return result
+    _load_text(data, source, result)
+    return result
+
+
+def _load_text(data: str, source: str, result: LoadResult) -> None:
     lines = data.replace("\r\n", "\n").replace("\r", "\n").split("\n")
     i = 0
     n = len(lines)
@@ -129,11 +164,24 @@ def load_elements(data: str | bytes, source: str = "<text>") -> LoadResult:
         if amsat.is_satellite_line(line):
             i = _take_amsat(lines, i, source, result)
             continue
-        if "NORAD_CAT_ID" in line and "MEAN_MOTION" in line and "," in line:
+        if _is_csv_header(line):
             i = _take_csv(lines, i, source, result)
             continue
         i += 1
-    return result
+
+
+#: What building a set from hostile values can raise besides TleError (sgp4, float/int conversion).
+_BAD_VALUE = (ValueError, ArithmeticError, TypeError, RuntimeError)
+
+
+def _accept(result: LoadResult, source: str, line: int, prefix: str, build: Callable[[], ElementSet]) -> None:
+    """Append ``build()`` to the sets, or a :class:`Rejection` with its reason: one bad set never stops a load."""
+    try:
+        result.sets.append(build())
+    except TleError as exc:
+        result.rejected.append(Rejection(source, line, f"{prefix}{exc}"))
+    except _BAD_VALUE as exc:  # sgp4 refusing values that passed our checks, or an unforeseen conversion
+        result.rejected.append(Rejection(source, line, f"{prefix}these elements cannot be used ({exc})"))
 
 
 def _take_tle(lines: list[str], i: int, source: str, result: LoadResult) -> int:
@@ -141,7 +189,7 @@ def _take_tle(lines: list[str], i: int, source: str, result: LoadResult) -> int:
     name = ""
     start = i + 1
     if i > 0 and _could_be_name(lines[i - 1]) and not lines[i - 1].startswith("2 "):
-        name = _clean_name(lines[i - 1])
+        name = sanitize_element_name(_clean_name(lines[i - 1]))
         start = i
     if not line1.startswith("1 "):
         result.rejected.append(Rejection(source, i + 1, "TLE line 2 without a preceding line 1"))
@@ -150,20 +198,17 @@ def _take_tle(lines: list[str], i: int, source: str, result: LoadResult) -> int:
         result.rejected.append(Rejection(source, i + 1, "TLE line 1 without a following line 2"))
         return i + 1
     line2 = lines[i + 1].rstrip()
-    try:
+
+    def build() -> ElementSet:
         fields = parse_tle(line1, line2)
-        result.sets.append(
-            ElementSet.from_fields(name, fields, source, start, lines=(line1.rstrip(), line2.rstrip()))
-        )
-    except TleError as exc:
-        result.rejected.append(Rejection(source, start, f"{name + ': ' if name else ''}{exc}"))
-    except (ValueError, RuntimeError) as exc:  # sgp4 refusing values that passed our checks
-        result.rejected.append(Rejection(source, start, f"SGP4 cannot initialise these elements ({exc})"))
+        return ElementSet.from_fields(name, fields, source, start, lines=(line1.rstrip(), line2.rstrip()))
+
+    _accept(result, source, start, f"{name}: " if name else "", build)
     return i + 2
 
 
 def _take_amsat(lines: list[str], i: int, source: str, result: LoadResult) -> int:
-    name = lines[i].partition(":")[2].strip()
+    name = sanitize_element_name(lines[i].partition(":")[2])
     start = i
     body = []
     i += 1
@@ -178,51 +223,62 @@ def _take_amsat(lines: list[str], i: int, source: str, result: LoadResult) -> in
         else:
             body.append(line)
         i += 1
-    try:
+
+    def build() -> ElementSet:
         fields = amsat.parse_amsat_block(amsat.AmsatBlock(name, start + 1, body))
-        result.sets.append(ElementSet.from_fields(name, fields, source, start + 1))
-    except TleError as exc:
-        result.rejected.append(Rejection(source, start + 1, str(exc)))
+        return ElementSet.from_fields(name, fields, source, start + 1)
+
+    _accept(result, source, start + 1, "", build)
     return i
 
 
 def _take_csv(lines: list[str], i: int, source: str, result: LoadResult) -> int:
-    start = i
-    header = lines[i]
-    columns = header.count(",")
-    block = [header]
+    """One CSV block: the header at ``lines[i]``, then rows, each parsed alone (one line per row)."""
+    header = next(csv.reader([lines[i]]))
     i += 1
-    while i < len(lines) and lines[i].strip() and lines[i].count(",") >= columns:
-        block.append(lines[i])
+    while i < len(lines) and lines[i].strip() and lines[i].count(",") >= len(header) - 1:
+        row_text, number = lines[i], i + 1
         i += 1
-    reader = csv.DictReader(io.StringIO("\n".join(block)))
-    for offset, row in enumerate(reader, start=2):
-        _add_omm(row, source, start + offset, result)
+        if len(row_text) > MAX_CSV_ROW:
+            result.rejected.append(Rejection(source, number, f"CSV row of {len(row_text)} characters is longer "
+                                                             f"than {MAX_CSV_ROW}"))
+            continue
+        try:
+            values = next(csv.reader([row_text]))
+        except (csv.Error, StopIteration) as exc:
+            result.rejected.append(Rejection(source, number, f"CSV row cannot be read ({exc})"))
+            continue
+        _add_omm(dict(zip(header, values)), source, number, result)
     return i
 
 
-def _load_json(text: str, source: str, result: LoadResult) -> None:
+def _json_int(text: str) -> int | str:
+    """JSON integers as ints, except absurdly long ones, kept as text so only their record is refused."""
+    return int(text) if len(text) <= 30 else text
+
+
+def _load_json(text: str, source: str, result: LoadResult) -> Rejection | None:
+    """Load a JSON document; returns the problem instead when ``text`` is not JSON at all."""
     try:
-        doc = json.loads(text)
-    except (json.JSONDecodeError, RecursionError) as exc:
+        doc = json.loads(text, parse_int=_json_int)
+    except (ValueError, RecursionError) as exc:
         line = getattr(exc, "lineno", 1)
-        result.rejected.append(Rejection(source, line, f"not valid JSON ({getattr(exc, 'msg', exc)})"))
-        return
+        return Rejection(source, line, f"not valid JSON ({getattr(exc, 'msg', exc)})")
     records = doc if isinstance(doc, list) else [doc]
     for index, record in enumerate(records, start=1):
         if not isinstance(record, dict):
             result.rejected.append(Rejection(source, 1, f"JSON entry {index} is not an OMM object"))
             continue
         _add_omm(record, source, index, result, what=f"JSON entry {index}")
+    return None
 
 
 def _add_omm(record: dict, source: str, line: int, result: LoadResult, what: str = "") -> None:
-    try:
+    def build() -> ElementSet:
         name, fields = omm.omm_fields(record)
-        result.sets.append(ElementSet.from_fields(name, fields, source, line))
-    except TleError as exc:
-        prefix = f"{what}: " if what else ""
-        result.rejected.append(Rejection(source, line, prefix + str(exc)))
+        return ElementSet.from_fields(name, fields, source, line)
+
+    _accept(result, source, line, f"{what}: " if what else "", build)
 
 
 def load_element_file(path: str | os.PathLike) -> LoadResult:

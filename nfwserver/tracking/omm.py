@@ -9,6 +9,7 @@ Both forms carry the same keys (``OBJECT_NAME``, ``OBJECT_ID``, ``EPOCH``, ``MEA
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from datetime import datetime, timezone
 
@@ -27,11 +28,17 @@ def _epoch(text: str) -> datetime:
 
 
 def _designator(object_id: str) -> str:
-    """``1998-067A`` -> ``98067A``."""
-    text = str(object_id or "").strip()
+    """``1998-067A`` -> ``98067A``; characters a designator cannot hold (not A-Z, 0-9, -) are dropped."""
+    text = re.sub(r"[^0-9A-Z-]", "", str(object_id or "").strip().upper())
     if len(text) >= 9 and text[4] == "-":
         return text[2:4] + text[5:]
     return text[:8]
+
+
+def _classification(value: object) -> str:
+    """U, C or S; anything else (which a TLE line could not hold) is taken as U."""
+    text = str(value)[:1].upper()
+    return text if text in ("U", "C", "S") else "U"
 
 
 def omm_fields(record: Mapping[str, object]) -> tuple[str, TleFields]:
@@ -47,7 +54,7 @@ def omm_fields(record: Mapping[str, object]) -> tuple[str, TleFields]:
     try:
         fields = TleFields(
             catalog_number=int(get("NORAD_CAT_ID")),
-            classification=str(get("CLASSIFICATION_TYPE", "U"))[:1] or "U",
+            classification=_classification(get("CLASSIFICATION_TYPE", "U")),
             international_designator=_designator(str(get("OBJECT_ID", ""))),
             epoch=_epoch(str(get("EPOCH"))),
             mean_motion_dot=float(get("MEAN_MOTION_DOT", 0.0)),

@@ -150,8 +150,15 @@ def check_ranges(f: TleFields) -> None:
         (0.0 <= f.eccentricity < 1.0, f"eccentricity {f.eccentricity} is outside 0..1"),
         (0.0 <= f.arg_perigee_deg < 360.0 + 1e-9, f"argument of perigee {f.arg_perigee_deg} deg is outside 0..360"),
         (0.0 <= f.mean_anomaly_deg < 360.0 + 1e-9, f"mean anomaly {f.mean_anomaly_deg} deg is outside 0..360"),
-        (0.0 < f.mean_motion_rev_per_day <= 20.0, f"mean motion {f.mean_motion_rev_per_day} rev/day is outside 0..20"),
+        (1e-6 <= f.mean_motion_rev_per_day <= 20.0,
+         f"mean motion {f.mean_motion_rev_per_day} rev/day is outside 1e-6..20"),
         (f.rev_number >= 0, f"revolution number {f.rev_number} is negative"),
+        # Values a TLE can hold (non-finite ones fail every comparison): anything else could not be
+        # stored and read back.
+        (abs(f.mean_motion_dot) < 1.0, f"first derivative of mean motion {f.mean_motion_dot} is outside ±1"),
+        (abs(f.mean_motion_ddot) < 1e9, f"second derivative of mean motion {f.mean_motion_ddot} is outside ±1e9"),
+        (abs(f.bstar) < 1e9, f"BSTAR {f.bstar} is outside ±1e9"),
+        (1957 <= f.epoch.year <= 2056, f"epoch {f.epoch:%Y-%m-%d} is outside the TLE's years 1957..2056"),
     )
     for ok, message in checks:
         if not ok:

@@ -24,32 +24,65 @@ from tests.conftest import DATA
 from tests.hamlib_daemons import HamlibDaemon
 
 
-@pytest.mark.skipif(sys.platform == "win32", reason="SIGKILL")
-def test_sigkill_during_an_element_update_leaves_a_whole_catalog(tmp_path) -> None:
+def _temporaries(store) -> list:
+    return sorted(store.parent.glob(f".{store.name}.*.tmp"))
+
+
+def _run_update_and_kill(store, delay: float | None) -> str:
+    """Run ``elements update`` and SIGKILL it: after ``delay`` seconds, or (``delay`` None) while it is
+    writing the new catalog -- its temporary exists and the store has not been replaced yet, checked
+    with the process stopped (SIGSTOP) so the moment cannot slip.  Returns "mid-write", "killed",
+    "finished" or "missed" (the write was never seen)."""
+    old_inode = store.stat().st_ino
+    proc = subprocess.Popen([sys.executable, "-m", "nfwserver", "elements", "update", str(DATA / "active.txt"),
+                             "--store", str(store)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    outcome = "missed"
+    try:
+        if delay is not None:
+            time.sleep(delay)
+            outcome = "killed" if proc.poll() is None else "finished"
+        else:
+            prefix = f".{store.name}.{proc.pid}."
+            deadline = time.monotonic() + 60
+            while proc.poll() is None and time.monotonic() < deadline:
+                if any(n.startswith(prefix) for n in os.listdir(store.parent)):
+                    os.kill(proc.pid, signal.SIGSTOP)
+                    writing = any(n.startswith(prefix) for n in os.listdir(store.parent))
+                    outcome = "mid-write" if writing and store.stat().st_ino == old_inode else "killed"
+                    break
+    finally:
+        if proc.poll() is None:
+            os.kill(proc.pid, signal.SIGKILL)
+        proc.wait(10)
+    return outcome
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGKILL, SIGSTOP")
+def test_sigkill_during_an_element_update_leaves_a_whole_catalog_and_no_temporary(tmp_path) -> None:
     store = tmp_path / "elements.txt"
     visual = load_element_file(DATA / "visual.txt").sets
     ElementStore(store).update(visual)
+    store.chmod(0o644)
     old_count = len(ElementStore(store).load())
     active = {s.catalog_number for s in load_element_file(DATA / "active.txt").sets}
     expected_new = len(active | {s.catalog_number for s in visual})
-    outcomes = set()
-    for delay in (0.05, 0.2, 0.4, 0.6, 0.8, 1.0, 1.5):
+    outcomes = []
+    for delay in (None, 0.05, None, 0.6):
         store.write_text("".join(s.tle_text() for s in visual))  # back to the old catalog each round
-        proc = subprocess.Popen([sys.executable, "-m", "nfwserver", "elements", "update", str(DATA / "active.txt"),
-                                 "--store", str(store)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        time.sleep(delay)
-        if proc.poll() is None:
-            os.kill(proc.pid, signal.SIGKILL)
-            outcomes.add("killed")
-        else:
-            outcomes.add("finished")
-        proc.wait(10)
-        # Either the old catalog or the whole new one: never a partial file.
+        outcome = _run_update_and_kill(store, delay)
+        outcomes.append(outcome)
+        if outcome == "mid-write":
+            assert _temporaries(store), "a kill during the write leaves its temporary"
+        # Opening the store removes what the killed writer left ...
+        ElementStore(store)
+        assert not _temporaries(store)
+        # ... and the catalog is either the old one or the whole new one: never a partial file.
         loaded = load_element_file(store)
         assert not loaded.rejected
         assert len(loaded.sets) in (old_count, expected_new)
         assert store.read_text().count("\n") == 3 * len(loaded.sets)
-    assert "killed" in outcomes
+        assert store.stat().st_mode & 0o777 == 0o644  # permissions kept by whichever write won
+    assert outcomes.count("mid-write") == 2, outcomes  # every targeted kill hit the write itself
 
 
 def _resume_delays(daemon: HamlibDaemon, attempt, cycles: int = 20) -> list[float]:

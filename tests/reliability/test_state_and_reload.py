@@ -54,24 +54,49 @@ def test_the_selected_satellite_survives_a_restart(tmp_path) -> None:
     third.stop()
 
 
-@pytest.mark.skipif(sys.platform == "win32", reason="SIGKILL")
-def test_sigkill_during_state_saves_leaves_a_valid_file(tmp_path) -> None:
+_SAVER = (
+    "import itertools, sys\n"
+    "from nfwserver.app.session_state import SessionState, StateFile\n"
+    "f = StateFile(sys.argv[1])\n"
+    "for k in itertools.count(2):\n"
+    "    f.save(SessionState(k))\n"
+    "    print(k, flush=True)  # k is on disk\n"
+)
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGKILL, SIGSTOP")
+def test_sigkill_during_state_saves_leaves_the_last_saved_state_and_no_temporary(tmp_path) -> None:
+    """Saves are confirmed one by one on stdout, so "saved" is told from "never saved": after the kill
+    the file holds the last confirmed state or the one being written, never an older one."""
     state = tmp_path / "state.json"
     StateFile(state).save(SessionState(1))
-    script = (
-        "import itertools, sys\n"
-        "from nfwserver.app.session_state import SessionState, StateFile\n"
-        f"f = StateFile({str(state)!r})\n"
-        "for k in itertools.count(2):\n"
-        "    f.save(SessionState(k))\n"
-    )
-    for delay in (0.05, 0.1, 0.2, 0.3, 0.5):
-        proc = subprocess.Popen([sys.executable, "-c", script])
-        time.sleep(delay)
+    state.chmod(0o640)
+    mid_write = 0
+    for delay in (0.05, None, 0.2, None, None):
+        proc = subprocess.Popen([sys.executable, "-c", _SAVER, str(state)], stdout=subprocess.PIPE, text=True)
+        first = int(proc.stdout.readline())  # saving has started (the old test often killed before that)
+        if delay is None:  # kill while a save is writing: its temporary exists (checked with the saver stopped)
+            prefix = f".{state.name}.{proc.pid}."
+            deadline = time.monotonic() + 30
+            while time.monotonic() < deadline:
+                if any(n.startswith(prefix) for n in os.listdir(tmp_path)):
+                    os.kill(proc.pid, signal.SIGSTOP)
+                    if any(n.startswith(prefix) for n in os.listdir(tmp_path)):
+                        mid_write += 1
+                        break
+                    os.kill(proc.pid, signal.SIGCONT)
+        else:
+            time.sleep(delay)
         os.kill(proc.pid, signal.SIGKILL)
-        proc.wait(5)
-        assert isinstance(StateFile(state).load().satellite, int)
-        assert json.loads(state.read_text())["satellite"] >= 1
+        confirmed = [first] + [int(line) for line in proc.stdout.read().split()]  # EOF: the saver is dead
+        proc.stdout.close()
+        proc.wait(10)
+        saved = json.loads(state.read_text())["satellite"]
+        assert confirmed[-1] <= saved <= confirmed[-1] + 1
+        assert StateFile(state).load().satellite == saved  # opening it removes the killed writer's temporary
+        assert not list(tmp_path.glob(".state.json.*.tmp"))
+        assert state.stat().st_mode & 0o777 == 0o640
+    assert mid_write == 3
 
 
 def test_configuration_changed_while_running(tmp_path) -> None:
