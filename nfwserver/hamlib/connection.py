@@ -26,6 +26,7 @@ import logging
 import socket
 
 from nfwserver.clock import Clock
+from nfwserver.hamlib.commands import HamlibCommand
 from nfwserver.hamlib.errors import describe_rprt
 from nfwserver.ratelimited_log import RateLimitedLog
 
@@ -159,6 +160,10 @@ class HamlibConnection:
         except (OSError, ValueError) as exc:  # timeout, reset, broken pipe, garbage numbers
             self._fail(str(exc) or type(exc).__name__)
             raise HamlibUnavailable(f"{self.name} at {self.host}:{self.port}: {exc or type(exc).__name__}") from None
+
+    def call(self, command: HamlibCommand, *args: object) -> list[str]:
+        """Send one command from :mod:`nfwserver.hamlib.commands` and read its reply (see :meth:`transact`)."""
+        return self.transact(command.line(*args), command.reply_lines)
 
     def close(self) -> None:
         if self._sock is not None:

@@ -11,6 +11,16 @@ from __future__ import annotations
 import math
 
 from nfwserver.clock import Clock
+from nfwserver.hamlib.commands import (
+    GET_FREQUENCY,
+    GET_SPLIT_FREQUENCY,
+    SET_FREQUENCY,
+    SET_MODE,
+    SET_SPLIT_FREQUENCY,
+    SET_SPLIT_MODE,
+    SET_SPLIT_VFO,
+    HamlibCommand,
+)
 from nfwserver.hamlib.connection import HamlibConnection, HamlibError, HamlibUnavailable
 from nfwserver.radio.backend import RadioError, RadioUnavailable
 from nfwserver.radio.modes import HAMLIB_MODES
@@ -30,48 +40,48 @@ class RigctldBackend:
     def __init__(self, clock: Clock, host: str = "127.0.0.1", port: int = 4532, timeout_s: float = 1.0) -> None:
         self.connection = HamlibConnection(host, port, clock, name="rigctld", timeout_s=timeout_s)
 
-    def _do(self, command: str, lines: int = 0) -> list[str]:
+    def _do(self, command: HamlibCommand, *args: object) -> list[str]:
         try:
-            return self.connection.transact(command, lines)
+            return self.connection.call(command, *args)
         except HamlibUnavailable as exc:
             raise RadioUnavailable(str(exc)) from None
         except HamlibError as exc:
             raise RadioError(str(exc)) from None
 
-    def _get_hz(self, command: str) -> int:
+    def _get_hz(self, command: HamlibCommand) -> int:
         """A frequency read back (Hz); non-finite or outside 100 kHz..300 GHz is a device fault."""
-        (line,) = self._do(command, 1)
+        (line,) = self._do(command)
         try:
             value = float(line)
         except ValueError:
             value = math.nan
         if not MIN_FREQUENCY_HZ <= value <= MAX_FREQUENCY_HZ:
-            raise RadioError(str(self.connection.fault(f"{line[:20]!r} to '{command}' is not a frequency "
+            raise RadioError(str(self.connection.fault(f"{line[:20]!r} to '{command.letter}' is not a frequency "
                                                        "within 100 kHz..300 GHz")))
         return int(value)
 
     def set_rx_frequency(self, hz: int) -> None:
-        self._do(f"F {_check_hz(hz)}")
+        self._do(SET_FREQUENCY, _check_hz(hz))
 
     def get_rx_frequency(self) -> int:
-        return self._get_hz("f")
+        return self._get_hz(GET_FREQUENCY)
 
     def set_tx_frequency(self, hz: int) -> None:
-        self._do(f"I {_check_hz(hz)}")
+        self._do(SET_SPLIT_FREQUENCY, _check_hz(hz))
 
     def get_tx_frequency(self) -> int:
-        return self._get_hz("i")
+        return self._get_hz(GET_SPLIT_FREQUENCY)
 
     def set_split(self, on: bool) -> None:
-        self._do(f"S {1 if on else 0} VFOB")
+        self._do(SET_SPLIT_VFO, 1 if on else 0, "VFOB")
 
     def set_modes(self, rx_mode: str, tx_mode: str | None) -> None:
         for mode in (rx_mode, tx_mode):
             if mode is not None and mode.upper() not in HAMLIB_MODES:
                 raise RadioError(f"mode {mode!r} is not a Hamlib mode")
-        self._do(f"M {rx_mode.upper()} 0")
+        self._do(SET_MODE, rx_mode.upper(), 0)
         if tx_mode is not None:
-            self._do(f"X {tx_mode.upper()} 0")
+            self._do(SET_SPLIT_MODE, tx_mode.upper(), 0)
 
     def close(self) -> None:
         self.connection.close()

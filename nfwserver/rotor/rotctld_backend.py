@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 
 from nfwserver.clock import Clock
+from nfwserver.hamlib.commands import GET_POSITION, SET_POSITION, STOP_ROTOR, HamlibCommand
 from nfwserver.hamlib.connection import HamlibConnection, HamlibError, HamlibUnavailable
 from nfwserver.rotor.backend import RotorError, RotorUnavailable
 from nfwserver.rotor.geometry import RotorGeometry
@@ -25,9 +26,9 @@ class RotctldBackend:
         self.geometry = geometry
         self.connection = HamlibConnection(host, port, clock, name="rotctld", timeout_s=timeout_s)
 
-    def _do(self, command: str, lines: int = 0) -> list[str]:
+    def _do(self, command: HamlibCommand, *args: object) -> list[str]:
         try:
-            return self.connection.transact(command, lines)
+            return self.connection.call(command, *args)
         except HamlibUnavailable as exc:
             raise RotorUnavailable(str(exc)) from None
         except HamlibError as exc:
@@ -39,7 +40,7 @@ class RotctldBackend:
             g.az_min - 1e-6 <= azimuth_deg <= g.az_max + 1e-6 and g.el_min - 1e-6 <= elevation_deg <= g.el_max + 1e-6
         ):
             raise RotorError(f"({azimuth_deg:.2f}, {elevation_deg:.2f}) is outside the rotor's range")
-        self._do(f"P {azimuth_deg:.2f} {elevation_deg:.2f}")
+        self._do(SET_POSITION, f"{azimuth_deg:.2f}", f"{elevation_deg:.2f}")
 
     def get_position(self) -> tuple[float, float]:
         """The rotor's position (rotor frame, degrees); a non-finite or out-of-range reply is a device fault.
@@ -47,7 +48,7 @@ class RotctldBackend:
         A reply may lie up to :data:`POSITION_SLACK_DEG` outside the configured range (rotors
         overshoot their stops a little); anything further is refused, as is anything not a number.
         """
-        az_text, el_text = self._do("p", 2)
+        az_text, el_text = self._do(GET_POSITION)
         try:
             az, el = float(az_text), float(el_text)
         except ValueError:
@@ -59,7 +60,7 @@ class RotctldBackend:
         return az, el
 
     def stop(self) -> None:
-        self._do("S")
+        self._do(STOP_ROTOR)
 
     def close(self) -> None:
         self.connection.close()
