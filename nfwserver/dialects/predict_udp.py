@@ -22,7 +22,6 @@ The server binds 127.0.0.1 unless told otherwise; a malformed datagram gets ``Hu
 from __future__ import annotations
 
 import logging
-import math
 import socket
 import threading
 import time
@@ -30,24 +29,19 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from datetime import datetime, timedelta, timezone
 
-import numpy as np
-
 from nfwserver import __version__
 from nfwserver.clock import Clock
 from nfwserver.core.state import StationState
+from nfwserver.tracking.bodies import BodyView, moon_view, sun_view
 from nfwserver.tracking.catalog import Catalog, Satellite
-from nfwserver.tracking.derived import geodetic_from_itrs, revolution_and_phase
-from nfwserver.tracking.doppler import SPEED_OF_LIGHT_KM_S
+from nfwserver.tracking.constants import SPEED_OF_LIGHT_KM_S
+from nfwserver.tracking.derived import satellite_report
 from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError
-from nfwserver.tracking.moon import moon_position_km
 from nfwserver.tracking.observer import Observer
 from nfwserver.tracking.passes import find_passes
-from nfwserver.tracking.sun import is_sunlit, sun_position_km
-from nfwserver.tracking.timescale import SECONDS_PER_DAY, gmst1982, julian_date
 
 log = logging.getLogger(__name__)
 DEFAULT_PORT = 1210
-EARTH_RADIUS_KM = 6378.16  # PREDICT's value for the footprint
 
 
 @dataclass
@@ -138,9 +132,9 @@ class PredictProtocol:
                 self.ctx.on_reload()
             return ""
         if text.startswith("GET_SUN"):
-            return self._body(sun_position_km(*julian_date(now)), now)
+            return self._body(sun_view(self.ctx.observer, now, self.ctx.ut1_utc))
         if text.startswith("GET_MOON"):
-            return self._body(np.array(moon_position_km(*julian_date(now))), now)
+            return self._body(moon_view(self.ctx.observer, now, self.ctx.ut1_utc))
         if text.startswith("GET_MODE"):
             return self.ctx.mode()
         if text.startswith("GET_VERSION"):
@@ -156,24 +150,12 @@ class PredictProtocol:
             return f"{int(now.timestamp())}\n"
         return "Huh?\n"
 
-    def _body(self, position_km: np.ndarray, now: datetime) -> str:
-        """az, el, declination, GHA, RA of a body given in the mean equator of date (km)."""
-        jd, fr = julian_date(now)
-        x, y, z = (float(v) for v in position_km)
-        r = math.sqrt(x * x + y * y + z * z)
-        dec = math.degrees(math.asin(z / r))
-        ra = math.degrees(math.atan2(y, x)) % 360.0
-        theta, _ = gmst1982(jd, fr + self.ctx.ut1_utc / SECONDS_PER_DAY)
-        gha = (math.degrees(theta) - ra) % 360.0
-        c, s = math.cos(theta), math.sin(theta)
-        fixed = np.array([c * x + s * y, -s * x + c * y, z])
-        obs = self.ctx.observer
-        d = fixed - np.array(obs.itrs_km())
-        e, n, u = (np.array(v) for v in obs.enu_basis())
-        az = math.degrees(math.atan2(float(d @ e), float(d @ n))) % 360.0
-        el = math.degrees(math.asin(float(d @ u) / float(np.linalg.norm(d))))
-        return (f"{_c_float(az, '%-7.2f')}\n{_c_float(el, '%+-6.2f')}\n{_c_float(dec, '%-7.2f')}\n"
-                f"{_c_float(gha, '%-7.2f')}\n{_c_float(ra, '%-7.2f')}\n")
+    @staticmethod
+    def _body(view: BodyView) -> str:
+        """az, el, declination, GHA, RA of the Sun or the Moon."""
+        return (f"{_c_float(view.azimuth_deg, '%-7.2f')}\n{_c_float(view.elevation_deg, '%+-6.2f')}\n"
+                f"{_c_float(view.declination_deg, '%-7.2f')}\n{_c_float(view.greenwich_hour_angle_deg, '%-7.2f')}\n"
+                f"{_c_float(view.right_ascension_deg, '%-7.2f')}\n")
 
     def _next_event(self, sat: Satellite, now: datetime, up: bool) -> datetime | None:
         cached = self.ctx._next_event.get(sat.catalog_number)
@@ -187,34 +169,19 @@ class PredictProtocol:
         return cached[2]
 
     def _get_sat(self, sat: Satellite, now: datetime) -> str:
-        calc = LookAngleCalculator(self.ctx.observer, self.ctx.ut1_utc)
         try:
-            la = calc.compute(sat.satrec, now)
+            rep = satellite_report(sat.elements, self.ctx.observer, now, self.ctx.ut1_utc)
         except PropagationError:
             return "Huh?\n"
-        jd, fr = julian_date(now)
-        _, r, v = sat.satrec.sgp4(jd, fr)
-        theta, _ = gmst1982(jd, fr + self.ctx.ut1_utc / SECONDS_PER_DAY)
-        c, s = math.cos(theta), math.sin(theta)
-        lat, lon_e, alt = geodetic_from_itrs(c * r[0] + s * r[1], -s * r[0] + c * r[1], r[2])
-        west = -lon_e % 360.0
-        footprint = 12756.33 * math.acos(EARTH_RADIUS_KM / (EARTH_RADIUS_KM + alt))
-        speed = math.sqrt(sum(x * x for x in v))
-        rev, phase = revolution_and_phase(sat.elements, now)
-        sun = sun_position_km(jd, fr)
-        sunlit = bool(is_sunlit(np.array(r), sun))
-        sun_el = float(self._body(sun, now).split("\n")[1])
-        if la.elevation_deg >= 0.0 and sunlit:
-            visibility = "V" if sun_el <= -12.0 else "D"
-        else:
-            visibility = "N"
-        event = self._next_event(sat, now, la.elevation_deg >= 0.0)
+        west = -rep.longitude_deg % 360.0
+        event = self._next_event(sat, now, rep.elevation_deg >= 0.0)
         next_event = int(event.timestamp()) if event is not None else 0
-        eclipse_depth = 0.0 if sunlit else -1.0
-        return (f"{sat.name}\n{_c_float(west, '%-7.2f')}\n{_c_float(lat, '%+-6.2f')}\n"
-                f"{_c_float(la.azimuth_deg, '%-7.2f')}\n{_c_float(la.elevation_deg, '%+-6.2f')}\n{next_event}\n"
-                f"{_c_float(footprint, '%-7.2f')}\n{_c_float(la.range_km, '%-7.2f')}\n{_c_float(alt, '%-7.2f')}\n"
-                f"{_c_float(speed, '%-7.2f')}\n{rev}\n{visibility}\n{_c_float(phase, '%-7.2f')}\n"
+        eclipse_depth = 0.0 if rep.sunlit else -1.0
+        return (f"{sat.name}\n{_c_float(west, '%-7.2f')}\n{_c_float(rep.latitude_deg, '%+-6.2f')}\n"
+                f"{_c_float(rep.azimuth_deg, '%-7.2f')}\n{_c_float(rep.elevation_deg, '%+-6.2f')}\n{next_event}\n"
+                f"{_c_float(rep.footprint_km, '%-7.2f')}\n{_c_float(rep.range_km, '%-7.2f')}\n"
+                f"{_c_float(rep.height_km, '%-7.2f')}\n{_c_float(rep.speed_km_s, '%-7.2f')}\n{rep.rev}\n"
+                f"{rep.visibility}\n{_c_float(rep.phase, '%-7.2f')}\n"
                 f"{_c_float(eclipse_depth, '%-7.2f')}\n{_c_float(360.0, '%-7.2f')}\n")
 
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 from nfwserver.radio.backend import RadioBackend, RadioError, RadioUnavailable
 from nfwserver.radio.transponder import Channel
-from nfwserver.tracking.doppler import SPEED_OF_LIGHT_KM_S
+from nfwserver.tracking.constants import SPEED_OF_LIGHT_KM_S
 
 log = logging.getLogger(__name__)
 
