@@ -44,9 +44,10 @@ class PredictUdpServer:
         sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         try:
             sock.bind((self.host, self.port))
-        except OSError:
+        except OSError as exc:
             sock.close()
-            raise
+            raise OSError(exc.errno, f"PREDICT UDP cannot listen on {self.host}:{self.port} "
+                                     f"([dialects] predict_host/predict_port): {exc.strerror or exc}") from None
         sock.settimeout(0.2)
         self.sock = sock
         self.address = sock.getsockname()
