@@ -52,7 +52,7 @@ class RateLimitedLog:
             self._windows[key] = _Window(now)
         if suppressed:
             message += f" ({suppressed} more like this in the last {elapsed:.0f} s)"
-        self.logger.log(level, message, *args, exc_info=exc_info)
+        self.logger.log(level, message, *args, exc_info=exc_info or None)
         return True
 
     def warning(self, key: str, message: str, *args: object) -> bool:

@@ -68,7 +68,7 @@ class Station:
                                           initial=bool(config.elements.urls))
         self.predict: PredictUdpServer | None = None
         if config.dialects.predict_udp:
-            context = PredictContext(self.core.state, clock, self._predict_list, mode=self._predict_mode,
+            context = PredictContext(self.core.state, clock, self._predict_list,
                                      callsign=config.dialects.callsign, on_reload=self.refresher.request)
             self.predict = PredictUdpServer(context, config.dialects.predict_host, config.dialects.predict_port)
         self.rotor: RotorCoupling | None = make_rotor(config.rotor, self.core, clock)
@@ -86,10 +86,6 @@ class Station:
     def _predict_list(self) -> list[int]:
         catalog = self.core.state.catalog
         return list(dict.fromkeys([*self.config.favourites, *(s.catalog_number for s in catalog)]))[:24]
-
-    def _predict_mode(self) -> str:
-        sat = self.core.state.selected()
-        return f"{sat.dde_name if sat is not None else 'none'}\n"
 
     # -- live configuration ------------------------------------------------------------------------
     def apply_config(self, new: Config) -> list[str]:

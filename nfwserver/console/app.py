@@ -31,6 +31,7 @@ from nfwserver.core.station_core import StationCore
 from nfwserver.core.status import describe
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.rotor.coupling import RotorCoupling
+from nfwserver.tracking.doppler import doppler_shift_hz
 from nfwserver.tracking.look_angles import LookAngleCalculator
 from nfwserver.tracking.passes import Pass, find_passes
 
@@ -166,7 +167,7 @@ class NfwConsole(App):
             la = sample.look_angles
             lines.append(f"AZ {la.azimuth_deg:6.1f}  EL {la.elevation_deg:5.1f}  RR {la.range_rate_km_s:+.4f} km/s  "
                          f"range {la.range_km:8.1f} km  AH {'Y' if sample.above_horizon else 'N'}  "
-                         f"Doppler@145.8MHz {-145.8e6 * la.range_rate_km_s / 299792.458:+.0f} Hz")
+                         f"Doppler@145.8MHz {doppler_shift_hz(145.8e6, la.range_rate_km_s):+.0f} Hz")
         else:
             lines.append("no position (no satellite, no observer, or SGP4 error)")
         ant = snap.state.antenna

@@ -1,226 +1,34 @@
-"""PREDICT's UDP socket server (default port 1210), answering from our session.
+"""PREDICT's UDP socket server (default port 1210): datagrams in, replies to the sender's address and port.
 
-Request and reply formats follow PREDICT 2.2's ``socket_server`` (KD2BD) byte for byte: one
-datagram per request, a command word optionally followed by a blank and a satellite name or catalog
-number; replies are newline-separated fields written with C ``printf`` formats:
-
-- ``GET_SAT name``: name, sub-satellite longitude (degrees *west*, ``%-7.2f``), latitude
-  (``%+-6.2f``), azimuth, elevation, next AOS/LOS as Unix time (``%ld``), footprint diameter (km),
-  range (km), altitude (km), speed (km/s), orbit number, visibility (``V`` visible, ``D`` daylight,
-  ``N`` not visible), phase (0-256), eclipse depth (deg), squint (deg; 360 when unknown);
-- ``GET_DOPPLER name``: Doppler shift at 100 MHz (``%f``);
-- ``GET_TLE name``: name and the two element lines;
-- ``GET_LIST``: the tracked satellites' names, one per line (PREDICT always lists 24 slots);
-- ``GET_SUN`` / ``GET_MOON``: azimuth, elevation, declination, Greenwich hour angle, right ascension;
-- ``GET_QTH``: callsign, latitude, longitude (*west* positive) (``%g``), altitude in metres (``%d``);
-- ``GET_TIME``: Unix time (``%lu``); ``GET_TIME$``: ``asctime`` text with the day zero-padded;
-- ``GET_VERSION``, ``GET_MODE``, ``RELOAD_TLE`` (empty reply); anything else: ``Huh?``.
-
-The server binds 127.0.0.1 unless told otherwise; a malformed datagram gets ``Huh?`` and never stops it.
+The protocol itself is :mod:`nfwserver.dialects.predict_protocol`.  The server binds 127.0.0.1 unless
+told otherwise (anything else is warned about at start by the configuration).  One thread
+(``nfw-predict``) receives and answers every short command; the listings of ``GET_SAT_POS`` and
+``PREDICT`` — up to a day of lines — are computed and sent by a second thread (``nfw-predict-list``),
+one at a time, so a long listing never delays ``GET_SAT``.  At most :data:`LISTING_QUEUE` listings wait;
+a request beyond that gets only the end-of-listing datagram (and one rate-limited warning).  A malformed
+datagram gets ``Huh?`` and never stops the server.
 """
 
 from __future__ import annotations
 
 import logging
-import math
+import queue
 import socket
 import threading
-import time
-from collections.abc import Callable
-from dataclasses import dataclass, field
-from datetime import datetime, timedelta, timezone
 
-import numpy as np
+from nfwserver.dialects.predict_protocol import END_OF_LISTING, PredictContext, PredictProtocol
 
-from nfwserver import __version__
-from nfwserver.clock import Clock
-from nfwserver.core.state import StationState
-from nfwserver.tracking.catalog import Catalog, Satellite
-from nfwserver.tracking.derived import geodetic_from_itrs, revolution_and_phase
-from nfwserver.tracking.doppler import SPEED_OF_LIGHT_KM_S
-from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError
-from nfwserver.tracking.moon import moon_position_km
-from nfwserver.tracking.observer import Observer
-from nfwserver.tracking.passes import find_passes
-from nfwserver.tracking.sun import is_sunlit, sun_position_km
-from nfwserver.tracking.timescale import SECONDS_PER_DAY, gmst1982, julian_date
+__all__ = ["DEFAULT_PORT", "PredictContext", "PredictUdpServer"]
 
 log = logging.getLogger(__name__)
 DEFAULT_PORT = 1210
-EARTH_RADIUS_KM = 6378.16  # PREDICT's value for the footprint
-
-
-@dataclass
-class PredictContext:
-    """What the PREDICT protocol reports about: the live station state (never a copy) and its satellites."""
-
-    state: StationState
-    clock: Clock
-    tracked: Callable[[], list[int]]  #: catalog numbers listed by GET_LIST (at most 24)
-    mode: Callable[[], str] = lambda: "none"
-    callsign: str = "NFWSERVER"
-    on_reload: Callable[[], None] | None = None
-    #: next AOS/LOS per satellite: (observer it was computed for, computed at, event)
-    _next_event: dict[int, tuple[object, datetime, datetime]] = field(default_factory=dict)
-
-    def catalog(self) -> Catalog:
-        return self.state.catalog
-
-    @property
-    def observer(self) -> Observer:
-        observer = self.state.observer
-        if observer is None:
-            raise ValueError("no station location is configured")
-        return observer
-
-    @property
-    def ut1_utc(self) -> float:
-        return self.state.ut1_utc_s
-
-
-def _find(catalog: Catalog, text: str) -> Satellite | None:
-    text = text.strip()[:25]
-    if text.isdigit():
-        return catalog.get(int(text))
-    for sat in catalog:
-        if sat.name[:25] == text or sat.dde_name == text:
-            return sat
-    return None
-
-
-def _c_float(value: float, spec: str) -> str:
-    """printf-style float formatting for the specs PREDICT uses (%-7.2f, %+-6.2f, %f)."""
-    if spec == "%-7.2f":
-        return f"{value:<7.2f}"
-    if spec == "%+-6.2f":
-        return f"{value:<+6.2f}"
-    return f"{value:f}"
-
-
-class PredictProtocol:
-    """Turns one request datagram into its reply (no I/O: the server and the tests use it)."""
-
-    def __init__(self, context: PredictContext) -> None:
-        self.ctx = context
-
-    def reply(self, datagram: bytes) -> bytes:
-        try:
-            text = datagram.split(b"\x00", 1)[0].decode("ascii", errors="replace")
-            return self._reply(text).encode("ascii", errors="replace")
-        except Exception:  # a bad request must never stop the server
-            log.exception("PREDICT request failed")
-            return b"Huh?\n"
-
-    def _argument(self, text: str) -> str:
-        head, _, rest = text.partition(" ")
-        return rest.split("\n", 1)[0]
-
-    def _reply(self, text: str) -> str:
-        now = self.ctx.clock.now()
-        if text.startswith("GET_SAT") and not text.startswith("GET_SAT_POS"):
-            sat = _find(self.ctx.catalog(), self._argument(text))
-            return self._get_sat(sat, now) if sat else "Huh?\n"
-        if text.startswith("GET_TLE"):
-            sat = _find(self.ctx.catalog(), self._argument(text))
-            return f"{sat.name}\n{sat.elements.line1}\n{sat.elements.line2}\n" if sat else "Huh?\n"
-        if text.startswith("GET_DOPPLER"):
-            sat = _find(self.ctx.catalog(), self._argument(text))
-            if sat is None:
-                return "Huh?\n"
-            la = LookAngleCalculator(self.ctx.observer, self.ctx.ut1_utc).compute(sat.satrec, now)
-            return _c_float(-100e6 * la.range_rate_km_s / SPEED_OF_LIGHT_KM_S, "%f") + "\n"
-        if text.startswith("GET_LIST"):
-            catalog = self.ctx.catalog()
-            names = [catalog.get(n).name for n in self.ctx.tracked()[:24] if catalog.get(n) is not None]
-            return "".join(f"{name}\n" for name in names + [""] * (24 - len(names)))
-        if text.startswith("RELOAD_TLE"):
-            if self.ctx.on_reload is not None:
-                self.ctx.on_reload()
-            return ""
-        if text.startswith("GET_SUN"):
-            return self._body(sun_position_km(*julian_date(now)), now)
-        if text.startswith("GET_MOON"):
-            return self._body(np.array(moon_position_km(*julian_date(now))), now)
-        if text.startswith("GET_MODE"):
-            return self.ctx.mode()
-        if text.startswith("GET_VERSION"):
-            return f"{__version__}\n"
-        if text.startswith("GET_QTH"):
-            o = self.ctx.observer
-            west = -o.longitude_deg % 360.0
-            return f"{self.ctx.callsign}\n{o.latitude_deg:g}\n{west:g}\n{int(round(o.altitude_m))}\n"
-        if text.startswith("GET_TIME$"):
-            stamp = time.asctime(now.astimezone(timezone.utc).timetuple()) + "\n"
-            return stamp[:8] + "0" + stamp[9:] if stamp[8] == " " else stamp
-        if text.startswith("GET_TIME"):
-            return f"{int(now.timestamp())}\n"
-        return "Huh?\n"
-
-    def _body(self, position_km: np.ndarray, now: datetime) -> str:
-        """az, el, declination, GHA, RA of a body given in the mean equator of date (km)."""
-        jd, fr = julian_date(now)
-        x, y, z = (float(v) for v in position_km)
-        r = math.sqrt(x * x + y * y + z * z)
-        dec = math.degrees(math.asin(z / r))
-        ra = math.degrees(math.atan2(y, x)) % 360.0
-        theta, _ = gmst1982(jd, fr + self.ctx.ut1_utc / SECONDS_PER_DAY)
-        gha = (math.degrees(theta) - ra) % 360.0
-        c, s = math.cos(theta), math.sin(theta)
-        fixed = np.array([c * x + s * y, -s * x + c * y, z])
-        obs = self.ctx.observer
-        d = fixed - np.array(obs.itrs_km())
-        e, n, u = (np.array(v) for v in obs.enu_basis())
-        az = math.degrees(math.atan2(float(d @ e), float(d @ n))) % 360.0
-        el = math.degrees(math.asin(float(d @ u) / float(np.linalg.norm(d))))
-        return (f"{_c_float(az, '%-7.2f')}\n{_c_float(el, '%+-6.2f')}\n{_c_float(dec, '%-7.2f')}\n"
-                f"{_c_float(gha, '%-7.2f')}\n{_c_float(ra, '%-7.2f')}\n")
-
-    def _next_event(self, sat: Satellite, now: datetime, up: bool) -> datetime | None:
-        cached = self.ctx._next_event.get(sat.catalog_number)
-        if cached is None or cached[0] != self.ctx.observer or not (cached[1] <= now < cached[2]):
-            passes = find_passes([sat], self.ctx.observer, now, now + timedelta(days=2), ut1_utc=self.ctx.ut1_utc)
-            events = sorted(t for p in passes for t in (p.aos, p.los) if t is not None and t > now)
-            if not events:
-                return None
-            self.ctx._next_event[sat.catalog_number] = (self.ctx.observer, now, events[0])
-            return events[0]
-        return cached[2]
-
-    def _get_sat(self, sat: Satellite, now: datetime) -> str:
-        calc = LookAngleCalculator(self.ctx.observer, self.ctx.ut1_utc)
-        try:
-            la = calc.compute(sat.satrec, now)
-        except PropagationError:
-            return "Huh?\n"
-        jd, fr = julian_date(now)
-        _, r, v = sat.satrec.sgp4(jd, fr)
-        theta, _ = gmst1982(jd, fr + self.ctx.ut1_utc / SECONDS_PER_DAY)
-        c, s = math.cos(theta), math.sin(theta)
-        lat, lon_e, alt = geodetic_from_itrs(c * r[0] + s * r[1], -s * r[0] + c * r[1], r[2])
-        west = -lon_e % 360.0
-        footprint = 12756.33 * math.acos(EARTH_RADIUS_KM / (EARTH_RADIUS_KM + alt))
-        speed = math.sqrt(sum(x * x for x in v))
-        rev, phase = revolution_and_phase(sat.elements, now)
-        sun = sun_position_km(jd, fr)
-        sunlit = bool(is_sunlit(np.array(r), sun))
-        sun_el = float(self._body(sun, now).split("\n")[1])
-        if la.elevation_deg >= 0.0 and sunlit:
-            visibility = "V" if sun_el <= -12.0 else "D"
-        else:
-            visibility = "N"
-        event = self._next_event(sat, now, la.elevation_deg >= 0.0)
-        next_event = int(event.timestamp()) if event is not None else 0
-        eclipse_depth = 0.0 if sunlit else -1.0
-        return (f"{sat.name}\n{_c_float(west, '%-7.2f')}\n{_c_float(lat, '%+-6.2f')}\n"
-                f"{_c_float(la.azimuth_deg, '%-7.2f')}\n{_c_float(la.elevation_deg, '%+-6.2f')}\n{next_event}\n"
-                f"{_c_float(footprint, '%-7.2f')}\n{_c_float(la.range_km, '%-7.2f')}\n{_c_float(alt, '%-7.2f')}\n"
-                f"{_c_float(speed, '%-7.2f')}\n{rev}\n{visibility}\n{_c_float(phase, '%-7.2f')}\n"
-                f"{_c_float(eclipse_depth, '%-7.2f')}\n{_c_float(360.0, '%-7.2f')}\n")
+LISTING_QUEUE = 8  #: listings waiting for the listing thread, at most
+_STOP = object()
 
 
 class PredictUdpServer:
-    """The UDP listener on its own thread (``nfw-predict``).  Construction does no I/O; :meth:`start`
-    binds the socket (raising :class:`OSError` when the port is taken) and starts the thread."""
+    """The UDP listener and its listing thread.  Construction does no I/O; :meth:`start` binds the socket
+    (raising :class:`OSError` when the port is taken, with nothing left running) and starts the threads."""
 
     def __init__(self, context: PredictContext, host: str = "127.0.0.1", port: int = DEFAULT_PORT) -> None:
         self.protocol = PredictProtocol(context)
@@ -228,20 +36,33 @@ class PredictUdpServer:
         self.sock: socket.socket | None = None
         self.address: tuple[str, int] = (host, port)
         self._stop = threading.Event()
+        self._listings: queue.Queue = queue.Queue(maxsize=LISTING_QUEUE)
         self._thread = threading.Thread(target=self._run, name="nfw-predict", daemon=True)
+        self._lister = threading.Thread(target=self._run_listings, name="nfw-predict-list", daemon=True)
 
     def start(self) -> None:
         sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         try:
             sock.bind((self.host, self.port))
-        except OSError:
+        except OSError as exc:
             sock.close()
-            raise
+            raise OSError(exc.errno, f"PREDICT UDP cannot listen on {self.host}:{self.port} "
+                                     f"([dialects] predict_host/predict_port): {exc.strerror or exc}") from None
         sock.settimeout(0.2)
         self.sock = sock
         self.address = sock.getsockname()
         log.info("PREDICT protocol on UDP %s:%d", *self.address)
         self._thread.start()
+        self._lister.start()
+
+    def _send(self, payload: bytes, peer: tuple[str, int]) -> None:
+        sock = self.sock
+        if sock is None:
+            return
+        try:
+            sock.sendto(payload, peer)
+        except OSError as exc:
+            self.protocol.diagnostics.warning("send", "PREDICT reply to %s failed: %s", peer, exc)
 
     def _run(self) -> None:
         sock = self.sock
@@ -255,14 +76,39 @@ class PredictUdpServer:
                 if self._stop.is_set():
                     return
                 continue
-            try:
-                sock.sendto(self.protocol.reply(data), peer)
-            except OSError as exc:
-                log.warning("PREDICT reply to %s failed: %s", peer, exc)
+            if self.protocol.is_listing(data):
+                try:
+                    self._listings.put_nowait((data, peer))
+                except queue.Full:
+                    self.protocol.diagnostics.warning("listing-queue", "PREDICT listing from %s dropped: %d "
+                                                      "listings already waiting", peer, LISTING_QUEUE)
+                    self._send(END_OF_LISTING, peer)
+                continue
+            self._send(self.protocol.reply(data), peer)
+
+    def _run_listings(self) -> None:
+        while True:
+            item = self._listings.get()
+            if item is _STOP:
+                return
+            data, peer = item
+            for datagram in self.protocol.listing(data):
+                if self._stop.is_set():
+                    return
+                self._send(datagram, peer)
 
     def stop(self) -> None:
         self._stop.set()
         if self._thread.is_alive():
             self._thread.join(2.0)
+        if self._lister.is_alive():
+            while True:  # make room for the stop marker: waiting listings are abandoned
+                try:
+                    self._listings.get_nowait()
+                except queue.Empty:
+                    break
+            self._listings.put(_STOP)
+            self._lister.join(2.0)
         if self.sock is not None:
             self.sock.close()
+            self.sock = None

@@ -27,7 +27,7 @@ import math
 from dataclasses import dataclass, replace
 
 from nfwserver.radio.modes import check_mode
-from nfwserver.tracking.doppler import SPEED_OF_LIGHT_KM_S
+from nfwserver.tracking.constants import SPEED_OF_LIGHT_KM_S
 
 HOLD_SIDES = ("satellite", "uplink", "downlink")
 #: Frequencies accepted for a channel (Hz): 100 kHz to 300 GHz.

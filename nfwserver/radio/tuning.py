@@ -25,7 +25,7 @@ from nfwserver.clock import Clock, SystemClock
 from nfwserver.radio.backend import RadioBackend, RadioError, RadioUnavailable
 from nfwserver.radio.transponder import Channel
 from nfwserver.ratelimited_log import RateLimitedLog
-from nfwserver.tracking.doppler import SPEED_OF_LIGHT_KM_S
+from nfwserver.tracking.constants import SPEED_OF_LIGHT_KM_S
 
 log = logging.getLogger(__name__)
 

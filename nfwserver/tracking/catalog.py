@@ -14,12 +14,9 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from datetime import datetime
 
+from nfwserver.tracking.constants import SECONDS_PER_DAY, WGS72_A_KM, WGS72_MU_KM3_S2
 from nfwserver.tracking.dde_names import assign_dde_names, validate_dde_name
 from nfwserver.tracking.elements import ElementSet
-
-#: WGS72 constants used by SGP4: Earth radius (km) and gravitational parameter (km^3/s^2).
-_WGS72_RADIUS_KM = 6378.135
-_WGS72_MU = 398600.8
 
 
 @dataclass(frozen=True)
@@ -43,14 +40,14 @@ class Satellite:
 
     def age_days(self, at: datetime) -> float:
         """Element age at ``at``: days since the epoch (negative before it)."""
-        return (at - self.elements.epoch).total_seconds() / 86400.0
+        return (at - self.elements.epoch).total_seconds() / SECONDS_PER_DAY
 
     @property
     def perigee_height_km(self) -> float:
         """Perigee height above the equatorial radius (km), from the mean motion (WGS72)."""
-        n = self.elements.mean_motion_rev_per_day * 2.0 * math.pi / 86400.0
-        a = (_WGS72_MU / (n * n)) ** (1.0 / 3.0)
-        return a * (1.0 - self.elements.eccentricity) - _WGS72_RADIUS_KM
+        n = self.elements.mean_motion_rev_per_day * 2.0 * math.pi / SECONDS_PER_DAY
+        a = (WGS72_MU_KM3_S2 / (n * n)) ** (1.0 / 3.0)
+        return a * (1.0 - self.elements.eccentricity) - WGS72_A_KM
 
     @property
     def is_decayed(self) -> bool:

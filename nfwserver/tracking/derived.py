@@ -19,17 +19,26 @@ from dataclasses import dataclass
 from datetime import datetime
 
 import numpy as np
-from sgp4.api import SatrecArray
 
-from nfwserver.tracking.doppler import SPEED_OF_LIGHT_KM_S, doppler_shift_hz
+from nfwserver.tracking.bodies import sun_view
+from nfwserver.tracking.constants import (
+    PREDICT_EARTH_RADIUS_KM,
+    PREDICT_FOOTPRINT_FACTOR_KM,
+    SECONDS_PER_DAY,
+    SPEED_OF_LIGHT_KM_S,
+    WGS84_A_KM,
+    WGS84_E2,
+)
+from nfwserver.tracking.doppler import doppler_shift_hz
 from nfwserver.tracking.elements import ElementSet
-from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError, earth_fixed_states
+from nfwserver.tracking.frames import ScalarLookAngles
+from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError
 from nfwserver.tracking.maidenhead import latlon_to_locator
-from nfwserver.tracking.observer import WGS84_A_KM, WGS84_F, Observer
+from nfwserver.tracking.observer import Observer
 from nfwserver.tracking.sun import is_sunlit, sun_position_km
 from nfwserver.tracking.timescale import julian_date
 
-_E2 = WGS84_F * (2.0 - WGS84_F)
+_E2 = WGS84_E2
 _SCHEDULE = re.compile(r"(\d{3})(.)")
 
 
@@ -61,7 +70,7 @@ def geodetic_from_itrs(x: float, y: float, z: float) -> tuple[float, float, floa
 
 def revolution_and_phase(elements: ElementSet, when: datetime) -> tuple[int, int]:
     """(rev number, phase 0-255) at ``when`` from the mean motion and its first derivative."""
-    dt = (when - elements.epoch).total_seconds() / 86400.0
+    dt = (when - elements.epoch).total_seconds() / SECONDS_PER_DAY
     fields_ndot = _ndot(elements)
     turns = elements.mean_anomaly_deg / 360.0 + elements.mean_motion_rev_per_day * dt + fields_ndot * dt * dt
     rev = elements.rev_number + math.floor(turns)
@@ -129,11 +138,9 @@ def realtime_values(elements: ElementSet, observer: Observer, when: datetime, ut
     """Compute the realtime screen for ``elements`` at ``when``; raises PropagationError if SGP4 fails."""
     la = LookAngleCalculator(observer, ut1_utc).compute(elements.satrec, when)
     jd, fr = julian_date(when)
-    pos, _, err = earth_fixed_states(SatrecArray([elements.satrec]), np.array([jd]), np.array([fr]), ut1_utc)
-    if err[0, 0]:
-        raise PropagationError(int(err[0, 0]))
-    lat, lon, height = geodetic_from_itrs(*pos[0, 0])
-    _, r_teme, _ = elements.satrec.sgp4(jd, fr)
+    _, r_teme, v_teme = elements.satrec.sgp4(jd, fr)
+    x, y, z, _, _, _ = ScalarLookAngles(observer, ut1_utc).itrs(r_teme, v_teme, jd, fr)
+    lat, lon, height = geodetic_from_itrs(x, y, z)
     sunlit = bool(is_sunlit(np.array(r_teme), sun_position_km(jd, fr)))
     rev, phase = revolution_and_phase(elements, when)
     return RealtimeValues(
@@ -144,3 +151,56 @@ def realtime_values(elements: ElementSet, observer: Observer, when: datetime, ut
         path_loss_db=path_loss_db(la.range_km, frequency_hz) if frequency_hz else None,
         doppler_hz=doppler_shift_hz(frequency_hz, la.range_rate_km_s) if frequency_hz else None,
     )
+
+
+def footprint_km(height_km: float) -> float:
+    """PREDICT's footprint diameter (km) for a satellite ``height_km`` above the ellipsoid."""
+    return PREDICT_FOOTPRINT_FACTOR_KM * math.acos(PREDICT_EARTH_RADIUS_KM / (PREDICT_EARTH_RADIUS_KM + height_km))
+
+
+def visibility_code(elevation_deg: float, sunlit: bool, sun_elevation_deg: float) -> str:
+    """PREDICT's visibility letter: ``V`` up, lit and the sky dark (Sun at or below -12 deg), ``D`` up and
+    lit in daylight or twilight, ``N`` otherwise."""
+    if elevation_deg >= 0.0 and sunlit:
+        return "V" if sun_elevation_deg <= -12.0 else "D"
+    return "N"
+
+
+@dataclass(frozen=True)
+class SatelliteReport:
+    """What PREDICT's ``GET_SAT`` reports about a satellite at one instant (besides the next event)."""
+
+    azimuth_deg: float
+    elevation_deg: float
+    range_km: float
+    latitude_deg: float  #: sub-satellite point, geodetic
+    longitude_deg: float  #: sub-satellite point, east positive, -180..180
+    height_km: float  #: above the WGS84 ellipsoid
+    footprint_km: float
+    speed_km_s: float  #: TEME (inertial) speed
+    rev: int
+    phase: int
+    sunlit: bool
+    visibility: str
+
+
+def satellite_report(elements: ElementSet, observer: Observer, when: datetime,
+                     ut1_utc: float = 0.0) -> SatelliteReport:
+    """Look angles, sub-satellite point, footprint, speed, orbit number, phase and visibility.
+
+    Raises :class:`PropagationError` when SGP4 fails.
+    """
+    jd, fr = julian_date(when)
+    err, r, v = elements.satrec.sgp4(jd, fr)
+    if err:
+        raise PropagationError(err)
+    scalar = ScalarLookAngles(observer, ut1_utc)
+    az, el, rng, _ = scalar.look(r, v, jd, fr)
+    x, y, z, _, _, _ = scalar.itrs(r, v, jd, fr)
+    lat, lon, height = geodetic_from_itrs(x, y, z)
+    sunlit = bool(is_sunlit(np.array(r), sun_position_km(jd, fr)))
+    sun_el = sun_view(observer, when, ut1_utc).elevation_deg
+    rev, phase = revolution_and_phase(elements, when)
+    return SatelliteReport(az, el, rng, lat, (lon + 180.0) % 360.0 - 180.0, height, footprint_km(height),
+                           math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]), rev, phase, sunlit,
+                           visibility_code(el, sunlit, sun_el))

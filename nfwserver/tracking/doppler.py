@@ -11,14 +11,15 @@ formulas are used, as every amateur tracking program does; the second-order term
 
 from __future__ import annotations
 
-#: Speed of light in vacuum, km/s.
-SPEED_OF_LIGHT_KM_S = 299_792.458
+from nfwserver.tracking.constants import SPEED_OF_LIGHT_KM_S
+
+__all__ = ["SPEED_OF_LIGHT_KM_S", "doppler_shift_hz", "downlink_frequency_hz", "uplink_frequency_hz"]
 
 
 def doppler_shift_hz(frequency_hz: float, range_rate_km_s: float) -> float:
     """Shift (Hz) of a signal of ``frequency_hz`` sent by the satellite, as received on the ground.
 
-    Equals Nova's ``DopplerHz = -FreqHz * RR / 299792.458``.
+    Equals Nova's ``DopplerHz = -FreqHz * RR / c``.
     """
     return -frequency_hz * range_rate_km_s / SPEED_OF_LIGHT_KM_S
 

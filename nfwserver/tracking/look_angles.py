@@ -16,17 +16,15 @@ many times through ``sgp4``'s ``SatrecArray`` (numpy).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from datetime import datetime
 
 import numpy as np
 from sgp4.api import SGP4_ERRORS, SatrecArray
 
+from nfwserver.tracking.frames import ScalarLookAngles, itrs_to_topocentric, teme_to_itrs
 from nfwserver.tracking.observer import Observer
-from nfwserver.tracking.timescale import SECONDS_PER_DAY, gmst1982, julian_date
-
-_DEG = 180.0 / math.pi
+from nfwserver.tracking.timescale import julian_date
 
 
 class PropagationError(ArithmeticError):
@@ -54,16 +52,14 @@ class LookAngleCalculator:
     of leaving it at 0).  Thread-safe: holds only immutable precomputed observer terms.
     """
 
-    __slots__ = ("observer", "ut1_utc", "_ox", "_oy", "_oz", "_e", "_n", "_u", "_ut1_days")
+    __slots__ = ("observer", "ut1_utc", "_scalar")
 
     def __init__(self, observer: Observer, ut1_utc: float = 0.0) -> None:
-        if not math.isfinite(ut1_utc) or abs(ut1_utc) > 1.0:
+        if not abs(ut1_utc) <= 1.0:
             raise ValueError(f"UT1-UTC {ut1_utc} s is outside -1..1 s")
         self.observer = observer
         self.ut1_utc = ut1_utc
-        self._ut1_days = ut1_utc / SECONDS_PER_DAY
-        self._ox, self._oy, self._oz = observer.itrs_km()
-        self._e, self._n, self._u = observer.enu_basis()
+        self._scalar = ScalarLookAngles(observer, ut1_utc)
 
     def compute(self, satrec, when: datetime) -> LookAngles:
         """Look angles of ``satrec`` (an ``sgp4.api.Satrec``) at ``when`` (aware UTC).
@@ -78,26 +74,7 @@ class LookAngleCalculator:
         err, r, v = satrec.sgp4(jd, fr)
         if err:
             raise PropagationError(err)
-        theta, theta_dot = gmst1982(jd, fr + self._ut1_days)
-        c, s = math.cos(theta), math.sin(theta)
-        x = c * r[0] + s * r[1]
-        y = -s * r[0] + c * r[1]
-        z = r[2]
-        w = theta_dot / SECONDS_PER_DAY
-        vx = c * v[0] + s * v[1] + w * y
-        vy = -s * v[0] + c * v[1] - w * x
-        vz = v[2]
-        dx, dy, dz = x - self._ox, y - self._oy, z - self._oz
-        e, n, u = self._e, self._n, self._u
-        east = e[0] * dx + e[1] * dy
-        north = n[0] * dx + n[1] * dy + n[2] * dz
-        up = u[0] * dx + u[1] * dy + u[2] * dz
-        rng = math.sqrt(dx * dx + dy * dy + dz * dz)
-        az = math.atan2(east, north) * _DEG
-        if az < 0.0:
-            az += 360.0
-        el = math.asin(up / rng) * _DEG
-        return LookAngles(az, el, rng, (dx * vx + dy * vy + dz * vz) / rng)
+        return LookAngles(*self._scalar.look(r, v, jd, fr))
 
 
 @dataclass(frozen=True)
@@ -121,32 +98,9 @@ def earth_fixed_states(
     jd = np.atleast_1d(np.asarray(jd, dtype=float))
     fr = np.atleast_1d(np.asarray(fr, dtype=float))
     err, r, v = satrecs.sgp4(jd, fr)
-    theta, theta_dot = gmst1982(jd, fr + ut1_utc / SECONDS_PER_DAY)
-    c, s = np.cos(theta), np.sin(theta)
-    w = theta_dot / SECONDS_PER_DAY
-    x = c * r[..., 0] + s * r[..., 1]
-    y = -s * r[..., 0] + c * r[..., 1]
-    pos = np.stack((x, y, r[..., 2]), axis=-1)
-    vel = np.stack(
-        (c * v[..., 0] + s * v[..., 1] + w * y, -s * v[..., 0] + c * v[..., 1] - w * x, v[..., 2]), axis=-1
-    )
+    pos, vel = teme_to_itrs(r, v, jd, fr, ut1_utc)
+    assert vel is not None
     return pos, vel, err
-
-
-def topocentric_from_earth_fixed(
-    observer: Observer, pos: np.ndarray, vel: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Azimuth (deg), elevation (deg), range (km), range rate (km/s) from Earth-fixed states."""
-    d = pos - np.array(observer.itrs_km())
-    e, n, u = (np.array(b) for b in observer.enu_basis())
-    east = d @ e
-    north = d @ n
-    up = d @ u
-    rng = np.sqrt(np.einsum("...i,...i->...", d, d))
-    az = np.degrees(np.arctan2(east, north)) % 360.0
-    el = np.degrees(np.arcsin(up / rng))
-    rr = np.einsum("...i,...i->...", d, vel) / rng
-    return az, el, rng, rr
 
 
 def look_angles_array(
@@ -157,7 +111,7 @@ def look_angles_array(
         satrecs = SatrecArray(list(satrecs))
     pos, vel, err = earth_fixed_states(satrecs, jd, fr, ut1_utc)
     with np.errstate(invalid="ignore"):
-        az, el, rng, rr = topocentric_from_earth_fixed(observer, pos, vel)
+        az, el, rng, rr = itrs_to_topocentric(observer, pos, vel)
     bad = err != 0
     if bad.any():
         for a in (az, el, rng, rr):

@@ -9,11 +9,13 @@ from __future__ import annotations
 
 import math
 
-EARTH_RADIUS_KM = 6378.14
+from nfwserver.tracking.constants import ALMANAC_EARTH_RADIUS_KM as EARTH_RADIUS_KM
+from nfwserver.tracking.constants import DAYS_PER_JULIAN_CENTURY, JD_J2000
 
 
 def moon_position_km(jd: float, fr: float = 0.0) -> tuple[float, float, float]:
-    t = (jd - 2451545.0 + fr) / 36525.0
+    """Geocentric Moon position (km), mean equator and equinox of date, at UTC ``jd + fr``."""
+    t = (jd - JD_J2000 + fr) / DAYS_PER_JULIAN_CENTURY
 
     def s(a: float, b: float) -> float:
         return math.sin(math.radians(a + b * t))

@@ -11,12 +11,9 @@ import math
 import re
 from dataclasses import dataclass
 
+from nfwserver.tracking.constants import WGS84_A_KM
+from nfwserver.tracking.constants import WGS84_E2 as _E2
 from nfwserver.tracking.maidenhead import is_locator, locator_to_latlon
-
-#: WGS84 equatorial radius (km) and flattening.
-WGS84_A_KM = 6378.137
-WGS84_F = 1.0 / 298.257223563
-_E2 = WGS84_F * (2.0 - WGS84_F)
 
 
 @dataclass(frozen=True)

@@ -41,10 +41,11 @@ from datetime import datetime, timedelta, timezone
 import numpy as np
 from sgp4.api import Satrec, SatrecArray
 
+from nfwserver.tracking.constants import SECONDS_PER_DAY
+from nfwserver.tracking.frames import itrs_to_topocentric, teme_to_itrs
 from nfwserver.tracking.horizon import HorizonTable
-from nfwserver.tracking.look_angles import topocentric_from_earth_fixed
 from nfwserver.tracking.observer import Observer
-from nfwserver.tracking.timescale import SECONDS_PER_DAY, gmst1982, julian_date
+from nfwserver.tracking.timescale import julian_date
 
 _FLAT = HorizonTable()
 
@@ -102,20 +103,14 @@ class _Evaluator:
         for index, group in self._groups:
             e, rr, vv = satrecs[index].sgp4_array(jd[group], fr[group])
             r[group], v[group], err[group] = rr, vv, e
-        theta, theta_dot = gmst1982(jd, fr + self.ut1_days)
-        c, s = np.cos(theta), np.sin(theta)
-        w = theta_dot / SECONDS_PER_DAY
-        x = c * r[:, 0] + s * r[:, 1]
-        y = -s * r[:, 0] + c * r[:, 1]
-        pos = np.column_stack((x, y, r[:, 2]))
-        vel = np.column_stack((c * v[:, 0] + s * v[:, 1] + w * y, -s * v[:, 0] + c * v[:, 1] - w * x, v[:, 2]))
+        pos, vel = teme_to_itrs(r, v, jd, fr, self.ut1_days * SECONDS_PER_DAY)
         return pos, vel, err
 
     def look(self, sat: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(azimuth, elevation, f = elevation - horizon) in degrees; NaN/-inf where SGP4 failed."""
         pos, vel, err = self.states(sat, t)
         with np.errstate(invalid="ignore"):
-            az, el, _, _ = topocentric_from_earth_fixed(self.observer, pos, vel)
+            az, el, _, _ = itrs_to_topocentric(self.observer, pos, vel)
         f = el - self.horizon.min_elevation_array(az)
         bad = err != 0
         if bad.any():
@@ -259,9 +254,6 @@ def _visibility_screen(satrecs: list[Satrec], observer: Observer, t0: datetime, 
     e_lo = math.radians(max(horizon.minimum - 1.0, -89.0))
     e_hi = math.radians(min(max(p[1] for p in horizon.points) + 1.0 if horizon.points else 1.0, 89.0))
     k_lo, k_hi = r_obs * math.cos(e_lo), r_obs * math.cos(e_hi)
-    theta, theta_dot = gmst1982(jd, fr + ut1_utc / SECONDS_PER_DAY)
-    c, s = np.cos(theta), np.sin(theta)
-    w = theta_dot / SECONDS_PER_DAY
     mask = np.zeros((len(satrecs), n_steps), dtype=bool)
     rates_out = np.zeros(len(satrecs))
     f_out = np.empty((len(satrecs), n_steps + 1))
@@ -270,12 +262,9 @@ def _visibility_screen(satrecs: list[Satrec], observer: Observer, t0: datetime, 
     for i0 in range(0, len(satrecs), chunk):
         part = satrecs[i0 : i0 + chunk]
         err, r, v = SatrecArray(part).sgp4(jd, fr)
-        x = c * r[..., 0] + s * r[..., 1]
-        y = -s * r[..., 0] + c * r[..., 1]
-        z = r[..., 2]
-        vx = c * v[..., 0] + s * v[..., 1] + w * y
-        vy = -s * v[..., 0] + c * v[..., 1] - w * x
-        vz = v[..., 2]
+        pos, vel = teme_to_itrs(r, v, jd, fr, ut1_utc)
+        x, y, z = pos[..., 0], pos[..., 1], pos[..., 2]
+        vx, vy, vz = vel[..., 0], vel[..., 1], vel[..., 2]
         rad = np.sqrt(x * x + y * y + z * z)
         with np.errstate(invalid="ignore"):
             cos_psi = (x * obs_unit[0] + y * obs_unit[1] + z * obs_unit[2]) / rad

@@ -13,14 +13,13 @@ import math
 
 import numpy as np
 
-AU_KM = 149_597_870.7
-#: Equatorial Earth radius used for the shadow (km).
-EARTH_RADIUS_KM = 6378.137
+from nfwserver.tracking.constants import AU_KM, JD_J2000
+from nfwserver.tracking.constants import WGS84_A_KM as EARTH_RADIUS_KM  # the shadow's sphere
 
 
 def sun_position_km(jd: float | np.ndarray, fr: float | np.ndarray = 0.0) -> np.ndarray:
     """Geocentric Sun position (km), mean equator and equinox of date; shape (..., 3)."""
-    n = np.asarray(jd, dtype=float) - 2451545.0 + np.asarray(fr, dtype=float)
+    n = np.asarray(jd, dtype=float) - JD_J2000 + np.asarray(fr, dtype=float)
     mean_lon = np.radians((280.460 + 0.9856474 * n) % 360.0)
     g = np.radians((357.528 + 0.9856003 * n) % 360.0)
     lam = mean_lon + np.radians(1.915) * np.sin(g) + np.radians(0.020) * np.sin(2.0 * g)

@@ -13,12 +13,11 @@ from __future__ import annotations
 import math
 from datetime import datetime, timedelta, timezone
 
+from nfwserver.tracking.constants import DAYS_PER_JULIAN_CENTURY, JD_J2000, SECONDS_PER_DAY
+
 #: Julian date of 2000-01-01T00:00:00 UTC.
 _JD_2000 = 2451544.5
 _EPOCH_2000 = datetime(2000, 1, 1, tzinfo=timezone.utc)
-#: Julian date of the J2000.0 epoch (2000-01-01T12:00).
-JD_J2000 = 2451545.0
-SECONDS_PER_DAY = 86400.0
 _TAU = 2.0 * math.pi
 
 
@@ -48,9 +47,9 @@ def gmst1982(jd_ut1: float, fraction_ut1: float = 0.0) -> tuple[float, float]:
     The IAU 1982 expression that defines SGP4's TEME frame (AIAA 2006-6753 appendix C), in the
     same arithmetic as skyfield's ``theta_GMST1982`` so both agree to the last bit.
     """
-    t = (jd_ut1 - JD_J2000 + fraction_ut1) / 36525.0
+    t = (jd_ut1 - JD_J2000 + fraction_ut1) / DAYS_PER_JULIAN_CENTURY
     g = 67310.54841 + (8640184.812866 + (0.093104 + (-6.2e-6) * t) * t) * t
     dg = 8640184.812866 + (0.093104 * 2.0 + (-6.2e-6 * 3.0) * t) * t
     theta = (jd_ut1 % 1.0 + fraction_ut1 + g / SECONDS_PER_DAY % 1.0) % 1.0 * _TAU
-    theta_dot = (1.0 + dg / (SECONDS_PER_DAY * 36525.0)) * _TAU
+    theta_dot = (1.0 + dg / (SECONDS_PER_DAY * DAYS_PER_JULIAN_CENTURY)) * _TAU
     return theta, theta_dot

@@ -212,6 +212,9 @@ def test_station_serves_the_configured_dialects_next_to_nova() -> None:
         with _socket.socket(_socket.AF_INET, _socket.SOCK_DGRAM) as client:
             client.settimeout(5)
             client.sendto(b"GET_MODE", station.predict.address)
-            assert client.recvfrom(100)[0] == b"ISS\n"
+            assert client.recvfrom(100)[0] == b""  # PREDICT: empty until something is tracked
+            station.core.set_tune(True, source="test")
+            client.sendto(b"GET_MODE", station.predict.address)
+            assert client.recvfrom(100)[0] == b"ISS (ZARYA)\n"
     finally:
         station.stop()

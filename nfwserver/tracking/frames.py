@@ -1,0 +1,116 @@
+"""Frame rotations: SGP4's TEME to the Earth-fixed ITRS, and ITRS to the observer's topocentric frame.
+
+TEME is rotated into the Earth-fixed frame about the z axis by the IAU 1982 Greenwich mean
+sidereal angle at UT1 (:func:`nfwserver.tracking.timescale.gmst1982`); velocities lose the
+Earth's rotation (``v_itrs = R v_teme - omega x r_itrs``).  Polar motion is neglected, as in
+skyfield's default ``TEME -> ITRS`` path.  The topocentric frame is the observer's geodetic
+east-north-up frame; azimuth is degrees clockwise from true north (0..360), elevation degrees
+above the geodetic horizontal, range km, range rate km/s (positive receding).
+
+This module holds the one vectorised implementation (numpy, any leading shape) and the one
+hand-written scalar fast path (:class:`ScalarLookAngles`, pure ``math``, used on every publish
+tick).  Positions are km, velocities km/s, times split UTC Julian dates ``jd + fr``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from nfwserver.tracking.constants import SECONDS_PER_DAY
+from nfwserver.tracking.observer import Observer
+from nfwserver.tracking.timescale import gmst1982
+
+_DEG = 180.0 / math.pi
+
+
+def teme_to_itrs(r: np.ndarray, v: np.ndarray | None, jd, fr, ut1_utc: float = 0.0
+                 ) -> tuple[np.ndarray, np.ndarray | None]:
+    """Rotate TEME states (..., 3) into the ITRS at the UTC instants ``jd + fr``.
+
+    ``jd``/``fr`` broadcast against ``r[..., 0]`` (e.g. shape (times,) for r of shape
+    (sats, times, 3)).  ``v`` may be None (positions only, e.g. the Sun or the Moon).
+    """
+    theta, theta_dot = gmst1982(jd, np.asarray(fr) + ut1_utc / SECONDS_PER_DAY)
+    c, s = np.cos(theta), np.sin(theta)
+    x = c * r[..., 0] + s * r[..., 1]
+    y = -s * r[..., 0] + c * r[..., 1]
+    pos = np.stack((x, y, r[..., 2]), axis=-1)
+    if v is None:
+        return pos, None
+    w = theta_dot / SECONDS_PER_DAY
+    vel = np.stack((c * v[..., 0] + s * v[..., 1] + w * y, -s * v[..., 0] + c * v[..., 1] - w * x, v[..., 2]),
+                   axis=-1)
+    return pos, vel
+
+
+class TopocentricFrame:
+    """An observer's east-north-up frame as numpy vectors, for many positions at once."""
+
+    __slots__ = ("origin", "east", "north", "up")
+
+    def __init__(self, observer: Observer) -> None:
+        self.origin = np.array(observer.itrs_km())
+        self.east, self.north, self.up = (np.array(b) for b in observer.enu_basis())
+
+    def enu(self, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(east, north, up) components (km) of ``pos - origin`` for ITRS positions (..., 3)."""
+        d = pos - self.origin
+        return d @ self.east, d @ self.north, d @ self.up
+
+    def look_angles(self, pos: np.ndarray, vel: np.ndarray | None = None
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+        """Azimuth (deg), elevation (deg), range (km), range rate (km/s; None without ``vel``)."""
+        d = pos - self.origin
+        east, north, up = d @ self.east, d @ self.north, d @ self.up
+        rng = np.sqrt(east * east + north * north + up * up)
+        az = np.degrees(np.arctan2(east, north)) % 360.0
+        el = np.degrees(np.arcsin(up / rng))
+        rr = None if vel is None else np.einsum("...i,...i->...", d, vel) / rng
+        return az, el, rng, rr
+
+
+def itrs_to_topocentric(observer: Observer, pos: np.ndarray, vel: np.ndarray
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Azimuth (deg), elevation (deg), range (km), range rate (km/s) of ITRS states (..., 3)."""
+    az, el, rng, rr = TopocentricFrame(observer).look_angles(pos, vel)
+    assert rr is not None
+    return az, el, rng, rr
+
+
+class ScalarLookAngles:
+    """The scalar fast path: one TEME state at one instant to (az, el, range, range rate).
+
+    Holds only immutable precomputed observer terms, so it is thread-safe.
+    """
+
+    __slots__ = ("_ox", "_oy", "_oz", "_e", "_n", "_u", "_ut1_days")
+
+    def __init__(self, observer: Observer, ut1_utc: float = 0.0) -> None:
+        self._ut1_days = ut1_utc / SECONDS_PER_DAY
+        self._ox, self._oy, self._oz = observer.itrs_km()
+        self._e, self._n, self._u = observer.enu_basis()
+
+    def itrs(self, r, v, jd: float, fr: float) -> tuple[float, float, float, float, float, float]:
+        """ITRS position (km) and velocity (km/s) of the TEME state ``r``, ``v`` at ``jd + fr`` (UTC)."""
+        theta, theta_dot = gmst1982(jd, fr + self._ut1_days)
+        c, s = math.cos(theta), math.sin(theta)
+        x = c * r[0] + s * r[1]
+        y = -s * r[0] + c * r[1]
+        w = theta_dot / SECONDS_PER_DAY
+        return x, y, r[2], c * v[0] + s * v[1] + w * y, -s * v[0] + c * v[1] - w * x, v[2]
+
+    def look(self, r, v, jd: float, fr: float) -> tuple[float, float, float, float]:
+        """(azimuth deg, elevation deg, range km, range rate km/s) of a TEME state."""
+        x, y, z, vx, vy, vz = self.itrs(r, v, jd, fr)
+        dx, dy, dz = x - self._ox, y - self._oy, z - self._oz
+        e, n, u = self._e, self._n, self._u
+        east = e[0] * dx + e[1] * dy
+        north = n[0] * dx + n[1] * dy + n[2] * dz
+        up = u[0] * dx + u[1] * dy + u[2] * dz
+        rng = math.sqrt(dx * dx + dy * dy + dz * dz)
+        az = math.atan2(east, north) * _DEG
+        if az < 0.0:
+            az += 360.0
+        return az, math.asin(up / rng) * _DEG, rng, (dx * vx + dy * vy + dz * vz) / rng
