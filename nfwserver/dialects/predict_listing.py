@@ -169,7 +169,7 @@ class Listing:
         elif end - start > MAX_SPAN_S:
             instants = []
         else:
-            instants = range(start, end + 1, step)
+            instants = list(range(start, end + 1, step))
         for count in instants:
             daynum = count / 86400.0 - DAYNUM_OFFSET
             if decayed(self.elements, daynum):

@@ -197,7 +197,7 @@ class FakeDdeSystem:
             data = self._call(conv, "request", lambda: conv.handler.on_request(conv_id, conv.topic, item, fmt))
             if data is None:
                 raise DdeError(DMLERR_NOTPROCESSED, f"the server refused the request for {item!r}")
-            data = bytes(data)  # type: ignore[arg-type]
+            data = bytes(data)  # type: ignore[call-overload]
             conv.client._deliver(Received(next(self._seq), "reply", item, fmt, data))
             return data
 

@@ -210,7 +210,7 @@ def _take_tle(lines: list[str], i: int, source: str, result: LoadResult) -> int:
 def _take_amsat(lines: list[str], i: int, source: str, result: LoadResult) -> int:
     name = sanitize_element_name(lines[i].partition(":")[2])
     start = i
-    body = []
+    body: list[str] = []
     i += 1
     while i < len(lines):
         line = lines[i].rstrip()

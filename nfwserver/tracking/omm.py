@@ -12,6 +12,7 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping
 from datetime import datetime, timezone
+from typing import Any
 
 from nfwserver.tracking.tle import TleError, TleFields, check_ranges
 
@@ -43,7 +44,7 @@ def _classification(value: object) -> str:
 
 def omm_fields(record: Mapping[str, object]) -> tuple[str, TleFields]:
     """(name, values) of one OMM record; raises :class:`TleError` for a missing or bad value."""
-    def get(key: str, default: object = None) -> object:
+    def get(key: str, default: object = None) -> Any:
         value = record.get(key, default)
         if value is None or value == "":
             if default is not None:
