@@ -4,32 +4,27 @@ Every output (DDE, dialects, TCP, EasyComm, PREDICT, rotor, radio, console) is a
 :class:`StationCore`; see docs/ARCHITECTURE.md.
 """
 
-from nfwserver.core.events import Direction, Event, EventLog
-from nfwserver.core.publisher import Publisher, PublishStats, run_virtual
-from nfwserver.core.sample import AntennaPosition, TickSample
-from nfwserver.core.state import StateSnapshot, StationState
-from nfwserver.core.station_core import CommandResult, CoreSnapshot, StationCore
-from nfwserver.core.status import INTERFACE_VERSION, ArithmeticErrorCode, StatusBit
-from nfwserver.core.tick_worker import TickWorker
-from nfwserver.core.tracker import Tracker
+from nfwserver.lazy_exports import lazy_exports
 
-__all__ = [
-    "INTERFACE_VERSION",
-    "AntennaPosition",
-    "ArithmeticErrorCode",
-    "CommandResult",
-    "CoreSnapshot",
-    "Direction",
-    "Event",
-    "EventLog",
-    "PublishStats",
-    "Publisher",
-    "StateSnapshot",
-    "StationCore",
-    "StationState",
-    "StatusBit",
-    "TickSample",
-    "TickWorker",
-    "Tracker",
-    "run_virtual",
-]
+_EXPORTS = {
+    "Direction": "events",
+    "Event": "events",
+    "EventLog": "events",
+    "PublishStats": "publisher",
+    "Publisher": "publisher",
+    "run_virtual": "publisher",
+    "AntennaPosition": "sample",
+    "TickSample": "sample",
+    "StateSnapshot": "state",
+    "StationState": "state",
+    "CommandResult": "station_core",
+    "CoreSnapshot": "station_core",
+    "StationCore": "station_core",
+    "INTERFACE_VERSION": "status",
+    "ArithmeticErrorCode": "status",
+    "StatusBit": "status",
+    "TickWorker": "tick_worker",
+    "Tracker": "tracker",
+}
+__all__ = sorted(_EXPORTS)
+__getattr__ = lazy_exports(__name__, _EXPORTS)

@@ -1,1 +1,16 @@
-"""Radio layer: transponder channels, Doppler tuning logic, and radio backends (Hamlib rigctld)."""
+"""Radio channels and Doppler tuning through Hamlib's rigctld.
+"""
+
+from nfwserver.lazy_exports import lazy_exports
+
+_EXPORTS = {
+    "Channel": "transponder",
+    "DopplerTuner": "tuning",
+    "RadioCoupling": "coupling",
+    "RigctldBackend": "rigctld_backend",
+    "RadioError": "backend",
+    "RadioUnavailable": "backend",
+    "DEFAULT_CHANNELS": "defaults",
+}
+__all__ = sorted(_EXPORTS)
+__getattr__ = lazy_exports(__name__, _EXPORTS)
