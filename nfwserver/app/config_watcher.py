@@ -15,12 +15,12 @@ from __future__ import annotations
 import logging
 import os
 import stat
-import threading
 from collections.abc import Callable
 from pathlib import Path
 
 from nfwserver.clock import Clock
 from nfwserver.config.schema import Config
+from nfwserver.core.service_thread import ServiceThread
 
 log = logging.getLogger(__name__)
 
@@ -37,8 +37,10 @@ def file_signature(path: Path) -> Signature:
     return st.st_mtime_ns, st.st_size, st.st_ino
 
 
-class ConfigWatcher:
+class ConfigWatcher(ServiceThread):
     """Calls ``apply(config)`` for each valid change of ``path``; ``refused(message)`` for an invalid one."""
+
+    thread_name = "nfw-config"
 
     def __init__(self, path: str | Path, clock: Clock, apply: Callable[[Config], None],
                  refused: Callable[[str], None], interval_s: float = 2.0, settle_s: float = 1.0) -> None:
@@ -48,22 +50,13 @@ class ConfigWatcher:
         self.refused = refused
         self.interval_s = interval_s
         self.settle_s = settle_s
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
+        super().__init__()
         self._seen: Signature = None
 
     def start(self) -> None:
         if self._thread is None:
             self._seen = file_signature(self.path)
-            self._stop.clear()
-            self._thread = threading.Thread(target=self._run, name="nfw-config", daemon=True)
-            self._thread.start()
-
-    def stop(self) -> None:
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join(5.0)
-            self._thread = None
+        super().start()
 
     def check(self) -> bool:
         """One look at the file (the thread's step; returns True when a change was handled)."""

@@ -15,11 +15,14 @@ import threading
 from collections.abc import Callable
 
 from nfwserver.clock import Clock
+from nfwserver.core.service_thread import ServiceThread
 
 log = logging.getLogger(__name__)
 
 
-class ElementRefresher:
+class ElementRefresher(ServiceThread):
+    thread_name = "nfw-elements"
+
     """Runs ``refresh()`` on its own thread; see the module docstring.  ``period_s`` 0: only on request."""
 
     def __init__(self, refresh: Callable[[], object], clock: Clock, period_s: float,
@@ -30,10 +33,8 @@ class ElementRefresher:
         self.min_interval_s = min_interval_s
         self.initial = initial
         self.fetches = 0
+        super().__init__()
         self._requested = threading.Event()
-        self._stop = threading.Event()
-        self._wake = threading.Event()
-        self._thread: threading.Thread | None = None
         self._last_fetch: float | None = None
 
     def request(self) -> None:
@@ -41,18 +42,6 @@ class ElementRefresher:
         self._requested.set()
         self._wake.set()
 
-    def start(self) -> None:
-        if self._thread is None:
-            self._stop.clear()
-            self._thread = threading.Thread(target=self._run, name="nfw-elements", daemon=True)
-            self._thread.start()
-
-    def stop(self) -> None:
-        self._stop.set()
-        self._wake.set()
-        if self._thread is not None:
-            self._thread.join(5.0)
-            self._thread = None
 
     def _fetch(self) -> None:
         self._last_fetch = self.clock.monotonic()

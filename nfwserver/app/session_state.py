@@ -73,7 +73,7 @@ class StateFile:
 class SessionSaver(TickWorker):
     """Saves the AutoTracking satellite when it changes, on the worker thread ``nfw-session``."""
 
-    worker_name = "nfw-session"
+    thread_name = "nfw-session"
 
     def __init__(self, state_file: StateFile, configured: int | None) -> None:
         super().__init__()

@@ -9,27 +9,25 @@ thread with the newest sample, skipping any that arrived while it was busy.
 from __future__ import annotations
 
 import logging
-import threading
 
 from nfwserver.clock import Clock, SystemClock
 from nfwserver.core.sample import TickSample
+from nfwserver.core.service_thread import ServiceThread
 from nfwserver.ratelimited_log import RateLimitedLog
 
 log = logging.getLogger(__name__)
 
 
-class TickWorker:
+class TickWorker(ServiceThread):
     """Base class: subclasses implement :meth:`process` and may extend :meth:`stop`."""
 
-    worker_name = "nfw-worker"
+    thread_name = "nfw-worker"
 
     def __init__(self, clock: Clock | None = None) -> None:
         #: A failure repeated every tick is logged (with its traceback) once, then counted.
         self.warnings = RateLimitedLog(log, clock if clock is not None else SystemClock())
+        super().__init__()
         self._pending: TickSample | None = None
-        self._wake = threading.Event()
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
 
     def process(self, sample: TickSample) -> object:
         raise NotImplementedError
@@ -48,18 +46,6 @@ class TickWorker:
                 try:
                     self.process(sample)
                 except Exception:  # keep the worker alive whatever happens
-                    self.warnings.log(logging.ERROR, "tick failed", "%s failed on a tick", self.worker_name,
+                    self.warnings.log(logging.ERROR, "tick failed", "%s failed on a tick", self.thread_name,
                                       exc_info=True)
 
-    def start(self) -> None:
-        if self._thread is None:
-            self._stop.clear()
-            self._thread = threading.Thread(target=self._run, name=self.worker_name, daemon=True)
-            self._thread.start()
-
-    def stop(self) -> None:
-        self._stop.set()
-        self._wake.set()
-        if self._thread is not None:
-            self._thread.join(5.0)
-            self._thread = None

@@ -90,13 +90,17 @@ class HamlibConnection:
         self.failures, self._backoff, self._retry_at = 0, 0.0, None
         return sock
 
-    def _fail(self, why: str) -> None:
+    def _drop(self) -> None:
+        """Close the socket (if any) and forget what was buffered from it."""
         if self._sock is not None:
             try:
                 self._sock.close()
             except OSError:
                 pass
         self._sock, self._buffer = None, b""
+
+    def _fail(self, why: str) -> None:
+        self._drop()
         self.failures += 1
         self._backoff = min(self.backoff_max_s, max(self.backoff_initial_s, self._backoff * 2.0))
         self._retry_at = self.clock.monotonic() + self._backoff
@@ -107,12 +111,7 @@ class HamlibConnection:
     def fault(self, why: str) -> HamlibError:
         """Count a nonsense reply, drop the connection (it may be out of step) and return the error to raise."""
         self.faults += 1
-        if self._sock is not None:
-            try:
-                self._sock.close()
-            except OSError:
-                pass
-        self._sock, self._buffer = None, b""
+        self._drop()
         self.warnings.warning("fault", "%s at %s:%d sent a reply that makes no sense (%s); reconnecting",
                               self.name, self.host, self.port, why)
         return HamlibError(f"{self.name}: {why}")

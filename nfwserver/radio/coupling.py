@@ -25,7 +25,7 @@ log = logging.getLogger(__name__)
 class RadioCoupling(TickWorker):
     """Follows ticks with ``tuner``; channels come from ``state.channels`` (catalog number -> channel)."""
 
-    worker_name = "nfw-radio"
+    thread_name = "nfw-radio"
 
     def __init__(self, tuner: DopplerTuner, state: StationState, clock: Clock | None = None) -> None:
         super().__init__(clock)

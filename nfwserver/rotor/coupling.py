@@ -70,7 +70,7 @@ def sky_from_rotor(rotor_az: float, rotor_el: float) -> tuple[float, float]:
 class RotorCoupling(TickWorker):
     """Drives ``driver`` from ticks; see the module docstring."""
 
-    worker_name = "nfw-rotor"
+    thread_name = "nfw-rotor"
 
     def __init__(self, driver: KctDriver, predict: Predict, pass_track: PassTrack, threshold_deg: float = 2.0,
                  speed_deg_s: float = 6.0, max_lead_s: float = 10.0, after_los: str = "park", flip_mode: str = "auto",
