@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 import time
 from datetime import datetime, timedelta, timezone
+from pathlib import Path
 
 import pytest
 
@@ -96,11 +97,10 @@ def test_start_defaults_to_now(capsys) -> None:
 
 def test_runs_with_no_argument_but_the_duration_after_config_init_and_a_location(capsys, tmp_path) -> None:
     assert main(["config", "init"]) == 0
-    path = capsys.readouterr().out.strip().splitlines()[-1].split()[-1]
-    text = open(path).read()
+    path = Path(capsys.readouterr().out.strip().splitlines()[-1].split()[-1])
+    text = path.read_text()
     assert '# location = "JO02ae"' in text
-    with open(path, "w") as f:
-        f.write(text.replace('# location = "JO02ae"', 'location = "JO02ae"'))
+    path.write_text(text.replace('# location = "JO02ae"', 'location = "JO02ae"'))
     assert main(["simulate", "--duration", "60"]) == 0
     out, err = capsys.readouterr()
     lines = out.splitlines()
