@@ -1,4 +1,10 @@
-"""``nfwserver run``: the station server, with the console on a terminal or headless as a service."""
+"""``nfwserver run``: the station server, with the console on a terminal or headless as a service.
+
+Headless, the log goes to a rotating file (its path is printed at start); the start logs the observer,
+satellite and enabled outputs, and a one-line status follows every ten minutes of the station clock.
+A console that fails never stops the station: the failure is logged, the user is told in one
+sentence, and the station carries on headless until a signal (or ``--duration``).
+"""
 
 from __future__ import annotations
 
@@ -8,9 +14,13 @@ import logging.handlers
 import signal
 import sys
 import threading
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
-from nfwserver.clock import SystemClock
+from nfwserver.cli.station_runner import run_console, serve_headless, start_report
+from nfwserver.clock import Clock, SystemClock
 
 log = logging.getLogger("nfwserver")
 
@@ -41,10 +51,29 @@ def _log_to_file(path: Path) -> logging.Handler:
     return handler
 
 
+def default_log_file() -> Path:
+    from platformdirs import user_log_dir
+
+    return Path(user_log_dir("nfwserver", appauthor=False)) / "nfwserver.log"
+
+
+@dataclass
+class RunPlan:
+    """How one ``run`` goes: console or headless, where the log goes, for how long, on which clock."""
+
+    console: bool
+    log_file: Path
+    duration_s: float | None = None
+    clock: Clock | None = None
+    transport: Any = None  #: a DDE server transport (default: the platform's)
+    make_console: Callable[..., Any] | None = None  #: builds the console app (default: NfwConsole)
+    console_options: dict | None = None  #: passed to the app's run() (tests: headless=True)
+    stop: threading.Event | None = None  #: set to stop (default: set by SIGINT/SIGTERM)
+
+
 def run(args: argparse.Namespace) -> int:
-    from nfwserver.app.station import Station
     from nfwserver.cli import CliError
-    from nfwserver.config import ConfigError, default_config_path, load_config
+    from nfwserver.config import ConfigError, load_config
 
     try:
         config = load_config(args.config)
@@ -52,55 +81,99 @@ def run(args: argparse.Namespace) -> int:
         raise CliError(f"configuration refused: {exc}") from None
     if args.duration is not None and not args.duration > 0:
         raise CliError("--duration must be positive")
-    hint = ""
-    if not config.observer_configured:
-        hint = (f"no observer configured: using {config.observer} (Greenwich). Set [observer] location in "
-                f"{default_config_path()} (`nfwserver config init` writes a starting file).")
-    console = sys.stdout.isatty() and not args.headless
-    file_handler = None
-    if not console:
-        from platformdirs import user_log_dir
+    plan = RunPlan(console=sys.stdout.isatty() and not args.headless,
+                   log_file=Path(args.log_file) if args.log_file else default_log_file(), duration_s=args.duration)
+    return serve(config, plan, watch=args.config)
 
-        default_log = Path(user_log_dir("nfwserver", appauthor=False)) / "nfwserver.log"
-        file_handler = _log_to_file(Path(args.log_file) if args.log_file else default_log)
-    station = Station(config, SystemClock())
+
+def _notes(station: Any, config: Any) -> tuple[list[str], str]:
+    """Start-up notes for the terminal, and the console's hint (no observer, stale elements)."""
+    from nfwserver.config import observer_hint
+
+    source = config.path or config.source
+    notes = [f"configuration: {source}", station.transport_note, f"{len(station.catalog)} satellites loaded"]
+    hints = [] if config.observer_configured else [observer_hint(config)]
+    ages = [s.age_days(station.clock.now()) for s in station.catalog]
+    if ages and min(ages) > 14:
+        hints.append(f"the newest element set is {min(ages):.0f} days old: positions drift; add current elements "
+                     "([elements] files or urls in the configuration)")
+    return notes + hints, " ".join(hints)
+
+
+def _make_console(station: Any, config: Any, hint: str) -> Any:
+    from nfwserver.console.app import NfwConsole
+
+    return NfwConsole(station.core, station.transport_note, hint, radio=station.radio, rotor=station.rotor,
+                      favourites=config.favourites or (25544, 27607, 43017, 44909, 7530),
+                      clients=station.nova.client_count, tcp=getattr(station, "tcp", None),
+                      easycomm=getattr(station, "easycomm", None), config_file=config.path or "")
+
+
+def _stop_on_signals(stop: threading.Event) -> None:
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        try:
+            signal.signal(sig, lambda *_: stop.set())
+        except ValueError:  # not the main thread (embedded use)
+            pass
+
+
+def _exit_app(app: Any) -> None:
+    try:
+        app.call_from_thread(app.exit)
+    except RuntimeError:  # not running (any more)
+        pass
+
+
+def serve(config: Any, plan: RunPlan, watch: str | None = None) -> int:
+    """Start the station from ``config``, run it as ``plan`` says, stop it; the exit code."""
+    from nfwserver.app.station import Station
+    from nfwserver.cli import CliError
+
+    clock = plan.clock or SystemClock()
+    file_handler = None
+    if not plan.console:
+        file_handler = _log_to_file(plan.log_file)
+        print(f"nfwserver: logging to {plan.log_file}", file=sys.stderr)
+    station = Station(config, clock, transport=plan.transport)
     try:
         station.start()
     except OSError as exc:
         station.stop()
         raise CliError(f"cannot start the station: {exc}") from None
-    notes = [f"configuration: {config.source}", station.transport_note, f"{len(station.catalog)} satellites loaded"]
-    if hint:
-        notes.append(hint)
-    ages = [s.age_days(station.clock.now()) for s in station.catalog]
-    if ages and min(ages) > 14:
-        stale = (f"the newest element set is {min(ages):.0f} days old: positions drift; add current elements "
-                 "([elements] files or urls in the configuration)")
-        notes.append(stale)
-        hint = f"{hint} {stale}".strip()
-    if args.config:
-        station.watch_config(args.config)
+    notes, hint = _notes(station, config)
+    if watch:
+        station.watch_config(watch)
+    started = clock.monotonic()
+    stop = plan.stop or threading.Event()
     try:
-        if console:
-            from nfwserver.console.app import NfwConsole
-
-            app = NfwConsole(station.core, station.transport_note, hint, radio=station.radio, rotor=station.rotor,
-                             favourites=config.favourites or (25544, 27607, 43017, 44909, 7530),
-                             clients=station.nova.client_count)
-            if args.duration:
-                threading.Timer(args.duration, app.exit).start()
-            app.run()
+        if plan.console:
+            app = (plan.make_console or _make_console)(station, config, hint)
+            timer = None
+            if plan.duration_s:
+                timer = threading.Timer(plan.duration_s, _exit_app, (app,))
+                timer.daemon = True
+                timer.start()
+            failure = run_console(app, **(plan.console_options or {}))
+            if timer is not None:
+                timer.cancel()
+            if failure is None:
+                return 0
+            file_handler = _log_to_file(plan.log_file)
+            log.error("the console stopped: %s: %s", type(failure).__name__, failure, exc_info=failure)
+            print(f"nfwserver: the console failed ({type(failure).__name__}: {failure}); the station keeps "
+                  f"serving without it, logging to {plan.log_file}; stop it with Ctrl+C.", file=sys.stderr)
         else:
             for note in notes:
                 print(f"nfwserver: {note}", file=sys.stderr)
                 log.info(note)
-            stop = threading.Event()
-            for sig in (signal.SIGINT, signal.SIGTERM):
-                try:
-                    signal.signal(sig, lambda *_: stop.set())
-                except ValueError:  # not the main thread (embedded use)
-                    pass
-            stop.wait(args.duration)
+        for line in start_report(station):
+            log.info(line)
+        if plan.stop is None:
+            _stop_on_signals(stop)
+        remaining = None
+        if plan.duration_s is not None:
+            remaining = max(0.0, plan.duration_s - (clock.monotonic() - started))
+        serve_headless(station, stop, remaining)
     finally:
         station.stop()
         log.info("stopped")

@@ -1,8 +1,14 @@
-"""``nfwserver simulate``: run the real server on the fake DDE transport under a virtual clock.
+"""``nfwserver simulate``: what will *my* client see?  The real server on the in-process DDE transport
+under a virtual clock, with one client playing a real client's transaction pattern.
 
-One client holds a hot advise loop on NFW32/NFW_DATA/NFW_SERVER and every string it receives is
-printed as ``<ISO-8601 UTC with ms and Z><TAB><string>``, the time being the instant the values were
-computed for.  Pokes can be scheduled: ``--poke 120:SAT=25544`` is sent by that client 120 s in.
+Default: a hot advise loop on NFW32|NFW_DATA!NFW_SERVER, every string printed as
+``<ISO-8601 UTC with ms and Z><TAB><string>``, the time being the instant the values were computed
+for.  With ``--client`` (:mod:`nfwserver.cli.simulated_clients`) each transaction is printed as
+``<time><TAB><kind><TAB><text>``, kind ``data``, ``notify``, ``reply`` or ``poke`` (``(empty)`` for an
+empty string).  ``--link`` watches any served item, the Orbitron, WXtrack and SatPC32 dialects
+included.  Pokes are scheduled with ``--poke 120:SAT=25544`` (sent 120 s in); ``TUNE ON`` is poked
+at the start only when no ``--poke`` holds a TUNE command.  The dialects take no pokes (their
+clients never send any), so on a dialect link the commands go to the server directly.
 """
 
 from __future__ import annotations
@@ -11,99 +17,193 @@ import argparse
 import logging
 import sys
 
-from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs, parse_time
+from nfwserver.cli.arguments import number_in, satellite_value, time_value
+from nfwserver.cli.simulated_clients import CLIENTS, Link, SimulatedClient, parse_link
+from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs
 from nfwserver.clock import VirtualClock
 from nfwserver.core.publisher import run_virtual
 from nfwserver.core.state import MAX_RATE_HZ, MIN_RATE_HZ
 from nfwserver.core.station_core import StationCore
-from nfwserver.dde.clipboard import CF_TEXT
 from nfwserver.dde.nova_service import NovaDdeService
-from nfwserver.fake_dde import DdeError, FakeDdeSystem, Received
+from nfwserver.dialects.dde_service import DialectServer
+from nfwserver.dialects.orbitron import ORBITRON
+from nfwserver.dialects.satpc32 import SATPC32
+from nfwserver.dialects.wxtrack import WXTRACK
+from nfwserver.fake_dde import DdeError, FakeDdeSystem
+
+MAX_DURATION_S = 30 * 86400.0
+NOVA_LINK = Link("NFW32", "NFW_DATA", "NFW_SERVER")
+DIALECTS = {d.service.upper(): d for d in (ORBITRON, WXTRACK, SATPC32)}
 
 
-def _poke_spec(text: str) -> tuple[float, str]:
+def poke_value(text: str) -> tuple[float, str]:
+    """``type=`` for ``--poke``: ``[SECONDS:]COMMAND`` with a non-negative offset."""
     offset, sep, command = text.partition(":")
-    if sep and offset.replace(".", "", 1).isdigit():
-        return float(offset), command
-    return 0.0, text
+    if not sep:
+        offset, command = "0", text
+    try:
+        seconds = float(offset)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: the offset before ':' must be seconds, e.g. 120:SAT=25544"
+                                         ) from None
+    if not 0 <= seconds <= MAX_DURATION_S or not command.strip():
+        raise argparse.ArgumentTypeError(f"{text!r}: give a command after an offset of 0 to {MAX_DURATION_S:.0f} s")
+    return seconds, command.strip()
+
+
+def link_value(text: str) -> Link:
+    try:
+        return parse_link(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
-        "simulate",
-        help="show what a DDE client receives, on virtual time",
-        description="Run the server on the in-process DDE transport under a virtual clock, with one "
-        "client holding a hot advise loop on NFW32/NFW_DATA/NFW_SERVER; print each string it "
-        "receives as '<UTC time>\\t<string>'. TUNE ON is poked at the start.",
-    )
+        "simulate", help="show what a DDE client receives, on virtual time",
+        description="Run the server on the in-process DDE transport under a virtual clock with one client "
+        "playing a real client's transaction pattern, and print what it receives. Defaults: the configured "
+        "observer, catalog and satellite, from now. TUNE ON is poked at the start unless a --poke holds a "
+        "TUNE command (so you can see what a client gets before TUNE ON).")
     add_tracking_options(p, output_format=False)
-    p.add_argument("--start", required=True, help="start time, ISO-8601 (UTC when no zone is given)")
-    p.add_argument("--duration", type=float, default=600.0, metavar="SECONDS", help="virtual duration")
-    p.add_argument("--rate", type=float, default=5.0, metavar="HZ", help="publish rate, 1-50 Hz (default 5)")
-    p.add_argument("--sat", type=int, metavar="CATNR", help="initial AutoTracking satellite")
-    p.add_argument("--poke", action="append", default=[], metavar="[SECONDS:]COMMAND",
-                   help="poke sent by the client at that offset (default 0); repeatable")
-    p.set_defaults(func=run)
+    p.add_argument("--start", type=time_value, default="now",
+                   help="'now' (default), relative (+2h, -30m) or ISO-8601 (UTC when no zone is given)")
+    p.add_argument("--duration", type=number_in(0, MAX_DURATION_S, low_open=True, unit="s"), default=600.0,
+                   metavar="SECONDS", help="virtual duration (default 600)")
+    p.add_argument("--rate", type=number_in(MIN_RATE_HZ, MAX_RATE_HZ, unit="Hz"), default=5.0, metavar="HZ",
+                   help=f"publish rate, {MIN_RATE_HZ:g}-{MAX_RATE_HZ:g} Hz (default 5)")
+    p.add_argument("--sat", type=satellite_value, metavar="CATNR|NAME",
+                   help="initial AutoTracking satellite (default: [server] satellite)")
+    p.add_argument("--poke", type=poke_value, action="append", default=[], metavar="[SECONDS:]COMMAND",
+                   help="poke sent by the client at that offset (default 0); repeatable. A TUNE command here "
+                        "replaces the automatic TUNE ON at the start")
+    p.add_argument("--client", choices=CLIENTS, default="hot",
+                   help="transaction pattern: hot (hot advise, default), warm (warm advise), wisp (poke, request "
+                        "every --poll s, re-poke when AH: is missing), delphi (warm link + request per "
+                        "notification), ndde (hot link + 1 s requests), matlab (poke, then requests)")
+    p.add_argument("--poll", type=number_in(0, 3600, unit="s"), metavar="SECONDS",
+                   help="request interval of wisp/matlab (default 3) and ndde (default 1); wisp with 0: warm "
+                        "link + a request per notification")
+    p.add_argument("--link", type=link_value, default=NOVA_LINK, metavar="SERVICE|TOPIC!ITEM",
+                   help=f"item to watch (default {NOVA_LINK}); e.g. Orbitron|Tracking!TrackingDataEx, "
+                        "WXtrack|Tracking!Tracking, SatPC32|SatPcDdeConv!SatPcDdeItem")
+    p.set_defaults(func=run, usage_error=p.error)
+
+
+def _has_tune(pokes: list[tuple[float, str]]) -> bool:
+    return any(command.upper().split()[:1] == ["TUNE"] for _, command in pokes)
+
+
+def _has_sat(pokes: list[tuple[float, str]]) -> float | None:
+    return next((offset for offset, command in pokes if command.upper().replace(" ", "").startswith("SAT=")), None)
 
 
 def run(args: argparse.Namespace) -> int:
     from nfwserver.cli import CliError
 
-    if not MIN_RATE_HZ <= args.rate <= MAX_RATE_HZ:
-        raise CliError(f"--rate must be between {MIN_RATE_HZ:g} and {MAX_RATE_HZ:g} Hz")
-    if not 0 < args.duration <= 30 * 86400:
-        raise CliError("--duration must be between 0 and 30 days")
-    try:
-        start = parse_time(args.start)
-    except ValueError as exc:
-        raise CliError(f"--start: {exc}") from None
+    pokes = sorted(args.poke, key=lambda p: p[0])
+    late = [command for offset, command in pokes if offset > args.duration]
+    if late:
+        args.usage_error(f"--poke {late[0]!r} comes after the end of --duration {args.duration:g} s")
+    if args.poll is not None and args.poll == 0 and args.client != "wisp":
+        args.usage_error("--poll 0 (a request per notification) is WiSP's mode: use it with --client wisp")
     inputs = load_tracking_inputs(args)
-    clock = VirtualClock(start)
+    clock = VirtualClock(args.start)
     server = StationCore(inputs.catalog, inputs.observer, clock, horizon=inputs.horizon,
                          ut1_utc=inputs.ut1_utc, rate_hz=args.rate)
-    if args.sat is None:
-        print("nfwserver: no --sat given: no AutoTracking satellite, so nothing is published", file=sys.stderr)
-    elif not server.select_satellite(args.sat, source="simulate"):
-        print(f"nfwserver: satellite {args.sat} is not in the element files; nothing is published",
-              file=sys.stderr)
+    wanted = str(args.sat) if args.sat is not None else (str(inputs.satellite) if inputs.satellite else None)
+    sat = inputs.catalog.find(wanted) if wanted is not None else None
+    if wanted is not None and sat is None:
+        origin = "--sat" if args.sat is not None else "[server] satellite"
+        if args.sat is not None:
+            raise CliError(f"satellite {wanted} is not in the catalog")
+        print(f"nfwserver: {origin} {wanted} is not in the catalog", file=sys.stderr)
+    if sat is not None:
+        server.select_satellite(sat.catalog_number, source="simulate")
+    else:
+        sat_poke = _has_sat(pokes)
+        if sat_poke is None:
+            print("nfwserver: no --sat given and no [server] satellite in the catalog: no AutoTracking satellite, "
+                  "so nothing is published", file=sys.stderr)
+        elif sat_poke > 0:
+            print(f"nfwserver: no satellite until the SAT= poke at {sat_poke:g} s: nothing is published before it",
+                  file=sys.stderr)
+    if not _has_tune(pokes):
+        pokes.insert(0, (0.0, "TUNE ON"))
+    return _simulate(args, server, clock, pokes)
+
+
+def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock,
+              pokes: list[tuple[float, str]]) -> int:
     # Refusals are reported below with their time; keep the core's own warning out of the way
     # (restored on the way out: the logger is shared with anything else in this process).
     core_log = logging.getLogger("nfwserver.core.station_core")
     saved_level = core_log.level
     core_log.setLevel(logging.ERROR)
     system = FakeDdeSystem(received_capacity=16)
-    service = NovaDdeService(server)
+    link: Link = args.link
+    dialect = DIALECTS.get(link.service.upper())
+    service = DialectServer(dialect, server) if dialect is not None else NovaDdeService(server)
     service.attach(system.server_transport())
-    client = system.connect("NFW32", "NFW_DATA", client_name="simulate")
     lines: list[str] = []
+    marked = args.client != "hot"
 
-    def collect(received: Received) -> None:
-        if received.kind == "data" and received.data is not None:
-            sample = server.snapshot().last_sample
-            when = sample.time if sample is not None else clock.now()
-            lines.append(f"{format_time(when)}\t{received.text}\n")
+    def emit(kind: str, text: str) -> None:
+        text = text.replace("\r", "\\r").replace("\n", "\\n")  # SatPC32 ends in CR LF: one line each
+        sample = server.snapshot().last_sample
+        when = sample.time if sample is not None and kind != "poke" else clock.now()
+        if marked:
+            lines.append(f"{format_time(when)}\t{kind}\t{text or '(empty)'}\n")
+        elif kind == "data":
+            lines.append(f"{format_time(when)}\t{text}\n")
 
-    client.on_receive = collect
-    client.start_advise("NFW_SERVER", CF_TEXT, hot=True)
-    pending = sorted((_poke_spec(p) for p in args.poke), key=lambda x: x[0])
-    pending.insert(0, (0.0, "TUNE ON"))
+    def refused(command: str, exc: DdeError) -> None:
+        refusal = server.events.recent(1)
+        reason = refusal[0].detail if refusal and refusal[0].detail else "refused"
+        print(f"nfwserver: poke {command!r} at {format_time(clock.now())} refused: {reason}", file=sys.stderr)
+
+    try:
+        conversation = system.connect(link.service, link.topic, client_name="simulate")
+    except DdeError:
+        service.detach()
+        core_log.setLevel(saved_level)
+        served = "NFW32|NFW_DATA or NFW_SERVER|NFW_DATA, " + ", ".join(f"{d.service}|{d.topic}"
+                                                                        for d in DIALECTS.values())
+        args.usage_error(f"--link {link}: nothing serves that service and topic here (served: {served})")
+    client = SimulatedClient(args.client, conversation, link.item, emit, args.poll, refused)
+    pending = list(pokes)
+    started = False
+    previous: list[float] = []  # the offset of the tick published last
 
     def before_tick(offset: float) -> None:
+        nonlocal started
+        if previous:  # the client's requests due by the previous tick, once it was published
+            client.after_tick(previous[0])
+        previous[:] = [offset]
         if lines:  # write what the previous tick delivered
             sys.stdout.write("".join(lines))
             lines.clear()
         while pending and pending[0][0] <= offset + 1e-9:
-            _, command = pending.pop(0)
+            command = pending.pop(0)[1]
+            if dialect is None:
+                client.poke(command)
+            else:  # the dialects take no pokes: their clients never send any; Nova's commands go to the core
+                result = server.command(command, source="simulate")
+                emit("poke", f"{command} (to the server{'' if result.accepted else ', refused'})")
+                if not result.accepted:
+                    print(f"nfwserver: {command!r} at {format_time(clock.now())} refused: {result.note}",
+                          file=sys.stderr)
+        if not started:
+            started = True
             try:
-                client.poke("NFW_SERVER", command)
-            except DdeError:
-                refusal = server.events.recent(1)
-                reason = refusal[0].detail if refusal else "refused"
-                print(f"nfwserver: poke {command!r} at {format_time(clock.now())} refused: {reason}",
-                      file=sys.stderr)
+                client.start()
+            except DdeError as exc:
+                print(f"nfwserver: {link}: {exc}", file=sys.stderr)
 
     try:
         run_virtual(server, clock, args.duration, before_tick=before_tick)
+        if previous:
+            client.after_tick(previous[0])
         sys.stdout.write("".join(lines))
         sys.stdout.flush()
     except BrokenPipeError:  # the reader went away (e.g. piped into head)

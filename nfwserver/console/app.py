@@ -1,123 +1,170 @@
 """The Textual console of ``nfwserver run``.
 
-Shows what Nova's diagnostic screens showed and more: the live session state (satellite, look
-angles, range rate, AH, Doppler at the satellite's beacon frequency when known, tune/track, status
-word, antenna position, clients, next pass), the outgoing strings (F1) and the incoming strings
-with the conversation that sent them (F3).  The input line at the bottom takes the same commands
-a client pokes (``TUNE ON``, ``SAT=27607`` ...).
+Shows what Nova's diagnostic screens showed and more: the live session state (satellite, tune and
+track, clients), InstantTrack's realtime values for the selected satellite (look angles, range,
+sub-satellite point and locator, orbit number, phase, mode, sunlit, and Doppler and path loss at the
+satellite's own downlink channel), the antenna, rotor (flip state, suspension) and radio, the outgoing
+strings (F1) and the incoming strings with the conversation that sent them (F3), the passes of the
+favourites with a sky plot.  The input line at the bottom takes the commands a client pokes
+(``TUNE ON``, ``SAT=27607`` ...) plus the console's own ``Z`` (UTC/local time) and ``FLIP AUTO|ON|OFF``.
 
-Events arrive on the server's threads; they are queued and drained on the UI thread by a timer,
-so a flood of strings at 50 Hz never blocks the publisher.
+Threads: events arrive on the server's threads and are queued, then drained on the UI thread by a
+timer, so a flood of strings at 50 Hz never blocks the publisher.  Pass searches and the sky track
+run on a worker thread (:mod:`nfwserver.console.pass_view`); key handling never waits for them.
+Every name is shown as literal text (never parsed as markup).
+
+On a narrow terminal (< 110 columns) one log pane is shown at a time (F1/F3 choose); on a short
+one (< 34 lines) the sky plot is left out.  The console works from 80x24.
 """
 
 from __future__ import annotations
 
 import collections
+import logging
 import threading
-from collections.abc import Callable
-from datetime import datetime, timedelta
+from collections.abc import Callable, Mapping
+from datetime import datetime, tzinfo
+from functools import partial
 
 from rich.text import Text
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
-from textual.widgets import Footer, Header, Input, OptionList, RichLog, Static
-from textual.widgets.option_list import Option
+from textual.widgets import Footer, Input, RichLog, Static
 
+from nfwserver.console.pass_view import PassSearch, next_pass_text, pass_table, search_passes
+from nfwserver.console.picker import SatellitePicker
+from nfwserver.console.reflow_log import ReflowLog
 from nfwserver.console.skyplot import render_sky
+from nfwserver.console.state_view import (
+    antenna_line,
+    guarded,
+    outputs_line,
+    radio_line,
+    realtime,
+    realtime_lines,
+    rotor_line,
+    satellite_line,
+    status_line,
+)
+from nfwserver.console.time_display import TimeDisplay
 from nfwserver.core.events import Direction, Event
 from nfwserver.core.nova_protocol import escape_for_log
 from nfwserver.core.station_core import StationCore
-from nfwserver.core.status import describe
 from nfwserver.radio.coupling import RadioCoupling
-from nfwserver.rotor.coupling import RotorCoupling
-from nfwserver.tracking.doppler import doppler_shift_hz
-from nfwserver.tracking.look_angles import LookAngleCalculator
-from nfwserver.tracking.passes import Pass, find_passes
+from nfwserver.rotor.coupling import FLIP_MODES, RotorCoupling
 
+log = logging.getLogger(__name__)
 
-def _clock(when: datetime | None) -> str:
-    return when.strftime("%H:%M:%S") if when else "--:--:--"
+NARROW_COLUMNS = 110
+SHORT_LINES = 34
 
 
 class NfwConsole(App):
-    """The console; give it the running server."""
+    """The console; give it the running station's core and adapters."""
 
     TITLE = "nfwserver"
     CSS = """
     #state { height: auto; border: round $accent; padding: 0 1; }
     #logs { height: 1fr; }
     .pane { width: 1fr; border: round $primary; }
-    #side { width: 40; border: round $primary; }
-    #picker { height: 12; display: none; border: round $warning; }
-    #picker.shown { display: block; }
-    #poke { dock: bottom; }
+    .hidden { display: none; }
+    #side { width: 38; border: round $primary; padding: 0 1; }
+    #poke { border: none; height: 1; padding: 0 1; }
     """
     BINDINGS = [
-        Binding("f1", "focus_outgoing", "Outgoing (F1)"),
-        Binding("f3", "focus_incoming", "Incoming (F3)"),
-        Binding("f2", "pick_satellite", "Satellites (F2)"),
-        Binding("ctrl+t", "toggle_tune", "Tune on/off"),
-        Binding("ctrl+d", "toggle_doppler", "Doppler tuning"),
-        Binding("ctrl+q", "quit", "Quit"),
+        Binding("f2", "pick_satellite", "Satellites", priority=True),
+        Binding("ctrl+d", "toggle_doppler", "Doppler", priority=True),
+        Binding("f4", "toggle_zone", "UTC/local", priority=True),
+        Binding("f1", "show_outgoing", "Out", priority=True),
+        Binding("f3", "show_incoming", "In", priority=True),
+        Binding("ctrl+t", "toggle_tune", "Tune", priority=True),
+        Binding("ctrl+f", "cycle_flip", "Flip", priority=True),
+        Binding("z", "toggle_zone", "UTC/local", show=False),
+        Binding("ctrl+q", "quit", "Quit", priority=True),
     ]
 
     def __init__(self, core: StationCore, transport_note: str = "", hint: str = "",
                  radio: RadioCoupling | None = None, rotor: RotorCoupling | None = None,
-                 favourites: tuple[int, ...] = (), clients: Callable[[], tuple[int, int]] | None = None) -> None:
+                 favourites: tuple[int, ...] = (), clients: Callable[[], tuple[int, int]] | None = None, *,
+                 tcp: object | None = None, easycomm: object | None = None, config_file: str = "",
+                 schedules: Mapping[int, str] | None = None, local_zone: tzinfo | None = None) -> None:
         super().__init__()
-        self.clients = clients or (lambda: (0, 0))
-        self.favourites = favourites
-        self._passes_key: int | None = None
         self.core = core
-        self.radio = radio
-        self.rotor = rotor
         self.transport_note = transport_note
         self.hint = hint
+        self.radio = radio
+        self.rotor = rotor
+        self.favourites = favourites
+        self.clients = clients or (lambda: (0, 0))
+        self.tcp = tcp
+        self.easycomm = easycomm
+        self.config_file = config_file
+        self.schedules = dict(schedules or {})
+        self.times = TimeDisplay(local_zone)
+        self.failure: BaseException | None = None  #: the exception that stopped the console, if one did
         self._queue: collections.deque[Event] = collections.deque(maxlen=2000)
         self._lock = threading.Lock()
-        self._unsubscribe = None
-        self._next_pass: Pass | None = None
-        self._pass_key: tuple[int | None, int] | None = None
+        self._unsubscribe: Callable[[], None] | None = None
+        self._search: PassSearch | None = None
+        self._search_key: tuple | None = None
+        self._shown_log = "incoming"
 
+    # -- layout -------------------------------------------------------------------------------
     def compose(self) -> ComposeResult:
-        yield Header(show_clock=False)
         yield Static(id="state")
         with Horizontal(id="logs"):
-            with Vertical(classes="pane"):
-                yield Static("[b]F1 outgoing[/b]")
+            with Vertical(id="outgoing-pane", classes="pane"):
                 yield RichLog(id="outgoing", max_lines=500, wrap=False, markup=False)
-            with Vertical(classes="pane"):
-                yield Static("[b]F3 incoming[/b]")
-                yield RichLog(id="incoming", max_lines=500, wrap=True, markup=False)
+            with Vertical(id="incoming-pane", classes="pane"):
+                yield ReflowLog(id="incoming", max_lines=500)
             with Vertical(id="side"):
-                yield Static("[b]Upcoming passes[/b]")
                 yield Static(id="passes")
-                yield Static("[b]Sky (selected satellite)[/b]")
                 yield Static(id="sky")
-        yield OptionList(id="picker")
-        yield Input(placeholder="poke: TUNE ON | TUNE OFF | TRACK ON | SAT=25544 | ANTAZ=123 ...", id="poke")
+        yield Input(placeholder="poke: TUNE ON | TRACK ON | SAT=25544 | Z (UTC/local) | FLIP AUTO|ON|OFF",
+                    id="poke")
         yield Footer()
 
     def on_mount(self) -> None:
+        self.query_one("#state").border_title = "nfwserver"
+        self.query_one("#outgoing-pane").border_title = "F1 outgoing"
+        self.query_one("#incoming-pane").border_title = "F3 incoming"
+        self.query_one("#side").border_title = "Passes"
         self._unsubscribe = self.core.events.subscribe(self._enqueue)
-        incoming = self.query_one("#incoming", RichLog)
-        for note in (self.transport_note, self.hint):
-            if note:
-                incoming.write(Text(f"note: {note}", style="yellow"))
         self.set_interval(0.1, self._drain)
         self.set_interval(0.25, self._refresh_state)
+        self._layout()
+        self.call_after_refresh(self._write_notes)
         self._refresh_state()
-        picker = self.query_one("#picker", OptionList)
-        for sat in self.core.state.catalog:
-            label = f"{sat.dde_name:12} {sat.catalog_number:>6}  {sat.name}"
-            picker.add_option(Option(label, id=str(sat.catalog_number)))
         self.query_one("#poke", Input).focus()
+
+    def _write_notes(self) -> None:
+        """First-run notes, written once the pane has its width, so they wrap to it."""
+        incoming = self.query_one("#incoming", ReflowLog)
+        for note in (self.transport_note, self.hint):
+            if note:
+                incoming.add(Text(f"note: {note}", style="yellow"))
+
+    def on_resize(self) -> None:
+        self._layout()
+
+    def _layout(self) -> None:
+        narrow = self.size.width < NARROW_COLUMNS
+        self.query_one("#outgoing-pane").set_class(narrow and self._shown_log != "outgoing", "hidden")
+        self.query_one("#incoming-pane").set_class(narrow and self._shown_log != "incoming", "hidden")
+        self.query_one("#sky").set_class(self.size.height < SHORT_LINES, "hidden")
 
     def on_unmount(self) -> None:
         if self._unsubscribe is not None:
             self._unsubscribe()
 
+    def _handle_exception(self, error: Exception) -> None:
+        """Remember what stopped the console; ``nfwserver run`` reports it and carries on headless."""
+        self.failure = error
+        super()._handle_exception(error)
+        self._exit_renderables.clear()  # one sentence from the run command instead of a screenful
+
+    # -- events -------------------------------------------------------------------------------
     def _enqueue(self, event: Event) -> None:  # any thread
         with self._lock:
             self._queue.append(event)
@@ -127,152 +174,152 @@ class NfwConsole(App):
             events = list(self._queue)
             self._queue.clear()
         outgoing = self.query_one("#outgoing", RichLog)
-        incoming = self.query_one("#incoming", RichLog)
+        incoming = self.query_one("#incoming", ReflowLog)
         for e in events:
-            stamp = _clock(e.time)
+            stamp = self.times.clock(e.time)
             if e.direction is Direction.OUT:
                 who = f" -> {e.client}" if e.client else ""
-                outgoing.write(f"{stamp} {e.text}{who}")
+                outgoing.write(Text(f"{stamp} {e.text}{who}"))
             else:
                 mark = "" if e.accepted is None else (" ok" if e.accepted else " REFUSED")
                 detail = f" ({e.detail})" if e.detail and not e.accepted else ""
                 who = e.client or "server"
                 style = "red" if e.accepted is False else ("dim" if e.direction is Direction.INFO else "")
-                incoming.write(Text(f"{stamp} [{who}] {escape_for_log(e.text)}{mark}{detail}", style=style))
+                incoming.add(Text(f"{stamp} [{who}] {escape_for_log(e.text)}{mark}{detail}", style=style))
 
-    def _upcoming_pass(self, now: datetime) -> Pass | None:
-        snap = self.core.snapshot()
-        key = (snap.catalog_number, int(now.timestamp() // 60))
-        if key != self._pass_key:
-            self._pass_key = key
-            self._next_pass = None
-            sat = self.core.state.catalog.get(snap.catalog_number) if snap.catalog_number else None
-            if sat is not None and self.core.state.observer is not None:
-                passes = find_passes([sat], self.core.state.observer, now, now + timedelta(hours=24),
-                                     horizon=self.core.state.horizon, ut1_utc=self.core.state.ut1_utc_s)
-                self._next_pass = next((p for p in passes if p.los is None or p.los > now), None)
-        return self._next_pass
+    def _note(self, text: str, style: str = "yellow") -> None:
+        self.query_one("#incoming", ReflowLog).add(Text(f"{self.times.clock(self.core.clock.now())} {text}",
+                                                        style=style))
 
+    # -- the state pane ---------------------------------------------------------------------------
     def _refresh_state(self) -> None:
         snap = self.core.snapshot()
-        sample = snap.last_sample
         now = self.core.clock.now()
-        lines = []
-        sat = f"{snap.dde_name} ({snap.catalog_number})" if snap.catalog_number else "none selected"
-        conversations, loops = self.clients()
-        lines.append(f"Satellite {sat}   TUNE {'ON' if snap.state.dde_output else 'OFF'}   "
-                     f"TRACK {'ON' if snap.state.tracking else 'OFF'}   rate {snap.state.rate_hz:g} Hz   "
-                     f"clients {conversations} ({loops} advise)")
-        if sample is not None and sample.look_angles is not None:
-            la = sample.look_angles
-            lines.append(f"AZ {la.azimuth_deg:6.1f}  EL {la.elevation_deg:5.1f}  RR {la.range_rate_km_s:+.4f} km/s  "
-                         f"range {la.range_km:8.1f} km  AH {'Y' if sample.above_horizon else 'N'}  "
-                         f"Doppler@145.8MHz {doppler_shift_hz(145.8e6, la.range_rate_km_s):+.0f} Hz")
-        else:
-            lines.append("no position (no satellite, no observer, or SGP4 error)")
-        ant = snap.state.antenna
-        ant_text = (f"{ant.azimuth_deg if ant.azimuth_deg is not None else '-'} / "
-                    f"{ant.elevation_deg if ant.elevation_deg is not None else '-'} ({ant.source or 'unknown'})")
-        nxt = self._upcoming_pass(now)
-        if nxt is not None:
-            pass_text = (f"AOS {_clock(nxt.aos)}  TCA {_clock(nxt.tca)} max {nxt.max_elevation_deg:.0f}deg  "
-                         f"LOS {_clock(nxt.los)}")
-        else:
-            pass_text = "no pass in the next 24 h"
-        lines.append(f"Antenna {ant_text}   next pass: {pass_text}")
+        catnr = snap.catalog_number
+        self._maybe_search(now, catnr)
+        search = self._search if self._search is not None and self._search.selected == catnr else None
+        sample = snap.last_sample
+        above = sample.above_horizon if sample is not None and sample.catalog_number == catnr else None
+        lines: list[Text | None] = [guarded("Satellite", lambda: satellite_line(snap, self.core, self.clients()))]
+        values, why = realtime(self.core, catnr, now, self.schedules.get(catnr) if catnr is not None else None)
+        lines.extend(realtime_lines(values, why, self.core, catnr, above))
+        lines.append(Text(next_pass_text(search, self.times, now)))
+        radio = guarded("Radio", lambda: radio_line(self.radio, snap.state.radio_tuning))
+        lines.append(antenna_line(snap, radio or Text()))
         if self.rotor is not None:
-            driver = self.rotor.driver
-            _, _, tgt_el, tgt_az = driver.positions()
-            pos = driver.rotor_position()
-            bits = driver.status().bits
-            target = f"{tgt_az:.1f}/{tgt_el:.1f}" if tgt_az is not None else "-"
-            actual = f"{pos[0]:.1f}/{pos[1]:.1f}" if pos is not None else "unreachable"
-            lines.append(f"Rotor: target {target}  actual {actual}  flip {'ON' if self.rotor.flip_state else 'off'}"
-                         f"  KCT status 0x{int(bits):02X}")
-        if self.radio is not None:
-            r = self.radio.last_result
-            state = "ON" if snap.state.radio_tuning else "OFF"
-            if not self.radio.tuner.available:
-                radio_text = f"Radio: Doppler tuning {state}, radio unreachable ({self.radio.tuner.last_error})"
-            elif r is not None:
-                tx = f" TX {r.tx_hz / 1e6:.6f} MHz" if r.tx_hz else ""
-                radio_text = f"Radio: Doppler tuning {state}, RX {r.rx_hz / 1e6:.6f} MHz{tx}"
-            else:
-                radio_text = f"Radio: Doppler tuning {state}"
-            lines.append(radio_text)
-        self._refresh_side(now)
-        current = None
-        if sample is not None and sample.look_angles is not None:
-            current = (sample.look_angles.azimuth_deg, sample.look_angles.elevation_deg)
-        self.query_one("#sky", Static).update(render_sky(getattr(self, "_track", []), current))
-        status = ", ".join(describe(snap.status)) or "ok"
-        lines.append(f"Status 0x{snap.status:04X}: {status}   {_clock(now)} UTC")
-        self.query_one("#state", Static).update("\n".join(lines))
+            lines.append(guarded("Rotor", partial(rotor_line, self.rotor)))
+        lines.append(guarded("Outputs", lambda: outputs_line(self.tcp, self.easycomm)))
+        lines.append(status_line(snap, self.times, now))
+        self.query_one("#state", Static).update(Text("\n").join(line for line in lines if line is not None))
+        self.query_one("#side").border_title = f"Passes ({self.times.zone(now)})"
+        self.query_one("#passes", Static).update(pass_table(self._search, self.core.state.catalog, self.times, now))
+        current = (values.azimuth_deg, values.elevation_deg) if values is not None else None
+        track = search.track if search is not None else []
+        self.query_one("#sky", Static).update(Text(render_sky(track, current)))
 
+    # -- pass searches on a worker thread -----------------------------------------------------------
+    def _maybe_search(self, now: datetime, catnr: int | None) -> None:
+        state = self.core.state
+        if state.observer is None:
+            return
+        key = (int(now.timestamp() // 60), catnr, id(state.observer), len(state.catalog))
+        if key == self._search_key:
+            return
+        self._search_key = key
+        args = (state.catalog, state.observer, state.horizon, state.ut1_utc_s, self.favourites, catnr, now)
+        self.run_worker(partial(self._search_thread, *args), thread=True, group="passes", exclusive=True,
+                        exit_on_error=False)
+
+    def _search_thread(self, *args) -> None:  # worker thread
+        try:
+            result = search_passes(*args)
+        except Exception:
+            log.exception("console: pass search failed")
+            return
+        try:
+            self.call_from_thread(self._searched, result)
+        except RuntimeError:  # the app is closing
+            pass
+
+    def _searched(self, result: PassSearch) -> None:
+        if self._search is None or result.now >= self._search.now or result.selected != self._search.selected:
+            self._search = result
+            self._refresh_state()
+
+    # -- commands -----------------------------------------------------------------------------------
     def on_input_submitted(self, message: Input.Submitted) -> None:
         text = message.value.strip()
         message.input.value = ""
-        if text:
-            self.core.command(text, source="console")
-            self._drain()
-            self._refresh_state()
-
-    def action_pick_satellite(self) -> None:
-        picker = self.query_one("#picker", OptionList)
-        picker.toggle_class("shown")
-        if picker.has_class("shown"):
-            picker.focus()
+        if not text:
+            return
+        word = text.upper().split()
+        if word == ["Z"]:
+            self.action_toggle_zone()
+        elif word[0] == "FLIP":
+            self._set_flip(word[1].lower() if len(word) == 2 else "")
         else:
-            self.query_one("#poke", Input).focus()
-
-    def on_option_list_option_selected(self, message: OptionList.OptionSelected) -> None:
-        if message.option.id:
-            self.core.command(f"SAT={message.option.id}", source="console")
-        message.option_list.remove_class("shown")
-        self.query_one("#poke", Input).focus()
-        self._passes_key = None
+            self.core.command(text, source="console")
         self._drain()
         self._refresh_state()
 
-    def _refresh_side(self, now: datetime) -> None:
-        """Upcoming passes of the favourites and the sky plot, recomputed once a minute."""
-        snap = self.core.snapshot()
-        key = int(now.timestamp() // 60) * 1_000_000 + (snap.catalog_number or 0)
-        if key == self._passes_key or self.core.state.observer is None:
+    def action_pick_satellite(self) -> None:
+        if isinstance(self.screen, SatellitePicker):
             return
-        self._passes_key = key
-        selected = [snap.catalog_number] if snap.catalog_number else []
-        wanted = list(dict.fromkeys([*self.favourites, *selected]))
-        sats = [s for s in (self.core.state.catalog.get(n) for n in wanted) if s is not None]
-        lines = []
-        if sats:
-            passes = find_passes(sats, self.core.state.observer, now, now + timedelta(hours=12),
-                                 horizon=self.core.state.horizon, ut1_utc=self.core.state.ut1_utc_s)
-            for p in [p for p in passes if p.los is None or p.los > now][:8]:
-                name = self.core.state.catalog.get(p.catalog_number).dde_name
-                lines.append(f"{name:12} {_clock(p.aos)} {p.max_elevation_deg:3.0f}deg {_clock(p.los)}")
-        self.query_one("#passes", Static).update("\n".join(lines) or "none in the next 12 h")
-        sat = self.core.state.catalog.get(snap.catalog_number) if snap.catalog_number else None
-        track: list[tuple[float, float]] = []
-        nxt = self._upcoming_pass(now)
-        if sat is not None and nxt is not None and nxt.aos is not None and nxt.los is not None:
-            calc = LookAngleCalculator(self.core.state.observer, self.core.state.ut1_utc_s)
-            t = nxt.aos
-            while t <= nxt.los:
-                la = calc.compute(sat.satrec, t)
-                track.append((la.azimuth_deg, la.elevation_deg))
-                t += timedelta(seconds=20)
-        self._track = track
+        picker = SatellitePicker(self.core.state.catalog, self.core.state.catalog_number, self.favourites)
+        self.push_screen(picker, self._picked)
 
-    def action_focus_outgoing(self) -> None:
-        self.query_one("#outgoing", RichLog).focus()
+    def _picked(self, catalog_number: int | None) -> None:
+        if catalog_number is not None:
+            self.core.command(f"SAT={catalog_number}", source="console")
+        self.query_one("#poke", Input).focus()
+        self._drain()
+        self._refresh_state()
 
-    def action_focus_incoming(self) -> None:
-        self.query_one("#incoming", RichLog).focus()
+    def _show_log(self, which: str) -> None:
+        self._shown_log = which
+        self._layout()
+        self.query_one(f"#{which}", RichLog).focus()
+
+    def action_show_outgoing(self) -> None:
+        self._show_log("outgoing")
+
+    def action_show_incoming(self) -> None:
+        self._show_log("incoming")
+
+    def action_toggle_zone(self) -> None:
+        self.times.toggle()
+        self._note(f"times now in {self.times.zone(self.core.clock.now())}", "dim")
+        self._refresh_state()
 
     def action_toggle_doppler(self) -> None:
-        if self.radio is not None:
-            self.core.set_radio_tuning(not self.core.state.radio_tuning, source="console")
+        on = not self.core.state.radio_tuning
+        self.core.set_radio_tuning(on, source="console")
+        if self.radio is None:
+            where = self.config_file or "the configuration file"
+            text = (f"Doppler tuning {'on' if on else 'off'}, but no radio is configured, so nothing is tuned: "
+                    f"set [radio] backend = \"rigctld\" (with host and port of a running rigctld) in {where} and "
+                    "give the satellite a channel in [satellites] channels.")
+            self._note(text)
+            self.notify(text, title="No radio", severity="warning", markup=False)
+        self._drain()
+        self._refresh_state()
 
     def action_toggle_tune(self) -> None:
         self.core.command("TUNE OFF" if self.core.snapshot().state.dde_output else "TUNE ON", source="console")
+
+    def action_cycle_flip(self) -> None:
+        if self.rotor is None:
+            self._set_flip("")
+            return
+        order = list(FLIP_MODES)
+        self._set_flip(order[(order.index(self.rotor.flip_mode) + 1) % len(order)])
+
+    def _set_flip(self, mode: str) -> None:
+        if self.rotor is None:
+            self._note("no rotor is configured ([rotor] backend), so there is no flip mode to set")
+        elif mode not in FLIP_MODES:
+            self._note(f"flip mode must be one of {', '.join(FLIP_MODES)}: FLIP AUTO, FLIP ON or FLIP OFF", "red")
+        else:
+            self.rotor.set_flip_mode(mode)
+        self._drain()
+        self._refresh_state()

@@ -76,7 +76,7 @@ def test_run_says_one_sentence_when_the_predict_port_is_taken(tmp_path, capsys) 
         cfg.write_text(f'[observer]\nlocation = "JO02ae"\n[dialects]\npredict_udp = true\npredict_port = {port}\n')
         assert main(["run", "--headless", "--duration", "0.2", "--config", str(cfg)]) == 1
     err = capsys.readouterr().err
-    lines = [line for line in err.splitlines() if line.strip()]
+    lines = [line for line in err.splitlines() if line.strip() and not line.startswith("nfwserver: logging to ")]
     assert len(lines) == 1 and "Traceback" not in err, err
     assert "PREDICT" in lines[0] and f"127.0.0.1:{port}" in lines[0] and "in use" in lines[0]
 

@@ -1,9 +1,11 @@
-"""``nfwserver simulate``: flags, output format, pokes, and bad input."""
+"""``nfwserver simulate``: flags, output format, pokes, the station defaults, and bad input."""
 
 from __future__ import annotations
 
 import re
 import time
+from datetime import datetime, timedelta, timezone
+from pathlib import Path
 
 import pytest
 
@@ -19,7 +21,7 @@ BASE = ["simulate", "--elements", str(DATA / "visual.txt"), "--observer", "-33.8
 
 
 def test_output_lines_times_and_pokes(capsys) -> None:
-    assert main([*BASE, "--duration", "60", "--rate", "2", "--sat", "25544",
+    assert main([*BASE, "--duration", "60", "--rate", "2", "--sat", "25544", "--poke", "0:TUNE ON",
                  "--poke", "10:TUNE OFF", "--poke", "20:TUNE ON", "--poke", "30:SAT=99999"]) == 0
     out, err = capsys.readouterr()
     lines = out.splitlines()
@@ -32,6 +34,23 @@ def test_output_lines_times_and_pokes(capsys) -> None:
     assert "99999" in err and "not in the catalog" in err
 
 
+def test_tune_on_is_poked_automatically_only_without_a_tune_poke(capsys) -> None:
+    assert main([*BASE, "--duration", "10", "--sat", "25544", "--poke", "5:TUNE ON"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("2026-05-08T00:00:05.000Z\tISS ") and len(lines) == 26  # nothing before TUNE ON
+    assert main([*BASE, "--duration", "10", "--sat", "25544", "--poke", "5:TRACK ON"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("2026-05-08T00:00:00.000Z\tISS ") and len(lines) == 51
+    help_text = " ".join(_help(capsys).split())
+    assert "TUNE ON is poked at the start unless a --poke holds a TUNE command" in help_text
+
+
+def _help(capsys) -> str:
+    with pytest.raises(SystemExit):
+        main(["simulate", "--help"])
+    return capsys.readouterr().out
+
+
 def test_a_45_minute_session_at_5_hz_runs_fast(capsys) -> None:
     started = time.perf_counter()
     assert main([*BASE, "--duration", "2700", "--sat", "25544"]) == 0
@@ -39,30 +58,76 @@ def test_a_45_minute_session_at_5_hz_runs_fast(capsys) -> None:
     assert time.perf_counter() - started < 30  # generous bound: far faster than real time
 
 
-def test_without_a_satellite_nothing_is_published_and_it_says_why(capsys) -> None:
-    assert main([*BASE, "--duration", "5"]) == 0
+def test_the_configured_satellite_and_names_for_sat(capsys, tmp_path) -> None:
+    config = tmp_path / "c.toml"
+    config.write_text("[server]\nsatellite = 3669\n")
+    assert main([*BASE, "--config", str(config), "--duration", "1"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert len(out) == 6 and all(line.split("\t")[1].startswith("ISIS-1 AZ:") for line in out)
+    assert main([*BASE, "--config", str(config), "--duration", "1", "--sat", "iss"]) == 0
+    assert all(line.split("\t")[1].startswith("ISS AZ:") for line in capsys.readouterr().out.splitlines())
+    assert main([*BASE, "--duration", "1", "--sat", "NO SUCH SAT"]) == 1
+    assert "satellite NO SUCH SAT is not in the catalog" in capsys.readouterr().err
+
+
+def test_without_a_satellite_nothing_is_published_and_the_warning_matches_the_pokes(capsys, tmp_path) -> None:
+    config = tmp_path / "c.toml"
+    config.write_text("[server]\nsatellite = 99999\n")
+    base = [*BASE, "--config", str(config), "--duration", "5"]
+    assert main(base) == 0
     out, err = capsys.readouterr()
-    assert out == "" and "no --sat" in err
+    assert out == "" and "99999 is not in the catalog" in err and "nothing is published" in err
+    assert main([*base, "--poke", "2:SAT=25544"]) == 0
+    out, err = capsys.readouterr()
+    assert out.startswith("2026-05-08T00:00:02.000Z\tISS ")
+    assert "nothing is published until" not in err and "until the SAT= poke at 2 s" in err
+    assert main([*base, "--poke", "SAT=25544"]) == 0
+    out, err = capsys.readouterr()
+    assert out.startswith("2026-05-08T00:00:00.000Z\tISS ") and "SAT=" not in err and "nothing" not in err
+
+
+def test_start_defaults_to_now(capsys) -> None:
+    args = [a for a in BASE if a not in ("--start", "2026-05-08T00:00:00")]
+    before = datetime.now(timezone.utc)
+    assert main([*args, "--duration", "1", "--sat", "25544"]) == 0
+    first = capsys.readouterr().out.splitlines()[0].split("\t")[0]
+    when = datetime.strptime(first, "%Y-%m-%dT%H:%M:%S.%fZ").replace(tzinfo=timezone.utc)
+    assert before - timedelta(seconds=1) <= when <= datetime.now(timezone.utc)
+
+
+def test_runs_with_no_argument_but_the_duration_after_config_init_and_a_location(capsys, tmp_path) -> None:
+    assert main(["config", "init"]) == 0
+    path = Path(capsys.readouterr().out.strip().splitlines()[-1].split()[-1])
+    text = path.read_text()
+    assert '# location = "JO02ae"' in text
+    path.write_text(text.replace('# location = "JO02ae"', 'location = "JO02ae"'))
+    assert main(["simulate", "--duration", "60"]) == 0
+    out, err = capsys.readouterr()
+    lines = out.splitlines()
+    assert len(lines) == 301 and all(LINE.match(line) for line in lines) and lines[0].split("\t")[1].startswith("ISS ")
+    assert "observer" not in err
 
 
 @pytest.mark.parametrize(
-    ("extra", "message"),
-    [(["--rate", "100"], "--rate"), (["--start", "yesterday"], "--start"), (["--duration", "-1"], "--duration")],
+    "extra",
+    [["--rate", "500"], ["--start", "yesterday"], ["--duration", "-5"], ["--duration", "0"],
+     ["--poke", "abc:TUNE ON"], ["--poke", "-5:TUNE ON"], ["--poke", "61:TUNE OFF"], ["--client", "excel"],
+     ["--link", "NFW32/NFW_DATA"], ["--link", "Nobody|Home!Here"], ["--client", "matlab", "--poll", "0"],
+     ["--poll", "-1"], ["--observer", "ZZ99zz"], ["--sat", ""]],
 )
-def test_bad_input_is_one_sentence_and_exit_1(capsys, extra, message) -> None:
+def test_bad_values_are_usage_errors_exit_2(capsys, extra) -> None:
     args = [a for a in BASE if a not in ("--start", "2026-05-08T00:00:00")] if "--start" in extra else BASE
-    assert main([*args, "--sat", "25544", *extra]) == 1
+    with pytest.raises(SystemExit) as info:
+        main([*args, "--duration", "60", "--sat", "25544", *extra])
+    assert info.value.code == 2
     err = capsys.readouterr().err
-    assert message in err and "Traceback" not in err
+    assert "error:" in err and "Traceback" not in err and len(err.strip().splitlines()[-1]) < 300
 
 
-def test_bad_observer_and_missing_file(capsys, tmp_path) -> None:
+def test_a_missing_element_file_is_a_runtime_error(capsys, tmp_path) -> None:
     assert main(["simulate", "--elements", str(tmp_path / "none.txt"), "--observer", "1,2",
                  "--start", "2026-05-08T00:00:00", "--sat", "1"]) == 1
     assert "no usable element sets" in capsys.readouterr().err
-    with pytest.raises(SystemExit) as info:
-        main(["simulate", "--observer", "1,2"])
-    assert info.value.code == 2
 
 
 def test_real_time_publisher_ticks_at_its_rate_and_stops() -> None:
