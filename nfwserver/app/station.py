@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import logging
 import os
-import sys
 import threading
 
 from nfwserver.app.element_sources import FetchResult, fetch_all
@@ -13,6 +12,7 @@ from nfwserver.app.session_state import SessionState, StateFile
 from nfwserver.clock import Clock
 from nfwserver.config.schema import Config
 from nfwserver.dde.events import Direction
+from nfwserver.dde.platform_transport import default_transport
 from nfwserver.dde.publisher import Publisher
 from nfwserver.dde.server import NovaServer
 from nfwserver.dde.transport import DdeServerTransport
@@ -21,7 +21,6 @@ from nfwserver.dialects.orbitron import ORBITRON
 from nfwserver.dialects.predict_udp import PredictContext, PredictUdpServer
 from nfwserver.dialects.satpc32 import SATPC32
 from nfwserver.dialects.wxtrack import WXTRACK
-from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.radio.rigctld_backend import RigctldBackend
 from nfwserver.radio.tuning import DopplerTuner
@@ -37,23 +36,6 @@ from nfwserver.tracking.catalog import Catalog, UpdateSummary
 log = logging.getLogger(__name__)
 
 DDE_DIALECTS = {d.name: d for d in (ORBITRON, WXTRACK, SATPC32)}
-
-
-def default_transport() -> tuple[DdeServerTransport, str]:
-    """The platform's DDE transport and a sentence describing it.
-
-    Windows gets real DDE once the DDEML transport is available; everywhere else (and until then)
-    the in-process fake DDE transport serves, which local tools and the console can use.
-    """
-    if sys.platform == "win32":
-        try:
-            from nfwserver.dde.windows_transport import WindowsDdeTransport  # type: ignore[import-not-found]
-
-            return WindowsDdeTransport(), "serving real DDE (DDEML)"
-        except ImportError:
-            pass
-    return (FakeDdeSystem().server_transport(),
-            "no Windows DDE here: serving on the in-process fake DDE transport (console and local tools)")
 
 
 class Station:
