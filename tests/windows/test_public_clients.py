@@ -115,6 +115,7 @@ def test_matlab_ddeinit_ddepoke_ddereq(station) -> None:
                 channel.Poke("NFW_SERVER", "NOT A COMMAND")
         else:  # Wine 8.0: a refused poke returns TRUE (result 0), which pywin32 takes as success
             channel.Poke("NFW_SERVER", "NOT A COMMAND")
+            channel.Request("NFW_SERVER")  # and the reply after a refusal may be out of step once
         assert NOVA.match(channel.Request("NFW_SERVER").rstrip("\x00"))  # the conversation goes on
     finally:
         server.Destroy()
