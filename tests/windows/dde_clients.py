@@ -2,11 +2,14 @@
 
 ``python dde_clients.py --clients 20 --seconds 60 --out FILE [--wait-disconnect 40]``
 
-Each client runs on a thread of its own with its own DDEML instance (a DDEML rule), connects
-(half to ``NFW32``, half to ``NFW_SERVER``; retrying while the station starts), pokes
-``TUNE ON``, starts a hot advise loop on ``NFW_SERVER`` and counts the strings delivered during a
-common window of ``--seconds``.  With ``--wait-disconnect`` it then keeps pumping until the station
-ends the conversation (``XTYP_DISCONNECT``).  Results go to ``--out`` as JSON, one record per client.
+Each client is a conversation of its own (the server sees N clients): half connect to ``NFW32``,
+half to ``NFW_SERVER`` (retrying while the station starts), poke ``TUNE ON`` and start a hot
+advise loop on ``NFW_SERVER``.  They share one DDEML instance on this program's one thread:
+Wine 8.0's DDEML finds instances by thread, so several instances on one thread misroute their
+callbacks, and many threads connecting at once lose conversations (docs/PLATFORMS.md).
+The strings delivered during a common window of ``--seconds`` are counted per conversation.
+With ``--wait-disconnect`` the program then waits until the station ends every conversation
+(``XTYP_DISCONNECT``).  Results go to ``--out`` as JSON, one record per client.
 """
 
 from __future__ import annotations
@@ -14,7 +17,6 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-import threading
 import time
 from pathlib import Path
 
@@ -25,49 +27,18 @@ from nfwserver.dde.ddeml_client import DdemlClient, DdeRefused  # noqa: E402
 SERVICES = ("NFW32", "NFW_SERVER")
 
 
-def run_client(index: int, args: argparse.Namespace, connected: threading.Barrier, out: dict) -> None:
-    service = SERVICES[index % 2]
-    record: dict = {"client": index, "service": service, "error": None}
-    out[index] = record
-    client = DdemlClient()
-    try:
-        deadline = time.monotonic() + args.connect_timeout
-        while True:
-            try:
-                conv = client.connect(service, "NFW_DATA")
-                break
-            except DdeRefused:
-                if time.monotonic() > deadline:
-                    raise
-                client.pump(0.25)
-        client.poke(conv, "NFW_SERVER", "TUNE ON")
-        client.start_advise(conv, "NFW_SERVER", hot=True)
-    except Exception as exc:  # reported, and the barrier released for the others
-        record["error"] = f"{type(exc).__name__}: {exc}"
-        connected.abort()
-        return
-    try:
-        connected.wait(args.connect_timeout + 30)
-    except threading.BrokenBarrierError:
-        record["error"] = "another client failed to connect"
-        return
-    start_count, start = client.advise_counts[conv], time.monotonic()
-    client.pump(args.seconds)
-    record["advise"] = client.advise_counts[conv] - start_count
-    record["window_s"] = time.monotonic() - start
-    record["still_connected"] = conv not in client.disconnected
-    try:
-        record["request_after"] = client.request_text(conv, "NFW_SERVER")
-    except DdeRefused as exc:
-        record["request_after"] = f"refused: {exc}"
-    data = [d for _, d in client.received if d]
-    record["sample"] = data[-1].split(b"\x00")[0].decode("cp1252") if data else ""
-    client.received.clear()
-    if args.wait_disconnect:
-        t0 = time.monotonic()
-        record["disconnected"] = client.pump(args.wait_disconnect, until=lambda: conv in client.disconnected)
-        record["disconnect_wait_s"] = time.monotonic() - t0
-    client.close()
+def connect(client: DdemlClient, service: str, timeout_s: float) -> int:
+    deadline = time.monotonic() + timeout_s
+    while True:
+        try:
+            conv = client.connect(service, "NFW_DATA")
+            client.poke(conv, "NFW_SERVER", "TUNE ON")
+            client.start_advise(conv, "NFW_SERVER", hot=True)
+            return conv
+        except DdeRefused:
+            if time.monotonic() > deadline:
+                raise
+            client.pump(0.25)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -78,17 +49,43 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--wait-disconnect", type=float, default=0.0)
     parser.add_argument("--out", required=True)
     args = parser.parse_args(argv)
-    connected = threading.Barrier(args.clients)
-    results: dict[int, dict] = {}
-    threads = [threading.Thread(target=run_client, args=(i, args, connected, results), daemon=True)
-               for i in range(args.clients)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join(args.connect_timeout + args.seconds + args.wait_disconnect + 60)
-    Path(args.out).write_text(json.dumps([results.get(i, {"client": i, "error": "no result"})
-                                          for i in range(args.clients)], indent=1))
-    return 0 if all(r.get("error") is None for r in results.values()) and len(results) == args.clients else 1
+    records = [{"client": i, "service": SERVICES[i % 2], "error": None} for i in range(args.clients)]
+    shared = DdemlClient()
+    clients: list[DdemlClient] = []
+    convs: list[int] = []
+    try:
+        for record in records:
+            clients.append(shared)
+            convs.append(connect(shared, record["service"], args.connect_timeout))
+    except Exception as exc:
+        records[len(convs)]["error"] = f"{type(exc).__name__}: {exc}"
+        Path(args.out).write_text(json.dumps(records, indent=1))
+        return 1
+    pump = clients[0].pump  # one thread: pumping dispatches every instance's messages
+    start_counts = [c.advise_counts[v] for c, v in zip(clients, convs)]
+    shared.received.clear()
+    start = time.monotonic()
+    pump(args.seconds)
+    window = time.monotonic() - start
+    for record, c, conv, n0 in zip(records, clients, convs, start_counts):
+        record["advise"] = c.advise_counts[conv] - n0
+        record["window_s"] = window
+        record["still_connected"] = conv not in c.disconnected
+        data = [d for _, d in c.received if d]
+        record["sample"] = data[-1].split(b"\x00")[0].decode("cp1252") if data else ""
+        try:
+            record["request_after"] = c.request_text(conv, "NFW_SERVER")
+        except DdeRefused as exc:
+            record["request_after"] = f"refused: {exc}"
+    if args.wait_disconnect:
+        t0 = time.monotonic()
+        pump(args.wait_disconnect, until=lambda: all(v in c.disconnected for c, v in zip(clients, convs)))
+        for record, c, conv in zip(records, clients, convs):
+            record["disconnected"] = conv in c.disconnected
+            record["disconnect_wait_s"] = time.monotonic() - t0
+    shared.close()
+    Path(args.out).write_text(json.dumps(records, indent=1))
+    return 0
 
 
 if __name__ == "__main__":

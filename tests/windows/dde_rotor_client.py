@@ -19,7 +19,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent.parent))
 
-from nfwserver.dde.ddeml_client import DdemlClient  # noqa: E402
+from nfwserver.dde.ddeml_client import DdemlClient, DdeRefused  # noqa: E402
 
 AZ_EL = re.compile(r" AZ:(\d+\.\d) EL:(-?\d+\.\d) ")
 
@@ -32,7 +32,14 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     host, port = args.rotctld.rsplit(":", 1)
     client = DdemlClient(ansi=True)
-    conv = client.connect("NFW32", "NFW_DATA")
+    for attempt in range(240):  # the station may still be starting: retry for up to a minute
+        try:
+            conv = client.connect("NFW32", "NFW_DATA")
+            break
+        except DdeRefused:
+            if attempt == 239:
+                raise
+            client.pump(0.25)
     client.poke(conv, "NFW_SERVER", "TUNE ON")
     client.start_advise(conv, "NFW_SERVER", hot=True)
     sent: list[tuple[float, float]] = []
