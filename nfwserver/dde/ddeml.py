@@ -52,8 +52,12 @@ DDE_FACK = 0x8000
 DDE_FBUSY = 0x4000
 DDE_FNOTPROCESSED = 0x0000
 
+CP_WINANSI = 1004
 CP_WINUNICODE = 1200
 DMLERR_NO_ERROR = 0
+DMLERR_NOTPROCESSED = 0x4009
+PM_REMOVE = 0x0001
+QS_ALLINPUT = 0x04FF
 TIMEOUT_ASYNC = 0xFFFFFFFF
 WM_APP = 0x8000
 
@@ -83,6 +87,9 @@ def load_user32():  # pragma: no cover - Windows only
         return fn
 
     proto("DdeInitializeW", UINT, ctypes.POINTER(DWORD), CALLBACK_TYPE, DWORD, DWORD)
+    proto("DdeInitializeA", UINT, ctypes.POINTER(DWORD), CALLBACK_TYPE, DWORD, DWORD)
+    proto("DdeCreateStringHandleA", HANDLE, DWORD, ctypes.c_char_p, ctypes.c_int)
+    proto("DdeQueryStringA", DWORD, DWORD, HANDLE, ctypes.c_char_p, DWORD, ctypes.c_int)
     proto("DdeUninitialize", wintypes.BOOL, DWORD)
     proto("DdeCreateStringHandleW", HANDLE, DWORD, wintypes.LPCWSTR, ctypes.c_int)
     proto("DdeFreeStringHandle", wintypes.BOOL, DWORD, HANDLE)
@@ -101,4 +108,5 @@ def load_user32():  # pragma: no cover - Windows only
     proto("TranslateMessage", wintypes.BOOL, ctypes.POINTER(wintypes.MSG))
     proto("DispatchMessageW", ctypes.c_ssize_t, ctypes.POINTER(wintypes.MSG))
     proto("PostThreadMessageW", wintypes.BOOL, DWORD, UINT, wintypes.WPARAM, wintypes.LPARAM)
+    proto("MsgWaitForMultipleObjects", DWORD, DWORD, LPVOID, wintypes.BOOL, DWORD, DWORD)
     return u

@@ -10,6 +10,10 @@ DDEML rules this follows (Microsoft's DDEML documentation, in our words):
   after ``DdePostAdvise``; the handle then belongs to DDEML.
 - ``XTYP_POKE`` and ``XTYP_EXECUTE`` deliver a data handle (read with ``DdeGetData``); the server
   answers ``DDE_FACK``, ``DDE_FBUSY`` or ``DDE_FNOTPROCESSED``.
+- Execute strings are converted by DDEML to the server instance's character set: an instance made
+  with ``DdeInitializeW`` (ours) receives UTF-16 even from ANSI clients (seen under Wine 8.0; the
+  DDEML documentation describes the same conversion).  :func:`execute_command` turns them back into
+  the ``CF_TEXT`` bytes the handler expects.
 - ``XTYP_ADVSTART`` returns TRUE to allow the advise loop; ``XTYP_ADVSTOP`` and
   ``XTYP_DISCONNECT`` are notifications (the return value is ignored).
 - A callback must not raise: any exception is logged and the transaction refused.
@@ -25,6 +29,7 @@ from collections.abc import Callable
 from typing import Protocol
 
 from nfwserver.dde import ddeml
+from nfwserver.dde.clipboard import CF_TEXT, CF_UNICODETEXT, decode_text, encode_text
 from nfwserver.dde.transport import ConversationId, DdeServerHandler, PokeResult
 
 log = logging.getLogger(__name__)
@@ -40,12 +45,27 @@ class DdemlApi(Protocol):
     def create_data(self, data: bytes, hsz_item: int, fmt: int) -> int: ...
 
 
+def execute_command(data: bytes, unicode_instance: bool = True) -> bytes:
+    """An execute transaction's data as ``CF_TEXT`` bytes (cp1252, NUL-terminated).
+
+    For a Unicode instance the data is UTF-16-LE; data that cannot be UTF-16 (an odd length
+    with a non-NUL second byte, as from a DDEML that passed an ANSI string through) is taken
+    as ANSI.  A one-character ANSI command followed by its NUL reads the same either way.
+    """
+    looks_utf16 = len(data) >= 2 and data[1] == 0 and (len(data) % 2 == 0 or data.endswith(b"\x00\x00"))
+    if unicode_instance and looks_utf16:
+        return encode_text(decode_text(data, CF_UNICODETEXT), CF_TEXT)
+    return data
+
+
 class DdemlDispatcher:
     """The DDEML callback's body.  ``lookup(service)`` returns the handler registered for a service."""
 
-    def __init__(self, lookup: Callable[[str], DdeServerHandler | None], api: DdemlApi) -> None:
+    def __init__(self, lookup: Callable[[str], DdeServerHandler | None], api: DdemlApi,
+                 unicode_instance: bool = True) -> None:
         self.lookup = lookup
         self.api = api
+        self.unicode_instance = unicode_instance  #: the instance was made with DdeInitializeW
         self._conversations: dict[int, tuple[ConversationId, DdeServerHandler]] = {}
         self._next_id = 1
 
@@ -94,7 +114,8 @@ class DdemlDispatcher:
             result = handler.on_poke(conv, topic, self.api.query_string(hsz2), fmt, self.api.get_data(hdata))
             return int(result) if result in (PokeResult.FACK, PokeResult.FBUSY) else ddeml.DDE_FNOTPROCESSED
         if utype == ddeml.XTYP_EXECUTE:
-            result = handler.on_execute(conv, topic, self.api.get_data(hdata))
+            command = execute_command(self.api.get_data(hdata), self.unicode_instance)
+            result = handler.on_execute(conv, topic, command)
             return int(result) if result in (PokeResult.FACK, PokeResult.FBUSY) else ddeml.DDE_FNOTPROCESSED
         if utype == ddeml.XTYP_ADVSTART:
             return int(bool(handler.on_advise_start(conv, topic, self.api.query_string(hsz2), fmt)))

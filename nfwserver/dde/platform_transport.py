@@ -1,4 +1,4 @@
-"""Choosing the DDE transport for this platform."""
+"""The DDE transport a station serves on by default: real DDEML on Windows, the fake one elsewhere."""
 
 from __future__ import annotations
 
@@ -6,24 +6,27 @@ import logging
 import sys
 
 from nfwserver.dde.transport import DdeServerTransport
+from nfwserver.fake_dde import FakeDdeSystem
 
 log = logging.getLogger(__name__)
 
+FAKE_NOTE = "no Windows DDE here: serving on the in-process fake DDE transport (console and local tools)"
 
-def default_transport() -> tuple[DdeServerTransport, str]:
+
+def default_transport(platform: str = sys.platform) -> tuple[DdeServerTransport, str]:
     """The platform's DDE transport and a sentence describing it.
 
-    On Windows, real DDE through DDEML; if that cannot start (no DDEML, or it fails to initialise)
-    the reason is logged and the in-process transport serves instead, as it does everywhere else.
+    On Windows (``platform == "win32"``) the DDEML transport; when it cannot start — it raises
+    :class:`OSError` (DDEML refused, no window station) or :class:`ImportError` — the station
+    still runs, on the in-process fake DDE transport, and the sentence says why.
     """
-    from nfwserver.fake_dde import FakeDdeSystem
-
-    if sys.platform == "win32":
+    if platform == "win32":
         try:
             from nfwserver.dde.windows_transport import WindowsDdeTransport
 
             return WindowsDdeTransport(), "serving real DDE (DDEML)"
-        except (ImportError, OSError, RuntimeError) as exc:
-            log.error("real DDE could not start (%s): serving on the in-process transport only", exc)
-    return (FakeDdeSystem().server_transport(),
-            "no Windows DDE here: serving on the in-process DDE transport (console and local tools)")
+        except (ImportError, OSError) as exc:
+            log.error("the Windows DDE transport did not start: %s", exc)
+            return (FakeDdeSystem().server_transport(),
+                    f"real DDE failed to start ({exc}): serving on the in-process fake DDE transport only")
+    return FakeDdeSystem().server_transport(), FAKE_NOTE

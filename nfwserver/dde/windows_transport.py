@@ -25,7 +25,9 @@ import logging
 import queue
 import sys
 import threading
+import time
 from collections.abc import Callable
+from dataclasses import dataclass
 
 from nfwserver.dde import ddeml
 from nfwserver.dde.ddeml_dispatch import DdemlDispatcher
@@ -34,6 +36,24 @@ from nfwserver.dde.transport import DdeServerHandler
 log = logging.getLogger(__name__)
 
 _WAKE = ddeml.WM_APP + 0x4E
+
+
+@dataclass
+class PostAdviseStats:
+    """Wall time of ``DdePostAdvise`` calls (s): DDEML runs our ``XTYP_ADVREQ`` for every loop inside it."""
+
+    count: int = 0
+    total_s: float = 0.0
+    max_s: float = 0.0
+
+    def add(self, seconds: float) -> None:
+        self.count += 1
+        self.total_s += seconds
+        self.max_s = max(self.max_s, seconds)
+
+    @property
+    def mean_s(self) -> float:
+        return self.total_s / self.count if self.count else 0.0
 
 
 class _User32Api:  # pragma: no cover - Windows only
@@ -76,6 +96,9 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
         self._hsz: dict[str, int] = {}
         self._registered: dict[str, int] = {}
         self._closed = False
+        self._failures = 0
+        #: DdePostAdvise calls on the DDE thread (each runs one XTYP_ADVREQ per advise loop)
+        self.post_advise_stats = PostAdviseStats()
         self._thread = threading.Thread(target=self._run, name="nfw-ddeml", daemon=True)
         self._thread.start()
         if not self._ready.wait(start_timeout_s) or self._error is not None:
@@ -140,8 +163,10 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
                 return
             try:
                 call()
-            except Exception:
-                log.exception("DDE transport call failed")
+            except Exception:  # only calls nobody waits for get here (see _call); rate-limited
+                self._failures += 1
+                if self._failures == 1 or self._failures % 600 == 0:
+                    log.exception("DDE transport call failed (%d failures so far)", self._failures)
 
     def _shutdown(self) -> None:
         for service in list(self._registered):
@@ -151,22 +176,34 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
         self._hsz.clear()
         self.u.DdeUninitialize(self.inst)
 
-    def _call(self, fn: Callable[[], None], wait: bool = True) -> None:
+    def _call(self, fn: Callable[[], None], wait: bool = True, timeout_s: float = 5.0) -> None:
+        """Run ``fn`` on the DDE thread.  With ``wait``, its exception is raised here, in the caller;
+        a DDE thread that does not answer within ``timeout_s`` raises :class:`TimeoutError`."""
         if threading.current_thread() is self._thread:
             fn()
             return
+        if not wait:
+            self._calls.put(fn)
+            self.u.PostThreadMessageW(self._thread_id, _WAKE, 0, 0)
+            return
         done = threading.Event()
+        failure: list[BaseException] = []
 
         def wrapped() -> None:
             try:
                 fn()
+            except BaseException as exc:
+                failure.append(exc)
             finally:
                 done.set()
 
         self._calls.put(wrapped)
-        self.u.PostThreadMessageW(self._thread_id, _WAKE, 0, 0)
-        if wait:
-            done.wait(5.0)
+        if not self.u.PostThreadMessageW(self._thread_id, _WAKE, 0, 0):
+            raise OSError("the DDE thread has stopped")
+        if not done.wait(timeout_s):
+            raise TimeoutError(f"the DDE thread did not answer within {timeout_s} s")
+        if failure:
+            raise failure[0]
 
     # -- DdeServerTransport ----------------------------------------------------------------
     def register_service(self, service: str, handler: DdeServerHandler) -> None:
@@ -174,7 +211,9 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
             self._handlers[service.upper()] = handler
             hsz = self._string(service)
             if not self.u.DdeNameService(self.inst, hsz, None, ddeml.DNS_REGISTER):
-                raise OSError(f"DdeNameService could not register {service}")
+                self._handlers.pop(service.upper(), None)
+                raise OSError(f"DdeNameService could not register {service} "
+                              f"(DMLERR 0x{self.u.DdeGetLastError(self.inst):04X})")
             self._registered[service.upper()] = hsz
             log.info("DDE service %s registered", service)
 
@@ -190,7 +229,15 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
         self._call(do)
 
     def post_advise(self, topic: str, item: str) -> None:
-        self._call(lambda: self.u.DdePostAdvise(self.inst, self._string(topic), self._string(item)), wait=False)
+        def do() -> None:
+            start = time.perf_counter()
+            ok = self.u.DdePostAdvise(self.inst, self._string(topic), self._string(item))
+            self.post_advise_stats.add(time.perf_counter() - start)
+            if not ok:
+                err = self.u.DdeGetLastError(self.inst)
+                raise OSError(f"DdePostAdvise {topic}/{item} failed with DMLERR 0x{err:04X}")
+
+        self._call(do, wait=False)
 
     def close(self) -> None:
         if self._closed:

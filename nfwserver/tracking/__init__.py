@@ -6,3 +6,7 @@ number, update semantics, DDE names), ``observer`` and ``maidenhead`` (station p
 (azimuth, elevation, range, range rate from SGP4, scalar and vectorised), ``passes`` (AOS/TCA/LOS),
 ``doppler`` and ``derived`` (InstantTrack's realtime values).
 """
+
+from nfwserver.tracking.sgp4_selfcheck import ensure_working_sgp4
+
+SGP4_CHOICE = ensure_working_sgp4()  # before any tracking module imports sgp4's classes

@@ -66,7 +66,7 @@ def test_run_headless_for_a_bounded_time(tmp_path, capsys) -> None:
     config.write_text('[observer]\nlocation = "JO02ae"\n[server]\nrate_hz = 20\n')
     assert main(["run", "--headless", "--duration", "0.3", "--config", str(config), "--log-file", str(log_file)]) == 0
     err = capsys.readouterr().err
-    assert "in-process DDE transport" in err and "satellites loaded" in err
+    assert "in-process fake DDE transport" in err and "satellites loaded" in err
     assert "stopped" in log_file.read_text()
 
 

@@ -99,3 +99,28 @@ def test_unknown_conversations_and_handler_failures_are_refused_not_raised() -> 
     assert dispatch(ddeml.XTYP_POKE, CF_TEXT, 77, topic, item, 424242) == ddeml.DDE_FNOTPROCESSED
     assert dispatch(ddeml.XTYP_REQUEST, CF_TEXT, 77, 999999, item, 0) == 0
     assert dispatch(ddeml.XTYP_WILDCONNECT, 0, 0, 0, 0, 0) == 0
+
+
+def test_execute_arrives_whole_from_utf16_and_from_ansi_data() -> None:
+    """A DdeInitializeW server gets executes as UTF-16; `TRACK ON` must not arrive as `T`."""
+    server, api, dispatch = _setup()
+    assert _connect(api, dispatch)
+    topic = api.hsz("NFW_DATA")
+    utf16 = "TRACK ON".encode("utf-16-le") + b"\x00\x00"
+    assert dispatch(ddeml.XTYP_EXECUTE, 0, 77, topic, 0, api.hdata(utf16)) == ddeml.DDE_FACK
+    assert server.core.snapshot().state.tracking
+    assert dispatch(ddeml.XTYP_EXECUTE, 0, 77, topic, 0, api.hdata(b"TRACK OFF\x00")) == ddeml.DDE_FACK
+    assert not server.core.snapshot().state.tracking
+    assert dispatch(ddeml.XTYP_EXECUTE, 0, 77, topic, 0, api.hdata("BOGUS".encode("utf-16-le"))) \
+        == ddeml.DDE_FNOTPROCESSED
+
+
+def test_execute_command_conversion() -> None:
+    from nfwserver.dde.ddeml_dispatch import execute_command
+
+    assert execute_command("TUNE ON".encode("utf-16-le") + b"\x00\x00") == b"TUNE ON\x00"
+    assert execute_command("TUNE ON".encode("utf-16-le")) == b"TUNE ON\x00"  # no terminator
+    assert execute_command(b"TUNE ON\x00") == b"TUNE ON\x00"  # ANSI passed through
+    assert execute_command(b"T\x00") in (b"T\x00",)  # one ANSI character reads the same either way
+    assert execute_command("TUNE ON".encode("utf-16-le") + b"\x00\x00", unicode_instance=False) \
+        == "TUNE ON".encode("utf-16-le") + b"\x00\x00"

@@ -1,0 +1,80 @@
+"""Fixtures of the Windows suite: a station process serving real DDE, and an in-process server.
+
+These run only where DDEML exists (Windows, or the Windows Python under Wine: ``tools/wine/test``).
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+
+import pytest
+
+#: Nova's DDE string, from the spec's own words: name, AZ/EL one decimal, RR ten decimals, AH Y/N.
+NOVA = re.compile(r"^\S{1,12} AZ:\d{1,3}\.\d EL:-?\d{1,2}\.\d RR:-?\d+\.\d{10} AH:[YN]$")
+
+
+def wine_version() -> str | None:
+    """Wine's version when running under Wine (ntdll exports ``wine_get_version``), else None."""
+    if sys.platform != "win32":
+        return None
+    import ctypes
+
+    ntdll = ctypes.WinDLL("ntdll")
+    if not hasattr(ntdll, "wine_get_version"):
+        return None
+    ntdll.wine_get_version.restype = ctypes.c_char_p
+    return ntdll.wine_get_version().decode()
+
+
+def request_after_refusal(client, conv: int, item: str) -> str:
+    """The first request after a refused transaction.  Wine 8.0's DDEML may fail that one request
+    with DMLERR_NOTPROCESSED while an advise loop is active (docs/PLATFORMS.md); on Windows it
+    must succeed at once."""
+    from nfwserver.dde.ddeml_client import DdeRefused
+
+    try:
+        return client.request_text(conv, item)
+    except DdeRefused:
+        if wine_version() is None:
+            raise
+        return client.request_text(conv, item)
+
+
+@pytest.fixture(scope="session")
+def station(tmp_path_factory):
+    """``nfwserver run --headless`` in another process, serving NFW32 and NFW_SERVER (ISS, 10 Hz)."""
+    if sys.platform != "win32":
+        pytest.skip("needs Windows DDEML")
+    from tests.windows.station_config import write_station_config
+    from tests.windows.station_process import StationProcess
+
+    base = tmp_path_factory.mktemp("station")
+    proc = StationProcess(write_station_config(base), duration_s=600, log_file=base / "station.log")
+    try:
+        proc.wait_serving()
+        yield proc
+    finally:
+        proc.stop()
+
+
+@pytest.fixture
+def live_server():
+    """A server core on the DDEML transport in this process (for checks of its state)."""
+    from nfwserver.clock import SystemClock
+    from nfwserver.core.publisher import Publisher
+    from nfwserver.core.station_core import StationCore
+    from nfwserver.dde.nova_service import NovaDdeService
+    from nfwserver.dde.windows_transport import WindowsDdeTransport
+    from tests.dde.conftest import CATALOG, ISS, OBSERVER
+
+    core = StationCore(CATALOG, OBSERVER, SystemClock(), satellite=ISS, rate_hz=10)
+    server = NovaDdeService(core)
+    transport = WindowsDdeTransport()
+    server.attach(transport)
+    publisher = Publisher(core, SystemClock())
+    publisher.start()
+    yield core
+    publisher.stop()
+    server.detach()
+    transport.close()

@@ -1,0 +1,92 @@
+"""A Windows program: N real DDEML clients holding hot advise loops on a running station.
+
+``python dde_clients.py --clients 20 --seconds 60 --out FILE [--wait-disconnect 40]``
+
+Each client is a conversation of its own (the server sees N clients): half connect to ``NFW32``,
+half to ``NFW_SERVER`` (retrying while the station starts), poke ``TUNE ON`` and start a hot
+advise loop on ``NFW_SERVER``.  They share one DDEML instance on this program's one thread:
+Wine 8.0's DDEML finds instances by thread, so several instances on one thread misroute their
+callbacks, and many threads connecting at once lose conversations (docs/PLATFORMS.md).
+The strings delivered during a common window of ``--seconds`` are counted per conversation.
+With ``--wait-disconnect`` the program then waits until the station ends every conversation
+(``XTYP_DISCONNECT``).  Results go to ``--out`` as JSON, one record per client.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent.parent))
+
+from nfwserver.dde.ddeml_client import DdemlClient, DdeRefused  # noqa: E402
+
+SERVICES = ("NFW32", "NFW_SERVER")
+
+
+def connect(client: DdemlClient, service: str, timeout_s: float) -> int:
+    deadline = time.monotonic() + timeout_s
+    while True:
+        try:
+            conv = client.connect(service, "NFW_DATA")
+            client.poke(conv, "NFW_SERVER", "TUNE ON")
+            client.start_advise(conv, "NFW_SERVER", hot=True)
+            return conv
+        except DdeRefused:
+            if time.monotonic() > deadline:
+                raise
+            client.pump(0.25)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--clients", type=int, default=20)
+    parser.add_argument("--seconds", type=float, default=60.0)
+    parser.add_argument("--connect-timeout", type=float, default=60.0)
+    parser.add_argument("--wait-disconnect", type=float, default=0.0)
+    parser.add_argument("--out", required=True)
+    args = parser.parse_args(argv)
+    records = [{"client": i, "service": SERVICES[i % 2], "error": None} for i in range(args.clients)]
+    shared = DdemlClient()
+    clients: list[DdemlClient] = []
+    convs: list[int] = []
+    try:
+        for record in records:
+            clients.append(shared)
+            convs.append(connect(shared, record["service"], args.connect_timeout))
+    except Exception as exc:
+        records[len(convs)]["error"] = f"{type(exc).__name__}: {exc}"
+        Path(args.out).write_text(json.dumps(records, indent=1))
+        return 1
+    pump = clients[0].pump  # one thread: pumping dispatches every instance's messages
+    start_counts = [c.advise_counts[v] for c, v in zip(clients, convs)]
+    shared.received.clear()
+    start = time.monotonic()
+    pump(args.seconds)
+    window = time.monotonic() - start
+    for record, c, conv, n0 in zip(records, clients, convs, start_counts):
+        record["advise"] = c.advise_counts[conv] - n0
+        record["window_s"] = window
+        record["still_connected"] = conv not in c.disconnected
+        data = [d for _, d in c.received if d]
+        record["sample"] = data[-1].split(b"\x00")[0].decode("cp1252") if data else ""
+        try:
+            record["request_after"] = c.request_text(conv, "NFW_SERVER")
+        except DdeRefused as exc:
+            record["request_after"] = f"refused: {exc}"
+    if args.wait_disconnect:
+        t0 = time.monotonic()
+        pump(args.wait_disconnect, until=lambda: all(v in c.disconnected for c, v in zip(clients, convs)))
+        for record, c, conv in zip(records, clients, convs):
+            record["disconnected"] = conv in c.disconnected
+            record["disconnect_wait_s"] = time.monotonic() - t0
+    shared.close()
+    Path(args.out).write_text(json.dumps(records, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
