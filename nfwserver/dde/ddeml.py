@@ -52,6 +52,11 @@ DDE_FACK = 0x8000
 DDE_FBUSY = 0x4000
 DDE_FNOTPROCESSED = 0x0000
 
+# Conversation status bits (CONVINFO.wStatus).
+ST_CONNECTED = 0x0001
+ST_TERMINATED = 0x0020
+QID_SYNC = 0xFFFFFFFF
+
 CP_WINANSI = 1004
 CP_WINUNICODE = 1200
 DMLERR_NO_ERROR = 0
@@ -70,6 +75,26 @@ else:
     CALLBACK_TYPE = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_uint, ctypes.c_uint, ctypes.c_void_p,
                                      ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t,
                                      ctypes.c_size_t)
+
+
+def running_under_wine() -> bool:  # pragma: no cover - Windows only
+    """True when this "Windows" is Wine (its ntdll exports ``wine_get_version``)."""
+    if sys.platform != "win32":
+        return False
+    try:
+        return hasattr(ctypes.WinDLL("ntdll"), "wine_get_version")
+    except OSError:
+        return False
+
+
+class ConvInfo(ctypes.Structure):  # pragma: no cover - layout of ddeml.h's CONVINFO (64-bit)
+    _fields_ = [("cb", ctypes.c_uint32), ("hUser", ctypes.c_size_t), ("hConvPartner", ctypes.c_void_p),
+                ("hszSvcPartner", ctypes.c_void_p), ("hszServiceReq", ctypes.c_void_p),
+                ("hszTopic", ctypes.c_void_p), ("hszItem", ctypes.c_void_p), ("wFmt", ctypes.c_uint),
+                ("wType", ctypes.c_uint), ("wStatus", ctypes.c_uint), ("wConvst", ctypes.c_uint),
+                ("wLastError", ctypes.c_uint), ("hConvList", ctypes.c_void_p),
+                # CONVCONTEXT: cb, wFlags, wCountryID, iCodePage, dwLangID, dwSecurity, SECURITY_QOS (12 bytes)
+                ("ConvCtxt", ctypes.c_uint32 * 9), ("hwnd", ctypes.c_void_p), ("hwndPartner", ctypes.c_void_p)]
 
 
 def load_user32():  # pragma: no cover - Windows only
@@ -102,6 +127,7 @@ def load_user32():  # pragma: no cover - Windows only
     proto("DdeGetLastError", UINT, DWORD)
     proto("DdeConnect", HANDLE, DWORD, HANDLE, HANDLE, LPVOID)
     proto("DdeDisconnect", wintypes.BOOL, HANDLE)
+    proto("DdeQueryConvInfo", UINT, HANDLE, DWORD, ctypes.POINTER(ConvInfo))
     proto("DdeClientTransaction", HANDLE, LPVOID, DWORD, HANDLE, HANDLE, UINT, UINT, DWORD, ctypes.POINTER(DWORD))
     proto("GetMessageW", wintypes.BOOL, ctypes.POINTER(wintypes.MSG), wintypes.HWND, UINT, UINT)
     proto("PeekMessageW", wintypes.BOOL, ctypes.POINTER(wintypes.MSG), wintypes.HWND, UINT, UINT, UINT)

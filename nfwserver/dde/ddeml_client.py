@@ -105,6 +105,17 @@ class DdemlClient:  # pragma: no cover - Windows only
             return None
         return None
 
+    def ended_by_server(self, conv: int) -> bool:
+        """The server ended ``conv``: XTYP_DISCONNECT arrived, or (Wine, whose client DDEML never
+        delivers XTYP_DISCONNECT) DdeQueryConvInfo reports the conversation terminated or gone."""
+        if conv in self.disconnected:
+            return True
+        info = ddeml.ConvInfo()
+        info.cb = ctypes.sizeof(ddeml.ConvInfo)
+        if not self.u.DdeQueryConvInfo(conv, ddeml.QID_SYNC, ctypes.byref(info)):
+            return True  # DDEML no longer knows the conversation
+        return bool(info.wStatus & ddeml.ST_TERMINATED) or not info.wStatus & ddeml.ST_CONNECTED
+
     def _error(self, what: str) -> DdeRefused:
         err = self.u.DdeGetLastError(self.inst)
         return DdeRefused(f"{what} failed with DMLERR 0x{err:04X}", err)

@@ -67,10 +67,17 @@ class DdemlDispatcher:
         self.api = api
         self.unicode_instance = unicode_instance  #: the instance was made with DdeInitializeW
         self._conversations: dict[int, tuple[ConversationId, DdeServerHandler]] = {}
+        self._links: set[tuple[int, str, int]] = set()  #: advise links DDEML holds: (hconv, ITEM, format)
         self._next_id = 1
 
     def conversation_count(self) -> int:
         return len(self._conversations)
+
+    def advise_links(self, item: str) -> int:
+        """Advise links DDEML holds on ``item`` (any conversation, topic or format; names compare
+        case-insensitively, as DDEML compares string handles)."""
+        key = item.upper()
+        return sum(1 for _, linked, _ in self._links if linked == key)
 
     def __call__(self, utype: int, fmt: int, hconv: int, hsz1: int, hsz2: int, hdata: int,
                  data1: int = 0, data2: int = 0) -> int:
@@ -97,6 +104,7 @@ class DdemlDispatcher:
             return 0
         entry = self._conversations.get(hconv)
         if utype == ddeml.XTYP_DISCONNECT:
+            self._links = {link for link in self._links if link[0] != hconv}
             if entry is not None:
                 del self._conversations[hconv]
                 entry[1].on_disconnect(entry[0])
@@ -118,8 +126,14 @@ class DdemlDispatcher:
             result = handler.on_execute(conv, topic, command)
             return int(result) if result in (PokeResult.FACK, PokeResult.FBUSY) else ddeml.DDE_FNOTPROCESSED
         if utype == ddeml.XTYP_ADVSTART:
-            return int(bool(handler.on_advise_start(conv, topic, self.api.query_string(hsz2), fmt)))
+            item = self.api.query_string(hsz2)
+            accepted = bool(handler.on_advise_start(conv, topic, item, fmt))
+            if accepted:  # a second start on the same link changes it, DDEML keeps one link
+                self._links.add((hconv, item.upper(), fmt))
+            return int(accepted)
         if utype == ddeml.XTYP_ADVSTOP:
-            handler.on_advise_stop(conv, topic, self.api.query_string(hsz2), fmt)
+            item = self.api.query_string(hsz2)
+            self._links.discard((hconv, item.upper(), fmt))
+            handler.on_advise_stop(conv, topic, item, fmt)
             return 0
         return 0  # XTYP_WILDCONNECT (not offered), registrations, errors: nothing to do

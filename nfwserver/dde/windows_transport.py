@@ -99,6 +99,7 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
         self._failures = 0
         #: DdePostAdvise calls on the DDE thread (each runs one XTYP_ADVREQ per advise loop)
         self.post_advise_stats = PostAdviseStats()
+        self._wine_atoms = False  #: set on the DDE thread when running under Wine (see post_advise)
         self._thread = threading.Thread(target=self._run, name="nfw-ddeml", daemon=True)
         self._thread.start()
         if not self._ready.wait(start_timeout_s) or self._error is not None:
@@ -110,6 +111,10 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
             from ctypes import wintypes
 
             self.u = ddeml.load_user32()
+            self._kernel32 = ctypes.WinDLL("kernel32")
+            self._kernel32.GlobalAddAtomW.argtypes = [wintypes.LPCWSTR]
+            self._kernel32.GlobalAddAtomW.restype = wintypes.ATOM
+            self._wine_atoms = ddeml.running_under_wine()
             self._thread_id = ctypes.windll.kernel32.GetCurrentThreadId()
             inst = wintypes.DWORD(0)
             self._dispatcher: DdemlDispatcher | None = None
@@ -231,6 +236,12 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
     def post_advise(self, topic: str, item: str) -> None:
         def do() -> None:
             start = time.perf_counter()
+            if self._wine_atoms and self._dispatcher is not None:
+                # Wine's DdePostAdvise takes one reference on the item's global atom for all the
+                # WM_DDE_DATA it posts, while every client releases one: after the first client the
+                # atom is gone and the others drop their data.  Add the references Windows would.
+                for _ in range(self._dispatcher.advise_links(item) - 1):
+                    self._kernel32.GlobalAddAtomW(item)
             ok = self.u.DdePostAdvise(self.inst, self._string(topic), self._string(item))
             self.post_advise_stats.add(time.perf_counter() - start)
             if not ok:

@@ -79,9 +79,10 @@ def main(argv: list[str] | None = None) -> int:
             record["request_after"] = f"refused: {exc}"
     if args.wait_disconnect:
         t0 = time.monotonic()
-        pump(args.wait_disconnect, until=lambda: all(v in c.disconnected for c, v in zip(clients, convs)))
+        pump(args.wait_disconnect, until=lambda: all(c.ended_by_server(v) for c, v in zip(clients, convs)))
         for record, c, conv in zip(records, clients, convs):
-            record["disconnected"] = conv in c.disconnected
+            record["disconnected"] = c.ended_by_server(conv)
+            record["xtyp_disconnect"] = conv in c.disconnected
             record["disconnect_wait_s"] = time.monotonic() - t0
     shared.close()
     Path(args.out).write_text(json.dumps(records, indent=1))
