@@ -11,12 +11,7 @@ import csv
 import sys
 from datetime import datetime, timedelta
 
-import numpy as np
-
 from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs, parse_time
-from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError, look_angles_array
-from nfwserver.tracking.passes import find_passes
-from nfwserver.tracking.timescale import julian_date
 
 EPHEMERIS_COLUMNS = ["time_utc", "azimuth_deg", "elevation_deg", "range_km", "range_rate_km_s", "above_horizon"]
 PASS_COLUMNS = ["catalog_number", "name", "aos_utc", "tca_utc", "los_utc", "max_elevation_deg",
@@ -86,6 +81,7 @@ def _num(value: float | None, decimals: int, fmt: str) -> str:
 
 def run_ephemeris(args: argparse.Namespace) -> int:
     from nfwserver.cli import CliError
+    from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError
 
     start = _time_arg(args.start, "--start")
     if not args.step > 0 or not args.duration >= 0 or args.duration / args.step > 10_000_000:
@@ -113,6 +109,7 @@ def run_ephemeris(args: argparse.Namespace) -> int:
 
 def run_passes(args: argparse.Namespace) -> int:
     from nfwserver.cli import CliError
+    from nfwserver.tracking.passes import find_passes
 
     start = _time_arg(args.start, "--start")
     if not 0 < args.hours <= 24 * 31:
@@ -143,6 +140,11 @@ def run_passes(args: argparse.Namespace) -> int:
 
 
 def run_visible(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from nfwserver.tracking.look_angles import look_angles_array
+    from nfwserver.tracking.timescale import julian_date
+
     at = _time_arg(args.at, "--at")
     inputs = load_tracking_inputs(args)
     sats = inputs.catalog.satellites()
