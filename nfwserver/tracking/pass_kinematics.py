@@ -56,31 +56,40 @@ class PairEvaluator:
         self.calls = 0  #: compiled SGP4 calls made (for profiling and tests)
         self.pairs = 0  #: satellite-time pairs propagated
 
-    def teme(self, sat: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """TEME position (n, 3), velocity (n, 3) and SGP4 error codes (n,), in the input order."""
+    def teme(self, sat: np.ndarray, t: np.ndarray, grouped: bool = False
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """TEME position (n, 3), velocity (n, 3) and SGP4 error codes (n,), in the input order.
+
+        ``grouped``: the pairs of each satellite are already contiguous (no sorting needed).
+        """
         n = len(t)
-        order = np.lexsort((t, sat))  # by satellite, then time (deep-space integrators like that)
-        s_sorted = sat[order]
-        fr = self.fr0 + t[order] / SECONDS_PER_DAY
+        order = None if grouped else np.argsort(sat, kind="stable")
+        s_sorted = sat if order is None else sat[order]
+        fr = self.fr0 + (t if order is None else t[order]) / SECONDS_PER_DAY
         jd = np.full(n, self.jd0)
         e = np.zeros(n, dtype=np.uint8)
         r = np.empty((n, 3))
         v = np.empty((n, 3))
-        bounds = np.flatnonzero(np.diff(s_sorted)) + 1
-        starts = np.concatenate(([0], bounds)).tolist()
-        stops = np.concatenate((bounds, [n])).tolist()
+        bounds = np.flatnonzero(s_sorted[1:] != s_sorted[:-1]) + 1
+        starts = [0, *bounds.tolist()]
+        stops = [*bounds.tolist(), n]
         satrecs = self.satrecs
-        for a, b in zip(starts, stops):
-            satrecs[s_sorted[a]]._sgp4(jd[a:b], fr[a:b], e[a:b], r[a:b], v[a:b])
+        for a, b, i in zip(starts, stops, s_sorted[starts].tolist()):
+            satrecs[i]._sgp4(jd[a:b], fr[a:b], e[a:b], r[a:b], v[a:b])
         self.calls += len(starts)
         self.pairs += n
+        if order is None:
+            return r, v, e
         back = np.empty_like(order)
         back[order] = np.arange(n)
         return r[back], v[back], e[back]
 
-    def evaluate(self, sat: np.ndarray, t: np.ndarray) -> Kinematics:
-        """Angles and derivatives at each pair (``sat`` intp, ``t`` float seconds)."""
-        r, v, err = self.teme(sat, t)
+    def evaluate(self, sat: np.ndarray, t: np.ndarray, grouped: bool = False) -> Kinematics:
+        """Angles and derivatives at each pair (``sat`` intp, ``t`` float seconds; see :meth:`teme`)."""
+        if not len(sat):
+            empty = np.empty(0)
+            return Kinematics(*(empty for _ in range(8)))
+        r, v, err = self.teme(sat, t, grouped)
         fr = self.fr0 + t / SECONDS_PER_DAY
         pos, vel = teme_to_itrs(r, v, self.jd0, fr, self.ut1_utc)
         assert vel is not None

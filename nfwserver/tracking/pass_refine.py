@@ -54,6 +54,13 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
     the ends (f for crossings, the rising/falling rate for maxima).  ``hidden`` marks hidden-peak
     brackets, which may be abandoned early."""
     n = len(sat)
+    # Work in satellite order, so every round's batch is already grouped by satellite.
+    perm = np.argsort(sat, kind="stable")
+    undo = np.empty_like(perm)
+    undo[perm] = np.arange(n)
+    sat, kind = sat[perm], kind[perm]
+    a, b, ga, gb = a[perm], b[perm], ga[perm], gb[perm]
+    hidden = None if hidden is None else hidden[perm]
     a, b = a.astype(float).copy(), b.astype(float).copy()
     ga = np.nan_to_num(ga.astype(float), nan=0.0, neginf=-180.0, posinf=180.0)
     gb = np.nan_to_num(gb.astype(float), nan=0.0, neginf=-180.0, posinf=180.0)
@@ -74,7 +81,7 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
     while len(active) and rounds < _MAX_ROUNDS:
         rounds += 1
         ca = c[active]
-        k = ev.evaluate(sat[active], ca)
+        k = ev.evaluate(sat[active], ca, grouped=True)
         kd = kind[active]
         f = np.maximum(np.nan_to_num(k.f, nan=-180.0), -180.0)
         g = np.where(kd == CROSSING, f, np.where(kd == TOP, k.s_rate, k.f_rate))
@@ -105,4 +112,4 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
             done |= hid & (best_f[active] <= 0.0) & ok & (step < 120.0) & (model < _HOPELESS_DEG)
         c[active] = np.where(ok, newton, 0.5 * (lo + hi))
         active = active[~done]
-    return Solution(t_out, el_out, az_out, f_out, el_rate_out, best_f, best_t, rounds)
+    return Solution(*(x[undo] for x in (t_out, el_out, az_out, f_out, el_rate_out, best_f, best_t)), rounds)

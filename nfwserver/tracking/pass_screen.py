@@ -6,11 +6,14 @@ can be above the lowest horizon point, and a bound on how fast that margin can s
 satellite's angular rate plus the change of the visibility limit with height), each coarse
 interval is either proven invisible or kept.
 
-Kept intervals are then sampled: near-circular orbits under a flat horizon on the coarse points
-themselves (their elevation has one smooth maximum per orbit, so no interval shorter than half
-an orbit can hide two turning points), other satellites more finely, proportionally to their
-angular rate.  Between consecutive samples, the function ``f = elevation - horizon(azimuth)``
-and its analytic rate give three kinds of bracket for :mod:`nfwserver.tracking.pass_refine`:
+Kept intervals are then sampled: under a flat horizon every 1200 s for a satellite at a low
+orbit's angular rate, proportionally longer for slower ones (the coarse points themselves when
+that is the coarse step).  The elevation turns only twice an orbit, its maximum and minimum
+at least ~2700 s apart even for the lowest orbits, so no step can hold two turns.  Under a
+sloping horizon the step is ``fine_step_s`` (60 s) at a low orbit's rate.
+
+Between consecutive samples, the function ``f = elevation - horizon(azimuth)`` and its analytic
+rate give three kinds of bracket for :mod:`nfwserver.tracking.pass_refine`:
 
 - **crossings**: ``f`` changes sign (an AOS or a LOS);
 - **hidden peaks**: ``f`` is negative at both ends but turns from rising to falling in between,
@@ -36,6 +39,8 @@ from nfwserver.tracking.pass_kinematics import PairEvaluator
 
 #: Geocentric angular rate (rad/s) of a low satellite, for which the fine step is ``fine_step_s``.
 _LEO_RATE = 1.2e-3
+#: Sampling step (s) under a flat horizon for a satellite at ``_LEO_RATE``.
+_FLAT_STEP_S = 1200.0
 #: Sat-time pairs per compiled screen call (bounds the screen's memory).
 _SCREEN_PAIRS = 250_000
 
@@ -127,10 +132,12 @@ def screen(satrecs: list, frame: TopocentricFrame, horizon: HorizonTable, jd0: f
         kept |= (np.isinf(margin[:, :-1]) & (margin[:, 1:] <= reach)) | (
             np.isinf(margin[:, 1:]) & (margin[:, :-1] <= reach))
         del margin, psi, ratio, rate, cx, cy, cz, rdot, rad
-        wanted = fine_step_s * np.clip(_LEO_RATE / np.maximum(bound, 1e-9), 1.0, coarse_step_s / fine_step_s)
+        # Sampling step: under a flat horizon f turns only where the elevation does, twice an orbit,
+        # so a step under half the time between the turns (1200 s at a low orbit's rate) leaves at
+        # most one turn per step; a sloping horizon adds turns at its own corners.
+        base = _FLAT_STEP_S if flat else fine_step_s
+        wanted = base * np.clip(_LEO_RATE / np.maximum(bound, 1e-9), 1.0, max(coarse_step_s / base, 1.0))
         per_sat = np.maximum(1, np.round(coarse_step_s / wanted)).astype(np.intp)
-        if flat:
-            per_sat[ecc < 0.05] = 1
         coarse_only = per_sat == 1
         if coarse_only.any():
             sel = np.flatnonzero(coarse_only)

@@ -50,7 +50,7 @@ _SHORT_PERIOD_S = 3.0 * 3600.0
 #: Mean motion (rev/day) below which a near-circular orbit joins the geosynchronous-like group.
 _SLOW_REV_PER_DAY = 1.5
 #: Coarse grid steps (s) of the three groups: low, geosynchronous-like, the rest.
-_LOW_STEP_S, _SLOW_STEP_S, _OTHER_STEP_S = 600.0, 3600.0, 1200.0
+_LOW_STEP_S, _SLOW_STEP_S, _OTHER_STEP_S = 1200.0, 3600.0, 1200.0
 #: Satellites searched together (bounds the memory of one search).
 _CHUNK = 2000
 
@@ -121,8 +121,12 @@ def find_passes(
     rev_per_day = no * MINUTES_PER_DAY / (2.0 * math.pi)
     short = periods <= _SHORT_PERIOD_S
     slow = ~short & (rev_per_day < _SLOW_REV_PER_DAY) & (ecc < 0.05)
+    other = ~short & ~slow
     passes: list[Pass] = []
-    for group, step in ((short, _LOW_STEP_S), (slow, _SLOW_STEP_S), (~short & ~slow, _OTHER_STEP_S)):
+    # The rest is split by period so that each part looks back and ahead only as far as it needs.
+    for group, step in ((short, _LOW_STEP_S), (slow, _SLOW_STEP_S), (other & (periods <= 8 * 3600.0), _OTHER_STEP_S),
+                        (other & (periods > 8 * 3600.0) & (periods <= 13 * 3600.0), _OTHER_STEP_S),
+                        (other & (periods > 13 * 3600.0), _OTHER_STEP_S)):
         members = np.flatnonzero(group)
         for c0 in range(0, len(members), _CHUNK):
             idx = members[c0 : c0 + _CHUNK]
