@@ -29,9 +29,10 @@ from nfwserver.tracking import amsat, omm
 from nfwserver.tracking.tle import TleError, TleFields, format_tle, parse_tle
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ElementSet:
-    """One satellite's mean elements at an epoch, with its initialised SGP4 model."""
+    """One satellite's mean elements at an epoch, with its initialised SGP4 model (slots: catalogs
+    hold tens of thousands)."""
 
     name: str  #: name as given ("ISS (ZARYA)"), stripped; "" when the set had none
     catalog_number: int

@@ -29,9 +29,9 @@ from nfwserver.tracking.pass_screen import Brackets
 _KEY = 1e8
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Pass:
-    """One pass of one satellite over the horizon table."""
+    """One pass of one satellite over the horizon table (slots: catalogs give tens of thousands)."""
 
     catalog_number: int
     aos: datetime | None  #: rise above the horizon table (None: earlier than the search reached)

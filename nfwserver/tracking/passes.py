@@ -52,7 +52,7 @@ _SLOW_REV_PER_DAY = 1.5
 #: Coarse grid steps (s) of the three groups: low, geosynchronous-like, the rest.
 _LOW_STEP_S, _SLOW_STEP_S, _OTHER_STEP_S = 1200.0, 3600.0, 1200.0
 #: Satellites searched together (bounds the memory of one search).
-_CHUNK = 2000
+_CHUNK = 600
 
 #: Fork-time hand-over of the work to worker processes (Satrec objects cannot be pickled); set only
 #: for the duration of one parallel :func:`find_passes` call.
