@@ -78,7 +78,7 @@ def main() -> None:
     print(f"| of which `SatrecArray.sgp4` alone | {sgp4_all:.1f} ms | | | |")
     print(f"| one satellite, one instant (scalar path) | {scalar_us:.2f} us | {sky_one:.0f} us "
           f"| {sky_one / scalar_us:.0f}x | <= 5 us |")
-    print("\nPass prediction against skyfield: see the next section (`python -m bench passes`).")
+    print("\nPass prediction: see the section *Pass prediction against skyfield* (`python -m bench passes`).")
     print()
 
 
