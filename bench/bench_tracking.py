@@ -2,15 +2,12 @@
 
 - look angles of every object in tests/data/active.txt at one instant (numpy path);
 - one satellite at one instant (scalar path used on every publish tick);
-- passes of 2,000 satellites over 24 h, as whole processes (import + load + compute).
+(pass prediction has its own benchmark, ``bench_passes``).
 """
 
 from __future__ import annotations
 
 import statistics
-import subprocess
-import sys
-import textwrap
 import time
 from datetime import datetime, timezone
 from pathlib import Path
@@ -36,15 +33,6 @@ def _median_ms(fn, repeat: int) -> float:
         fn()
         times.append(time.perf_counter() - t)
     return statistics.median(times) * 1e3
-
-
-def _process_seconds(code: str, repeat: int = 3) -> float:
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT, stdout=subprocess.DEVNULL)
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
 
 
 def main() -> None:
@@ -81,34 +69,6 @@ def main() -> None:
     scalar_us = statistics.median(per_call)
     sky_one = _median_ms(lambda: (sky_sats[0] - topos).at(t).altaz(), 51) * 1e3
 
-    subset = ROOT / "bench" / "results"
-    subset.mkdir(exist_ok=True)
-    two_k = subset / "active-2000.txt"
-    two_k.write_text("\n".join(ACTIVE.read_text().splitlines()[: 3 * 2000]) + "\n")
-    ours_code = textwrap.dedent(f"""
-        from datetime import datetime, timedelta, timezone
-        from nfwserver.tracking.elements import load_element_file
-        from nfwserver.tracking.observer import Observer
-        from nfwserver.tracking.passes import find_passes
-        sets = load_element_file({str(two_k)!r}).sets
-        start = datetime(2026, 5, 8, tzinfo=timezone.utc)
-        print(len(find_passes(sets, Observer(52.2, 0.12, 20.0), start, start + timedelta(hours=24),
-                              workers=WORKERS)))
-    """)
-    sky_code = textwrap.dedent(f"""
-        from skyfield.api import load, wgs84
-        from skyfield.iokit import parse_tle_file
-        ts = load.timescale(builtin=True)
-        with open({str(two_k)!r}, 'rb') as f:
-            sats = list(parse_tle_file(f, ts))
-        topos = wgs84.latlon(52.2, 0.12, elevation_m=20.0)
-        a, b = ts.utc(2026, 5, 8), ts.utc(2026, 5, 9)
-        print(sum(len(s.find_events(topos, a, b, altitude_degrees=0.0)[1]) for s in sats))
-    """)
-    ours_passes = _process_seconds(ours_code.replace("WORKERS", "1"))
-    ours_passes_2 = _process_seconds(ours_code.replace("WORKERS", "2"))
-    sky_passes = _process_seconds(sky_code)
-
     print("## Tracking engine\n")
     print(f"{len(sets):,} objects from tests/data/active.txt; observer 52.2N 0.12E; medians.\n")
     print("| measurement | nfwserver | skyfield | ratio | goal |")
@@ -118,10 +78,7 @@ def main() -> None:
     print(f"| of which `SatrecArray.sgp4` alone | {sgp4_all:.1f} ms | | | |")
     print(f"| one satellite, one instant (scalar path) | {scalar_us:.2f} us | {sky_one:.0f} us "
           f"| {sky_one / scalar_us:.0f}x | <= 5 us |")
-    print(f"| passes, 2,000 satellites x 24 h, whole process, one process | {ours_passes:.2f} s | "
-          f"{sky_passes:.2f} s (`find_events`) | {sky_passes / ours_passes:.1f}x | >= 5x |")
-    print(f"| same, `workers=2` (both cores; `nfwserver passes --workers 2`) | {ours_passes_2:.2f} s | "
-          f"{sky_passes:.2f} s | {sky_passes / ours_passes_2:.1f}x | >= 5x |")
+    print("\nPass prediction: see the section *Pass prediction against skyfield* (`python -m bench passes`).")
     print()
 
 

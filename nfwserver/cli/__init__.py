@@ -2,6 +2,9 @@
 
 Each command module exposes ``register(subparsers)``, which adds its sub-parser and sets
 ``func`` (a callable taking the parsed namespace and returning the exit code) as a default.
+Only the module of the command being run is imported (:data:`nfwserver.cli.arguments.COMMANDS`
+lists every command with its help line for ``--help``), so start-up does not pay for numpy,
+the DDE server or the console unless the command needs them.
 Conventions (README, "Command line"): data on stdout, diagnostics on stderr; exit 0 on success, 2 for
 usage errors, 1 for runtime errors, with one clear sentence and no traceback for bad input.
 """
@@ -15,22 +18,19 @@ import sys
 from collections.abc import Sequence
 
 from nfwserver import __version__
+from nfwserver.cli.arguments import COMMANDS, command_word, join_negative_values
 
 #: Command modules, in the order their commands appear in ``--help``.
-COMMAND_MODULES: tuple[str, ...] = (
-    "run_command",
-    "simulate_command",
-    "tracking_commands",
-    "elements_command",
-    "config_command",
-)
+COMMAND_MODULES: tuple[str, ...] = tuple(dict.fromkeys(module for _, module, _ in COMMANDS))
 
 
 class CliError(Exception):
     """A runtime problem to report in one sentence (exit code 1)."""
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
+    """The argument parser; with ``argv``, only the module of the command named in it is imported
+    (the other commands get help-only stand-ins), without it every command module is."""
     parser = argparse.ArgumentParser(
         prog="nfwserver",
         description="Satellite-tracking server speaking Nova for Windows' DDE interface.",
@@ -38,17 +38,23 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"nfwserver {__version__}")
     parser.add_argument("-v", "--verbose", action="count", default=0, help="more diagnostics on stderr")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for name in COMMAND_MODULES:
-        importlib.import_module(f"nfwserver.cli.{name}").register(subparsers)
+    wanted = command_word(argv) if argv is not None else None
+    chosen = {module for name, module, _ in COMMANDS if argv is None or name == wanted}
+    done: set[str] = set()
+    for name, module, help_text in COMMANDS:
+        if module in chosen:
+            if module not in done:
+                importlib.import_module(f"nfwserver.cli.{module}").register(subparsers)
+                done.add(module)
+        else:
+            subparsers.add_parser(name, help=help_text, add_help=False)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the process exit code."""
-    from nfwserver.cli.arguments import join_negative_values
-
     args_list = join_negative_values(list(sys.argv[1:] if argv is None else argv))
-    parser = build_parser()
+    parser = build_parser(args_list)
     args = parser.parse_args(args_list)
     logging.basicConfig(
         level=logging.WARNING - 10 * min(args.verbose, 2),

@@ -14,6 +14,31 @@ from datetime import datetime, timedelta, timezone
 
 from nfwserver.tracking.observer import Observer, parse_observer
 
+#: Every command: (name, module under ``nfwserver.cli``, help line), in ``--help`` order.  A module
+#: registering several commands is imported once, when any of them runs.
+COMMANDS: tuple[tuple[str, str, str], ...] = (
+    ("run", "run_command", "run the server (console on a terminal, or --headless)"),
+    ("simulate", "simulate_command", "show what a DDE client receives, on virtual time"),
+    ("ephemeris", "tracking_commands", "position table of one satellite"),
+    ("passes", "tracking_commands", "AOS/TCA/LOS of satellites over a window"),
+    ("visible", "tracking_commands", "satellites above the horizon table at an instant"),
+    ("elements", "elements_command", "update or list the stored element catalog"),
+    ("config", "config_command", "configuration file: path, init, show"),
+)
+
+#: Top-level options that take no value (so the word after them is not their argument).
+_FLAGS = {"-v", "--verbose", "-vv", "-vvv", "--version", "-h", "--help"}
+
+
+def command_word(argv: list[str] | tuple[str, ...] | object) -> str | None:
+    """The command named in ``argv`` (the first word that is not a top-level option), or None."""
+    for word in argv:  # type: ignore[attr-defined]
+        if word in _FLAGS or (word.startswith("-v") and set(word[1:]) == {"v"}):
+            continue
+        return None if word.startswith("-") else word
+    return None
+
+
 # A value that starts with '-' followed by a digit or '.', e.g. "-33.87,151.21,40" or "-0.3".
 _NEGATIVE_VALUE = re.compile(r"^-[0-9.]")
 # One relative-time term: "+2h", "-30m", "+90s", "+1d", "+1.5h"; terms may follow each other ("+1h30m").

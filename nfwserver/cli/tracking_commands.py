@@ -16,14 +16,8 @@ import csv
 import sys
 from datetime import datetime, timedelta
 
-import numpy as np
-
 from nfwserver.cli.arguments import number_in, satellite_value, time_value
 from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs, warn
-from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError, look_angles_array
-from nfwserver.tracking.passes import find_passes
-from nfwserver.tracking.screening import MAX_PLAUSIBLE_RANGE_KM, STALE_AFTER_DAYS, screen_satellites, stale_satellites
-from nfwserver.tracking.timescale import julian_date
 
 EPHEMERIS_COLUMNS = ["time_utc", "azimuth_deg", "elevation_deg", "range_km", "range_rate_km_s", "above_horizon"]
 PASS_COLUMNS = ["catalog_number", "name", "aos_utc", "tca_utc", "los_utc", "max_elevation_deg",
@@ -76,6 +70,8 @@ def _pick(catalog, text: str):
 
 def _screen(sats: list, inputs, at: datetime) -> list:
     """The satellites whose positions at ``at`` are usable; the rest and stale sets are reported."""
+    from nfwserver.tracking.screening import STALE_AFTER_DAYS, screen_satellites, stale_satellites
+
     screened = screen_satellites(sats, inputs.observer, at, inputs.ut1_utc)
     if screened.unusable:
         names = ", ".join(s.dde_name for s in screened.unusable[:5]) + (", ..." if len(screened.unusable) > 5 else "")
@@ -115,6 +111,7 @@ def _num(value: float | None, decimals: int, fmt: str) -> str:
 
 def run_ephemeris(args: argparse.Namespace) -> int:
     from nfwserver.cli import CliError
+    from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError
 
     start = args.start
     if args.duration / args.step > 10_000_000:
@@ -142,6 +139,8 @@ def run_ephemeris(args: argparse.Namespace) -> int:
 
 
 def run_passes(args: argparse.Namespace) -> int:
+    from nfwserver.tracking.passes import find_passes
+
     start = args.start
     inputs = load_tracking_inputs(args)
     sats = [_pick(inputs.catalog, text) for text in args.sat] if args.sat else inputs.catalog.satellites()
@@ -163,6 +162,12 @@ def run_passes(args: argparse.Namespace) -> int:
 
 
 def run_visible(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from nfwserver.tracking.look_angles import look_angles_array
+    from nfwserver.tracking.screening import MAX_PLAUSIBLE_RANGE_KM
+    from nfwserver.tracking.timescale import julian_date
+
     at = args.at
     inputs = load_tracking_inputs(args)
     sats = _screen(inputs.catalog.satellites(), inputs, at)

@@ -14,11 +14,14 @@ import logging
 import sys
 from dataclasses import dataclass
 from datetime import datetime, timezone
+from typing import TYPE_CHECKING
 
 from nfwserver.cli.arguments import number_in, observer_value, parse_time_text
-from nfwserver.tracking.catalog import Catalog
-from nfwserver.tracking.horizon import HorizonTable, load_horizon
-from nfwserver.tracking.observer import Observer, parse_observer
+
+if TYPE_CHECKING:  # imported when the options are resolved: `--help` and parsing stay light
+    from nfwserver.tracking.catalog import Catalog
+    from nfwserver.tracking.horizon import HorizonTable
+    from nfwserver.tracking.observer import Observer
 
 log = logging.getLogger(__name__)
 
@@ -63,8 +66,12 @@ def parse_time(text: str) -> datetime:
 
 
 def format_time(when: datetime) -> str:
-    """UTC with milliseconds and Z: ``2026-05-08T12:00:00.000Z``."""
-    return when.astimezone(timezone.utc).strftime("%Y-%m-%dT%H:%M:%S.") + f"{when.microsecond // 1000:03d}Z"
+    """UTC with milliseconds (truncated) and Z: ``2026-05-08T12:00:00.000Z`` (no ``strftime``: this runs
+    once per table cell)."""
+    if when.utcoffset():
+        when = when.astimezone(timezone.utc)
+    return (f"{when.year:04d}-{when.month:02d}-{when.day:02d}T{when.hour:02d}:{when.minute:02d}:"
+            f"{when.second:02d}.{when.microsecond // 1000:03d}Z")
 
 
 def warn(message: str) -> None:
@@ -93,6 +100,7 @@ def _load_config(args: argparse.Namespace):
 
 def _catalog_from_files(paths: list[str], dde_names: dict[int, str]) -> Catalog:
     from nfwserver.cli import CliError
+    from nfwserver.tracking.catalog import Catalog
     from nfwserver.tracking.elements import load_element_file
 
     sets = []
@@ -127,6 +135,8 @@ def load_tracking_inputs(args: argparse.Namespace) -> TrackingInputs:
     Raises :class:`nfwserver.cli.CliError` when nothing usable remains.
     """
     from nfwserver.cli import CliError
+    from nfwserver.tracking.horizon import HorizonTable, load_horizon
+    from nfwserver.tracking.observer import parse_observer
 
     config = _load_config(args)
     observer = getattr(args, "observer", None)

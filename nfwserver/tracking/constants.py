@@ -35,3 +35,5 @@ MINUTES_PER_DAY = 1_440.0
 DAYS_PER_JULIAN_CENTURY = 36_525.0
 #: Julian date of the J2000.0 epoch (2000-01-01T12:00 TT; used here on the UT/UTC scales as usual).
 JD_J2000 = 2_451_545.0
+#: Earth rotations per UT1 day relative to the mean equinox (IAU 1982 GMST rate at J2000).
+SIDEREAL_TURNS_PER_UT1_DAY = 1.00273790935

@@ -33,9 +33,10 @@ from nfwserver.tracking.element_names import MAX_NAME_LENGTH, sanitize_element_n
 from nfwserver.tracking.tle import TleError, TleFields, format_tle, parse_tle
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ElementSet:
-    """One satellite's mean elements at an epoch, with its initialised SGP4 model."""
+    """One satellite's mean elements at an epoch, with its initialised SGP4 model (slots: catalogs
+    hold tens of thousands)."""
 
     name: str  #: name as given ("ISS (ZARYA)"), sanitised (element_names); "" when the set had none
     catalog_number: int

@@ -14,14 +14,16 @@ import bisect
 import math
 from collections.abc import Iterable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:  # numpy is imported by the array methods only: reading a configuration stays light
+    import numpy as np
 
 
 class HorizonTable:
     """Minimum elevation by azimuth; immutable once built."""
 
-    __slots__ = ("_az", "_el", "_ext_az", "_ext_el", "_np_az", "_np_el", "minimum")
+    __slots__ = ("_az", "_el", "_ext_az", "_ext_el", "minimum")
 
     def __init__(self, points: Iterable[tuple[float, float]] = ()) -> None:
         pts: dict[float, float] = {}
@@ -40,8 +42,6 @@ class HorizonTable:
             self._ext_el = [self._el[-1], *self._el, self._el[0]]
         else:
             self._ext_az, self._ext_el = [], []
-        self._np_az = np.array(self._az)
-        self._np_el = np.array(self._el)
         #: The lowest minimum elevation anywhere (0 for a flat horizon).
         self.minimum = min(self._el) if self._el else 0.0
 
@@ -71,15 +71,19 @@ class HorizonTable:
 
     def min_elevation_array(self, azimuth_deg: np.ndarray) -> np.ndarray:
         """Vectorised :meth:`min_elevation` over an array of azimuths (degrees)."""
+        import numpy as np
+
         az = np.asarray(azimuth_deg, dtype=float)
         if len(self._az) == 0:
             return np.zeros_like(az)
         if len(self._az) == 1:
             return np.full_like(az, self._el[0])
-        return np.interp(az % 360.0, self._np_az, self._np_el, period=360.0)
+        return np.interp(az % 360.0, self._az, self._el, period=360.0)
 
     def slope_array(self, azimuth_deg: np.ndarray) -> np.ndarray:
         """d(minimum elevation)/d(azimuth) (deg/deg) at each azimuth; 0 for a flat table."""
+        import numpy as np
+
         az = np.asarray(azimuth_deg, dtype=float)
         if len(self._az) < 2:
             return np.zeros_like(az)

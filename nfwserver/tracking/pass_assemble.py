@@ -1,0 +1,190 @@
+"""Pass search, stage 3: turn brackets into events, pair them into passes, and find each TCA.
+
+Order of work (every step batched over all satellites of the search):
+
+1. crossings and hidden peaks are refined together (:func:`nfwserver.tracking.pass_refine.solve`);
+2. hidden peaks that rise above the horizon give two more crossings each, refined next;
+3. rises and sets are paired per satellite (a set with no rise before it in the search is a
+   pass whose AOS lies before the search span, a final rise one whose LOS lies after it);
+4. passes overlapping the window keep their culmination brackets; those are refined, and the
+   TCA is the highest of the refined maxima and the pass's own ends (a pass under a sloping
+   horizon may peak at its AOS or LOS).
+
+Times are seconds after ``t0`` (the start of the search span) until :func:`assemble` turns them
+into aware UTC datetimes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from datetime import datetime, timedelta
+
+import numpy as np
+
+from nfwserver.tracking.pass_kinematics import PairEvaluator
+from nfwserver.tracking.pass_refine import CROSSING, F_TOP, TOP, solve
+from nfwserver.tracking.pass_screen import Brackets
+
+#: Key spacing per satellite when sorting (sat, t) pairs as one float (s; far above any span).
+_KEY = 1e8
+
+
+@dataclass(frozen=True, slots=True)
+class Pass:
+    """One pass of one satellite over the horizon table (slots: catalogs give tens of thousands)."""
+
+    catalog_number: int
+    aos: datetime | None  #: rise above the horizon table (None: earlier than the search reached)
+    tca: datetime  #: maximum elevation
+    los: datetime | None  #: set below the horizon table (None: later than the search reached)
+    max_elevation_deg: float
+    aos_azimuth_deg: float | None
+    los_azimuth_deg: float | None
+    aos_before_start: bool = False  #: the pass was in progress at the window start
+    los_after_end: bool = False  #: the pass is still in progress at the window end
+
+    @property
+    def duration_s(self) -> float | None:
+        """LOS - AOS in seconds, when both are known."""
+        if self.aos is None or self.los is None:
+            return None
+        return (self.los - self.aos).total_seconds()
+
+
+def _events(ev: PairEvaluator, br: Brackets, flat: bool):
+    """Refined crossings (sat, t, rising, az, el, el rate) and the maxima of the hidden peaks that rose."""
+    cr, pk = br.crossings, br.peaks
+    nc = len(cr)
+    kind = np.concatenate((np.full(nc, CROSSING), np.full(len(pk), TOP if flat else F_TOP)))
+    sol = solve(ev, np.concatenate((cr.sat, pk.sat)), np.concatenate((cr.a, pk.a)), np.concatenate((cr.b, pk.b)),
+                np.concatenate((cr.ga, pk.ga)), np.concatenate((cr.gb, pk.gb)), kind,
+                np.concatenate((np.zeros(nc, dtype=bool), np.ones(len(pk), dtype=bool))))
+    sat, t, rising = cr.sat, sol.t[:nc], cr.ga <= 0.0
+    az, el, el_rate = sol.az[:nc], sol.el[:nc], sol.el_rate[:nc]
+    up = np.flatnonzero(sol.best_f[nc:] > 0.0)
+    tops = (pk.sat[up], sol.t[nc:][up], sol.el[nc:][up])
+    if len(up):
+        ps, top_t, f_top = pk.sat[up], sol.best_t[nc:][up], sol.best_f[nc:][up]
+        m = len(up)
+        s2 = solve(ev, np.concatenate((ps, ps)), np.concatenate((pk.a[up], top_t)),
+                   np.concatenate((top_t, pk.b[up])), np.concatenate((np.full(m, -1.0), f_top)),
+                   np.concatenate((f_top, np.full(m, -1.0))), np.full(2 * m, CROSSING))
+        sat = np.concatenate((sat, ps, ps))
+        t = np.concatenate((t, s2.t))
+        rising = np.concatenate((rising, np.ones(m, dtype=bool), np.zeros(m, dtype=bool)))
+        az = np.concatenate((az, s2.az))
+        el = np.concatenate((el, s2.el))
+        el_rate = np.concatenate((el_rate, s2.el_rate))
+    if not flat:
+        tops = (tops[0][:0], tops[1][:0], tops[2][:0])  # f's maximum is not the elevation's
+    return sat, t, rising, az, el, el_rate, tops
+
+
+def _pair(sat: np.ndarray, t: np.ndarray, rising: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Passes as (sat, index of the rise or -1, index of the set or -1), events sorted by (sat, t)."""
+    n = len(sat)
+    first = np.ones(n, dtype=bool)
+    first[1:] = sat[1:] != sat[:-1]
+    last = np.ones(n, dtype=bool)
+    last[:-1] = sat[1:] != sat[:-1]
+    idx = np.arange(n)
+    sets_after_rise = ~rising & ~first & np.roll(rising, 1)
+    sets_alone = ~rising & first
+    rises_open = rising & last
+    p_sat = np.concatenate((sat[sets_after_rise], sat[sets_alone], sat[rises_open]))
+    p_rise = np.concatenate((idx[sets_after_rise] - 1, np.full(sets_alone.sum(), -1), idx[rises_open]))
+    p_set = np.concatenate((idx[sets_after_rise], idx[sets_alone], np.full(rises_open.sum(), -1)))
+    return p_sat, p_rise, p_set
+
+
+def assemble(ev: PairEvaluator, br: Brackets, flat: bool, catalog_numbers: list[int], t0: datetime,
+             span: float, win_lo: float, win_hi: float) -> list[Pass]:
+    """Passes overlapping ``[win_lo, win_hi]`` (s after ``t0``) from the brackets of a search."""
+    sat, t, rising, az, el, el_rate, tops = _events(ev, br, flat)
+    order = np.lexsort((t, sat))
+    sat, t, rising, az, el, el_rate = sat[order], t[order], rising[order], az[order], el[order], el_rate[order]
+    p_sat, p_rise, p_set = _pair(sat, t, rising)
+    lo = np.where(p_rise >= 0, t[p_rise], -np.inf)
+    hi = np.where(p_set >= 0, t[p_set], np.inf)
+    keep = (hi >= win_lo) & (lo <= win_hi)
+    p_sat, p_rise, p_set, lo, hi = p_sat[keep], p_rise[keep], p_set[keep], lo[keep], hi[keep]
+    if not len(p_sat):
+        return []
+    porder = np.lexsort((lo, p_sat))
+    p_sat, p_rise, p_set, lo, hi = p_sat[porder], p_rise[porder], p_set[porder], lo[porder], hi[porder]
+    lo_c, hi_c = np.maximum(lo, 0.0), np.minimum(hi, span)
+    # Candidates for each pass's TCA: its known ends, refined culminations, hidden-peak maxima.
+    best_el = np.full(len(p_sat), -np.inf)
+    best_t = 0.5 * (lo_c + hi_c)
+    for ends in (p_rise, p_set):
+        known = ends >= 0
+        # The elevation at an end equals the horizon there; an end is the TCA only if nothing beats it.
+        end_el = np.where(known, el[np.maximum(ends, 0)], -np.inf)
+        better = end_el > best_el
+        best_el, best_t = np.where(better, end_el, best_el), np.where(better, t[np.maximum(ends, 0)], best_t)
+    cu = br.culminations
+    owner = _owner(p_sat, lo_c, hi_c, cu.sat, cu.a, cu.b)
+    cand_pass = [owner[owner >= 0]]
+    sel = owner >= 0
+    s1 = solve(ev, cu.sat[sel], cu.a[sel], cu.b[sel], cu.ga[sel], cu.gb[sel], np.full(int(sel.sum()), TOP))
+    cand_t, cand_el = [s1.t], [s1.el]
+    tp = _owner(p_sat, lo_c, hi_c, tops[0], tops[1], tops[1])
+    cand_pass.append(tp[tp >= 0])
+    cand_t.append(tops[1][tp >= 0])
+    cand_el.append(tops[2][tp >= 0])
+    # A pass whose elevation rises at AOS and falls at LOS but showed no culmination bracket.
+    has = np.zeros(len(p_sat), dtype=bool)
+    has[np.concatenate(cand_pass)] = True
+    rate_lo = np.where(p_rise >= 0, el_rate[np.maximum(p_rise, 0)], np.nan)
+    rate_hi = np.where(p_set >= 0, el_rate[np.maximum(p_set, 0)], np.nan)
+    rescue = np.flatnonzero(~has & (rate_lo > 0.0) & (rate_hi < 0.0))
+    if len(rescue):
+        s2 = solve(ev, p_sat[rescue], lo_c[rescue], hi_c[rescue], rate_lo[rescue], rate_hi[rescue],
+                   np.full(len(rescue), TOP))
+        cand_pass.append(rescue)
+        cand_t.append(s2.t)
+        cand_el.append(s2.el)
+    cp, ct, ce = np.concatenate(cand_pass), np.concatenate(cand_t), np.concatenate(cand_el)
+    inside = (ct >= lo_c[cp] - 1e-3) & (ct <= hi_c[cp] + 1e-3) & np.isfinite(ce)
+    cp, ct, ce = cp[inside], ct[inside], ce[inside]
+    srt = np.lexsort((ce, cp))  # the last entry of each pass is its highest candidate
+    cp, ct, ce = cp[srt], ct[srt], ce[srt]
+    top = np.ones(len(cp), dtype=bool)
+    top[:-1] = cp[1:] != cp[:-1]
+    cp, ct, ce = cp[top], ct[top], ce[top]
+    better = ce > best_el[cp]
+    best_el[cp[better]], best_t[cp[better]] = ce[better], ct[better]
+    return _records(p_sat, p_rise, p_set, t, az, best_t, best_el, catalog_numbers, t0, win_lo, win_hi)
+
+
+def _owner(p_sat: np.ndarray, lo: np.ndarray, hi: np.ndarray, sat: np.ndarray, a: np.ndarray,
+           b: np.ndarray) -> np.ndarray:
+    """Index of the pass (sorted by sat, lo) overlapping each interval ``[a, b]`` of ``sat``, or -1."""
+    if not len(sat) or not len(p_sat):
+        return np.full(len(sat), -1)
+    keys = p_sat * _KEY + lo
+    i = np.searchsorted(keys, sat * _KEY + b, side="right") - 1
+    ic = np.maximum(i, 0)
+    ok = (i >= 0) & (p_sat[ic] == sat) & (hi[ic] >= a)
+    return np.where(ok, i, -1)
+
+
+def _records(p_sat, p_rise, p_set, t, az, tca_t, tca_el, catalog_numbers, t0: datetime, win_lo: float,
+             win_hi: float) -> list[Pass]:
+    passes = []
+    t_list, az_list = t.tolist(), az.tolist()
+    for s, r, st, tc, el in zip(p_sat.tolist(), p_rise.tolist(), p_set.tolist(), tca_t.tolist(), tca_el.tolist()):
+        a = t_list[r] if r >= 0 else None
+        b = t_list[st] if st >= 0 else None
+        passes.append(Pass(
+            catalog_number=catalog_numbers[s],
+            aos=t0 + timedelta(seconds=a) if a is not None else None,
+            tca=t0 + timedelta(seconds=tc),
+            los=t0 + timedelta(seconds=b) if b is not None else None,
+            max_elevation_deg=el,
+            aos_azimuth_deg=az_list[r] if r >= 0 else None,
+            los_azimuth_deg=az_list[st] if st >= 0 else None,
+            aos_before_start=a is None or a < win_lo,
+            los_after_end=b is None or b > win_hi,
+        ))
+    return passes

@@ -1,0 +1,141 @@
+"""Topocentric angles and their first and second time derivatives, for pass searches.
+
+For (satellite, time) pairs this module propagates SGP4 (one compiled call per satellite and
+batch), rotates to the Earth-fixed frame (:mod:`nfwserver.tracking.frames`) and returns, per
+pair: elevation and azimuth (deg), their rates (deg/s) and second derivatives (deg/s^2),
+``f = elevation - horizon(azimuth)`` with ``f'`` and ``f''``, and ``s = sin(elevation)`` with
+``s'`` and ``s''`` (1/s, 1/s^2).  ``s`` has the same maxima as the elevation but stays smooth
+through near-zenith passes, where the elevation itself has an almost sharp peak.
+
+Second derivatives use an approximate Earth-fixed acceleration (two-body gravity plus the
+centrifugal and Coriolis terms; J2 and drag, about 0.1 % of it, are left out).  They only steer
+Newton iterations, whose results are fixed by the first derivatives, so the approximation costs
+at most an extra iteration, never accuracy.  Times are seconds after a reference UTC instant.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from nfwserver.tracking.constants import SECONDS_PER_DAY, SIDEREAL_TURNS_PER_UT1_DAY, WGS72_MU_KM3_S2
+from nfwserver.tracking.frames import TopocentricFrame, teme_to_itrs
+from nfwserver.tracking.horizon import HorizonTable
+from nfwserver.tracking.observer import Observer
+
+_DEG = 180.0 / np.pi
+
+
+@dataclass
+class Kinematics:
+    """Angles and derivatives for a batch of pairs (arrays of one length); NaN/-inf where SGP4 failed."""
+
+    el: np.ndarray
+    az: np.ndarray
+    el_rate: np.ndarray
+    f: np.ndarray
+    f_rate: np.ndarray
+    f_accel: np.ndarray
+    s_rate: np.ndarray
+    s_accel: np.ndarray
+
+
+class PairEvaluator:
+    """Propagates (satellite index, seconds after ``t0``) pairs of a list of ``Satrec`` objects.
+
+    ``jd0 + fr0`` is the reference instant (split UTC Julian date), ``ut1_utc`` seconds.
+    """
+
+    def __init__(self, satrecs: list, observer: Observer, jd0: float, fr0: float, ut1_utc: float,
+                 horizon: HorizonTable) -> None:
+        self.satrecs = satrecs
+        self.frame = TopocentricFrame(observer)
+        self.jd0, self.fr0, self.ut1_utc = jd0, fr0, ut1_utc
+        self.horizon = horizon
+        self.calls = 0  #: compiled SGP4 calls made (for profiling and tests)
+        self.pairs = 0  #: satellite-time pairs propagated
+
+    def teme(self, sat: np.ndarray, t: np.ndarray, grouped: bool = False
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """TEME position (n, 3), velocity (n, 3) and SGP4 error codes (n,), in the input order.
+
+        ``grouped``: the pairs of each satellite are already contiguous (no sorting needed).
+        """
+        n = len(t)
+        order = None if grouped else np.argsort(sat, kind="stable")
+        s_sorted = sat if order is None else sat[order]
+        fr = self.fr0 + (t if order is None else t[order]) / SECONDS_PER_DAY
+        jd = np.full(n, self.jd0)
+        e = np.zeros(n, dtype=np.uint8)
+        r = np.empty((n, 3))
+        v = np.empty((n, 3))
+        bounds = np.flatnonzero(s_sorted[1:] != s_sorted[:-1]) + 1
+        starts = [0, *bounds.tolist()]
+        stops = [*bounds.tolist(), n]
+        satrecs = self.satrecs
+        for a, b, i in zip(starts, stops, s_sorted[starts].tolist()):
+            satrecs[i]._sgp4(jd[a:b], fr[a:b], e[a:b], r[a:b], v[a:b])
+        self.calls += len(starts)
+        self.pairs += n
+        if order is None:
+            return r, v, e
+        back = np.empty_like(order)
+        back[order] = np.arange(n)
+        return r[back], v[back], e[back]
+
+    def evaluate(self, sat: np.ndarray, t: np.ndarray, grouped: bool = False) -> Kinematics:
+        """Angles and derivatives at each pair (``sat`` intp, ``t`` float seconds; see :meth:`teme`)."""
+        if not len(sat):
+            empty = np.empty(0)
+            return Kinematics(*(empty for _ in range(8)))
+        r, v, err = self.teme(sat, t, grouped)
+        fr = self.fr0 + t / SECONDS_PER_DAY
+        pos, vel = teme_to_itrs(r, v, self.jd0, fr, self.ut1_utc)
+        assert vel is not None
+        return topocentric_derivatives(self.frame, self.horizon, pos, vel, err)
+
+
+def topocentric_derivatives(frame: TopocentricFrame, horizon: HorizonTable, pos: np.ndarray, vel: np.ndarray,
+                            err: np.ndarray) -> Kinematics:
+    """Angles and derivatives from Earth-fixed position (km) and velocity (km/s), shape (n, 3)."""
+    x, y, z = pos[:, 0], pos[:, 1], pos[:, 2]
+    rad2 = x * x + y * y + z * z
+    g = -WGS72_MU_KM3_S2 / (rad2 * np.sqrt(rad2))
+    w = 2.0 * np.pi * SIDEREAL_TURNS_PER_UT1_DAY / SECONDS_PER_DAY
+    acc = np.empty_like(pos)
+    acc[:, 0] = g * x + 2.0 * w * vel[:, 1] + w * w * x
+    acc[:, 1] = g * y - 2.0 * w * vel[:, 0] + w * w * y
+    acc[:, 2] = g * z
+    d = pos - frame.origin
+    e, n, u = d @ frame.east, d @ frame.north, d @ frame.up
+    e1, n1, u1 = vel @ frame.east, vel @ frame.north, vel @ frame.up
+    e2, n2, u2 = acc @ frame.east, acc @ frame.north, acc @ frame.up
+    q = e * e + n * n
+    rho = np.sqrt(q + u * u)
+    rho1 = (e * e1 + n * n1 + u * u1) / rho
+    rho2 = (e1 * e1 + n1 * n1 + u1 * u1 + e * e2 + n * n2 + u * u2 - rho1 * rho1) / rho
+    s = u / rho
+    s1 = (u1 - s * rho1) / rho
+    s2 = (u2 - 2.0 * s1 * rho1 - s * rho2) / rho
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cos_el = np.sqrt(q) / rho
+        el1 = s1 / cos_el
+        el2 = (s2 + s * el1 * el1) / cos_el
+        az1 = (n * e1 - e * n1) / q
+        az2 = (n * e2 - e * n2) / q - az1 * 2.0 * (e * e1 + n * n1) / q
+    el = np.degrees(np.arcsin(np.clip(s, -1.0, 1.0)))
+    az = np.degrees(np.arctan2(e, n)) % 360.0
+    f = el - horizon.min_elevation_array(az)
+    if horizon.is_flat:
+        f_rate, f_accel = el1 * _DEG, el2 * _DEG
+    else:
+        slope = horizon.slope_array(az)
+        f_rate = (el1 - slope * az1) * _DEG
+        f_accel = (el2 - slope * az2) * _DEG
+    bad = err != 0
+    if bad.any():
+        f[bad] = -np.inf
+        for a in (el, el1, f_rate, f_accel, s1, s2):
+            a[bad] = np.nan
+    return Kinematics(el, az, el1 * _DEG, f, f_rate, f_accel, s1, s2)

@@ -1,0 +1,210 @@
+"""Pass search, stage 1: screen a catalog on a coarse grid and bracket every event.
+
+Every satellite is propagated on a common coarse grid (``SatrecArray``, one compiled call).  From
+the Earth-central angle between the observer and the satellite, the largest angle at which it
+can be above the lowest horizon point, and a bound on how fast that margin can shrink (the
+satellite's angular rate plus the change of the visibility limit with height), each coarse
+interval is either proven invisible or kept.
+
+Kept intervals are then sampled: under a flat horizon every 1200 s for a satellite at a low
+orbit's angular rate, proportionally longer for slower ones (the coarse points themselves when
+that is the coarse step).  The elevation turns only twice an orbit, its maximum and minimum
+at least ~2700 s apart even for the lowest orbits, so no step can hold two turns.  Under a
+sloping horizon the step is ``fine_step_s`` (60 s) at a low orbit's rate.
+
+Between consecutive samples, the function ``f = elevation - horizon(azimuth)`` and its analytic
+rate give three kinds of bracket for :mod:`nfwserver.tracking.pass_refine`:
+
+- **crossings**: ``f`` changes sign (an AOS or a LOS);
+- **hidden peaks**: ``f`` is negative at both ends but turns from rising to falling in between,
+  so a short pass may lie inside;
+- **culminations**: the elevation turns from rising to falling with ``f`` positive at an end
+  (a maximum inside a pass, a TCA candidate).
+
+Times are seconds after the search start ``t0``; angles degrees; rates degrees per second.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from sgp4.api import SatrecArray
+
+from nfwserver.tracking.constants import SECONDS_PER_DAY
+from nfwserver.tracking.frames import TopocentricFrame, teme_to_itrs
+from nfwserver.tracking.horizon import HorizonTable
+from nfwserver.tracking.pass_kinematics import PairEvaluator
+
+#: Geocentric angular rate (rad/s) of a low satellite, for which the fine step is ``fine_step_s``.
+_LEO_RATE = 1.2e-3
+#: Sampling step (s) under a flat horizon for a satellite at ``_LEO_RATE``.
+_FLAT_STEP_S = 1200.0
+#: Sat-time pairs per compiled screen call (bounds the screen's memory).
+_SCREEN_PAIRS = 40_000
+
+
+@dataclass
+class Intervals:
+    """Brackets ``[a, b]`` (s) of satellite ``sat`` with the bracketed function's values at the ends."""
+
+    sat: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    ga: np.ndarray
+    gb: np.ndarray
+
+    @staticmethod
+    def concat(parts: list[Intervals]) -> Intervals:
+        return Intervals(*(np.concatenate([getattr(p, k) for p in parts]) for k in ("sat", "a", "b", "ga", "gb")))
+
+    def __len__(self) -> int:
+        return len(self.sat)
+
+
+@dataclass
+class Brackets:
+    crossings: Intervals  #: values of f at the ends
+    peaks: Intervals  #: values of df/dt at the ends
+    culminations: Intervals  #: values of d(elevation)/dt at the ends
+
+
+def _classify(sat: np.ndarray, t: np.ndarray, f: np.ndarray, f_rate: np.ndarray, el_rate: np.ndarray,
+              link: np.ndarray, kept: np.ndarray) -> Brackets:
+    """Brackets between samples ``i`` and ``i + 1`` wherever ``link[i]`` (same satellite, adjacent)."""
+    i = np.flatnonzero(link)
+    j = i + 1
+    fa, fb = f[i], f[j]
+    cross = np.isfinite(fa) & np.isfinite(fb) & ((fa > 0.0) != (fb > 0.0))
+    turn = (f_rate[i] >= 0.0) & (f_rate[j] <= 0.0)
+    peak = turn & (fa <= 0.0) & (fb <= 0.0) & kept[i] & np.isfinite(fa) & np.isfinite(fb)
+    culm = (el_rate[i] >= 0.0) & (el_rate[j] <= 0.0) & ((fa > 0.0) | (fb > 0.0))
+
+    def pick(mask: np.ndarray, values: np.ndarray) -> Intervals:
+        k = i[mask]
+        return Intervals(sat[k], t[k], t[k + 1], values[k], values[k + 1])
+
+    return Brackets(pick(cross, f), pick(peak, f_rate), pick(culm, el_rate))
+
+
+def screen(satrecs: list, frame: TopocentricFrame, horizon: HorizonTable, jd0: float, fr0: float,
+           span_s: float, coarse_step_s: float, fine_step_s: float, ut1_utc: float,
+           evaluator: PairEvaluator) -> Brackets:
+    """Brackets of every event of ``satrecs`` within ``[0, span_s]`` seconds after ``jd0 + fr0``."""
+    n_steps = max(1, math.ceil(span_s / coarse_step_s))
+    grid = np.linspace(0.0, n_steps * coarse_step_s, n_steps + 1)
+    jd = np.full(grid.shape, jd0)
+    fr = fr0 + grid / SECONDS_PER_DAY
+    obs = frame.origin
+    r_obs = float(np.linalg.norm(obs))
+    obs_unit = obs / r_obs
+    e_lo = math.radians(max(horizon.minimum - 1.0, -89.0))
+    k_lo = r_obs * math.cos(e_lo)
+    flat = horizon.is_flat
+    parts: list[Brackets] = []
+    chunk = max(1, _SCREEN_PAIRS // len(grid))
+    for i0 in range(0, len(satrecs), chunk):
+        part = satrecs[i0 : i0 + chunk]
+        err, r, v = SatrecArray(part).sgp4(jd, fr)
+        pos, vel = teme_to_itrs(r, v, jd, fr, ut1_utc)
+        del r, v
+        ok = err == 0
+        x, y, z = pos[..., 0], pos[..., 1], pos[..., 2]
+        vx, vy, vz = vel[..., 0], vel[..., 1], vel[..., 2]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rad = np.sqrt(x * x + y * y + z * z)
+            psi = np.arccos(np.clip((x * obs_unit[0] + y * obs_unit[1] + z * obs_unit[2]) / rad, -1.0, 1.0))
+            ratio = np.clip(k_lo / rad, -1.0, 1.0)
+            margin = np.where(ok, psi - (np.arccos(ratio) - e_lo), np.inf)  # > 0: below the lowest point
+            # Angular rate of the satellite's direction plus the rate of change of the visibility limit.
+            cx, cy, cz = y * vz - z * vy, z * vx - x * vz, x * vy - y * vx
+            rdot = (x * vx + y * vy + z * vz) / rad
+            rate = (np.sqrt(cx * cx + cy * cy + cz * cz) + np.abs(k_lo * rdot) * rad / np.sqrt(
+                np.maximum(rad * rad - k_lo * k_lo, 1e-6 * rad * rad))) / (rad * rad)
+        # Sampled maxima miss the true one by little on near-circular orbits; eccentric orbits
+        # (fast perigee passages) get a wider safety factor.
+        ecc = np.array([sr.ecco for sr in part])
+        bound = np.nanmax(np.where(ok, rate, np.nan), axis=1, initial=0.0) * (1.1 + 2.0 * ecc) + 1e-5
+        reach = bound[:, None] * coarse_step_s
+        kept = (margin[:, :-1] + margin[:, 1:] - reach) * 0.5 <= 0.0
+        # A failed propagation at one end hides nothing: keep the interval if the other end is close.
+        kept |= (np.isinf(margin[:, :-1]) & (margin[:, 1:] <= reach)) | (
+            np.isinf(margin[:, 1:]) & (margin[:, :-1] <= reach))
+        del margin, psi, ratio, rate, cx, cy, cz, rdot, rad
+        # Sampling step: under a flat horizon f turns only where the elevation does, twice an orbit,
+        # so a step under half the time between the turns (1200 s at a low orbit's rate) leaves at
+        # most one turn per step; a sloping horizon adds turns at its own corners.
+        base = _FLAT_STEP_S if flat else fine_step_s
+        wanted = base * np.clip(_LEO_RATE / np.maximum(bound, 1e-9), 1.0, max(coarse_step_s / base, 1.0))
+        per_sat = np.maximum(1, np.round(coarse_step_s / wanted)).astype(np.intp)
+        coarse_only = per_sat == 1
+        if coarse_only.any():
+            sel = np.flatnonzero(coarse_only)
+            k = _coarse_kinematics(frame, horizon, pos[sel], vel[sel], err[sel])
+            m = len(grid)
+            sat_ids = np.repeat(sel + i0, m)
+            link = np.ones((len(sel), m), dtype=bool)
+            link[:, -1] = False
+            kept_full = np.zeros((len(sel), m), dtype=bool)
+            kept_full[:, :-1] = kept[sel]
+            parts.append(_classify(sat_ids, np.tile(grid, len(sel)), *k, link.ravel(), kept_full.ravel()))
+        fine = np.flatnonzero(~coarse_only)
+        if len(fine):
+            parts.append(_fine_samples(fine + i0, kept[fine], per_sat[fine], grid, coarse_step_s, evaluator))
+        del pos, vel
+    if not parts:
+        empty = Intervals(np.empty(0, np.intp), *(np.empty(0) for _ in range(4)))
+        return Brackets(empty, empty, empty)
+    return Brackets(*(Intervals.concat([getattr(p, k) for p in parts])
+                      for k in ("crossings", "peaks", "culminations")))
+
+
+def _coarse_kinematics(frame: TopocentricFrame, horizon: HorizonTable, pos: np.ndarray, vel: np.ndarray,
+                       err: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Flattened f, df/dt and d(elevation)/dt (deg, deg/s) at the coarse points of some satellites."""
+    d = pos - frame.origin
+    e, n, u = d @ frame.east, d @ frame.north, d @ frame.up
+    e1, n1, u1 = vel @ frame.east, vel @ frame.north, vel @ frame.up
+    q = e * e + n * n
+    rho2 = q + u * u
+    with np.errstate(invalid="ignore", divide="ignore"):
+        hz = np.sqrt(q)
+        el = np.degrees(np.arctan2(u, hz))
+        # d(el)/dt = (u' rho^2 - u rho rho') / (rho^2 hz) = (u' q - u (e e' + n n')) / (rho^2 hz)
+        el_rate = np.degrees((u1 * q - u * (e * e1 + n * n1)) / (rho2 * hz))
+        az = np.degrees(np.arctan2(e, n)) % 360.0
+        f = el - horizon.min_elevation_array(np.nan_to_num(az))
+        f_rate = el_rate
+        if not horizon.is_flat:
+            f_rate = el_rate - horizon.slope_array(np.nan_to_num(az)) * np.degrees((n * e1 - e * n1) / q)
+    bad = err != 0
+    f[bad] = -np.inf
+    el_rate[bad] = np.nan
+    return f.ravel(), f_rate.ravel(), el_rate.ravel()
+
+
+def _fine_samples(sats: np.ndarray, kept: np.ndarray, per_sat: np.ndarray, grid: np.ndarray,
+                  coarse_step_s: float, evaluator: PairEvaluator) -> Brackets:
+    """Sample the kept coarse intervals of ``sats`` ``per_sat`` times each and classify the samples.
+
+    A run of consecutive kept intervals shares its inner edges, so each sample appears once and
+    the samples stay sorted by (satellite, time).
+    """
+    row, interval = np.nonzero(kept)
+    if len(row) == 0:
+        empty = Intervals(np.empty(0, np.intp), *(np.empty(0) for _ in range(4)))
+        return Brackets(empty, empty, empty)
+    run_end = np.ones(len(row), dtype=bool)
+    run_end[:-1] = (row[1:] != row[:-1]) | (interval[1:] != interval[:-1] + 1)
+    per = per_sat[row]
+    counts = np.where(run_end, per + 1, per)
+    sample_row = np.repeat(row, counts)
+    first = np.repeat(np.cumsum(counts) - counts, counts)
+    step_in = np.arange(len(sample_row)) - first
+    step = coarse_step_s / per_sat[sample_row]
+    t = grid[np.repeat(interval, counts)] + step_in * step
+    k = evaluator.evaluate(sats[sample_row], t)
+    link = np.zeros(len(t), dtype=bool)
+    link[:-1] = (sample_row[1:] == sample_row[:-1]) & (np.abs(t[1:] - t[:-1] - step[1:]) < 1e-3)
+    return _classify(sats[sample_row], t, k.f, k.f_rate, k.el_rate, link, np.ones(len(t), dtype=bool))
