@@ -19,7 +19,7 @@ from sgp4.api import jday
 
 from nfwserver.storage import atomic_write_text, remove_stale_temporaries
 from nfwserver.tracking.catalog import Catalog, UpdateSummary
-from nfwserver.tracking.elements import ElementSet, Rejection, load_element_file
+from nfwserver.tracking.elements import ElementSet, load_element_file
 
 log = logging.getLogger(__name__)
 
@@ -49,14 +49,6 @@ def has_decayed(es: ElementSet, at: datetime) -> bool:
     from nfwserver.tracking.catalog import Satellite
 
     return Satellite(es, "").is_decayed
-
-
-@dataclass
-class StoreUpdate:
-    summary: UpdateSummary
-    rejected: list[Rejection] = field(default_factory=list)
-    failed: list[str] = field(default_factory=list)
-    total: int = 0
 
 
 class ElementStore:

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 from datetime import datetime, timezone
 
 from nfwserver.tracking.bodies import sun_view
+from nfwserver.tracking.constants import WGS84_A_KM  # PREDICT's xkmper (predict.c: 6.378137E3)
 from nfwserver.tracking.derived import satellite_report
 from nfwserver.tracking.elements import ElementSet
 from nfwserver.tracking.look_angles import PropagationError
@@ -46,7 +47,6 @@ DAYNUM_OFFSET = 3651.0  #: PREDICT's day 0 is 31Dec79 00:00 UTC: daynum = unix /
 ONE_YEAR_S = 31557600  #: QuickFind/QuickPredict accept a start within this of now
 MAX_SPAN_S = 86400  #: longest list (PREDICT's limit for ``+`` starts; ours for every list)
 MAX_CALCULATIONS = 5000  #: positions one listing may compute before giving up
-PREDICT_EARTH_RADIUS_KM = 6378.137  #: PREDICT's xkmper
 _ATOL = re.compile(r"[ \t\n\v\f\r]*([+-]?\d+)")
 _DAYS = ("Mon", "Tue", "Wed", "Thu", "Fri", "Sat", "Sun")
 _MONTHS = ("Jan", "Feb", "Mar", "Apr", "May", "Jun", "Jul", "Aug", "Sep", "Oct", "Nov", "Dec")
@@ -92,8 +92,8 @@ def aos_happens(elements: ElementSet, observer: Observer) -> bool:
         return False
     inclination = elements.inclination_deg if elements.inclination_deg < 90.0 else 180.0 - elements.inclination_deg
     sma = 331.25 * math.exp(math.log(1440.0 / n) * (2.0 / 3.0))
-    apogee = sma * (1.0 + elements.eccentricity) - PREDICT_EARTH_RADIUS_KM
-    ratio = PREDICT_EARTH_RADIUS_KM / (apogee + PREDICT_EARTH_RADIUS_KM)
+    apogee = sma * (1.0 + elements.eccentricity) - WGS84_A_KM
+    ratio = WGS84_A_KM / (apogee + WGS84_A_KM)
     if not 0.0 < ratio <= 1.0:  # C's acos gives nan: the comparison fails
         return False
     return math.acos(ratio) + math.radians(inclination) > abs(math.radians(observer.latitude_deg))

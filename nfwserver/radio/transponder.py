@@ -27,7 +27,7 @@ import math
 from dataclasses import dataclass, replace
 
 from nfwserver.radio.modes import check_mode
-from nfwserver.tracking.constants import SPEED_OF_LIGHT_KM_S
+from nfwserver.tracking.doppler import downlink_frequency_hz, uplink_frequency_hz
 
 HOLD_SIDES = ("satellite", "uplink", "downlink")
 #: Frequencies accepted for a channel (Hz): 100 kHz to 300 GHz.
@@ -91,8 +91,8 @@ class Channel:
 
     def ground_frequencies(self, range_rate_km_s: float) -> tuple[float, float | None]:
         """(receive, transmit) frequencies on the ground, Hz; transmit is None without an uplink."""
-        shrink = 1.0 - range_rate_km_s / SPEED_OF_LIGHT_KM_S  # downlink factor
-        grow = 1.0 + range_rate_km_s / SPEED_OF_LIGHT_KM_S  # uplink factor
+        shrink = downlink_frequency_hz(1.0, range_rate_km_s)  # downlink factor
+        grow = uplink_frequency_hz(1.0, range_rate_km_s)  # uplink factor
         if self.uplink_hz is None or self.hold == "satellite":
             rx = self.satellite_downlink_hz() * shrink
             up = self.satellite_uplink_hz()

@@ -25,7 +25,7 @@ from nfwserver.clock import Clock, SystemClock
 from nfwserver.radio.backend import RadioBackend, RadioError, RadioUnavailable
 from nfwserver.radio.transponder import Channel
 from nfwserver.ratelimited_log import RateLimitedLog
-from nfwserver.tracking.constants import SPEED_OF_LIGHT_KM_S
+from nfwserver.tracking.doppler import downlink_frequency_hz
 
 log = logging.getLogger(__name__)
 
@@ -78,7 +78,7 @@ class DopplerTuner:
         moved = heard - self._last_rx
         if abs(moved) <= self.knob_tolerance_hz:
             return 0.0
-        at_satellite = moved / (1.0 - range_rate_km_s / SPEED_OF_LIGHT_KM_S)
+        at_satellite = moved / downlink_frequency_hz(1.0, range_rate_km_s)
         self.channel = self.channel.with_offset(self.channel.passband_offset_hz + at_satellite)
         self._last_rx = heard
         log.info("operator retuned by %+.0f Hz; following from there", moved)

@@ -16,8 +16,6 @@ from typing import Any
 
 from nfwserver.tracking.tle import TleError, TleFields, check_ranges
 
-OMM_KEYS = ("OBJECT_NAME", "NORAD_CAT_ID", "EPOCH", "MEAN_MOTION", "ECCENTRICITY")
-
 
 def _epoch(text: str) -> datetime:
     text = str(text).strip().rstrip("Z")

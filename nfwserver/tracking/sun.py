@@ -9,8 +9,6 @@ Distances are km; times are split UTC Julian dates (the formulae's TT-UTC differ
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from nfwserver.tracking.constants import AU_KM, JD_J2000
@@ -43,10 +41,3 @@ def is_sunlit(position_km: np.ndarray, sun_km: np.ndarray) -> bool | np.ndarray:
                        np.linalg.norm(p, axis=-1))
     lit = closest > EARTH_RADIUS_KM
     return bool(lit) if lit.ndim == 0 else lit
-
-
-def sun_elevation_deg(sun_itrs_km: np.ndarray, observer_itrs_km: tuple[float, float, float],
-                      up: tuple[float, float, float]) -> float:
-    """Elevation (deg) of the Sun seen from an observer, all vectors Earth-fixed."""
-    d = np.asarray(sun_itrs_km) - np.asarray(observer_itrs_km)
-    return math.degrees(math.asin(float(np.dot(d, up) / np.linalg.norm(d))))

@@ -11,7 +11,7 @@ up to about 0.2 m/s.  Pass ``ut1_utc`` (IERS Bulletin A, seconds) to remove that
 from __future__ import annotations
 
 import math
-from datetime import datetime, timedelta, timezone
+from datetime import datetime, timezone
 
 from nfwserver.tracking.constants import DAYS_PER_JULIAN_CENTURY, JD_J2000, SECONDS_PER_DAY
 
@@ -31,14 +31,6 @@ def julian_date(when: datetime) -> tuple[float, float]:
         when = when.replace(tzinfo=timezone.utc)
     delta = when - _EPOCH_2000
     return _JD_2000 + delta.days, (delta.seconds + delta.microseconds * 1e-6) / SECONDS_PER_DAY
-
-
-def datetime_from_julian(jd: float, fraction: float = 0.0) -> datetime:
-    """Aware UTC datetime of a (split) Julian date, rounded to the microsecond."""
-    days = (jd - _JD_2000) + fraction
-    whole = math.floor(days)
-    micros = round((days - whole) * SECONDS_PER_DAY * 1e6)
-    return _EPOCH_2000 + timedelta(days=whole, microseconds=micros)
 
 
 def gmst1982(jd_ut1: float, fraction_ut1: float = 0.0) -> tuple[float, float]:
