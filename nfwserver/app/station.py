@@ -124,7 +124,8 @@ class Station:
                 ("[server] services/topic/items", (running.server.services, running.server.topic,
                                                     running.server.items),
                  (new.server.services, new.server.topic, new.server.items)),
-                ("[dialects]", running.dialects, new.dialects)):
+                ("[dialects]", running.dialects, new.dialects), ("[tcp]", running.tcp, new.tcp),
+                ("[easycomm]", running.easycomm, new.easycomm)):
             if old != now:
                 restart.append(label)
         # What needs a restart keeps running as it was: remember it, so the next comparison is true.
@@ -135,7 +136,7 @@ class Station:
                                             port=running.radio.port),
                               server=replace(new.server, services=running.server.services,
                                              topic=running.server.topic, items=running.server.items),
-                              dialects=running.dialects)
+                              dialects=running.dialects, tcp=running.tcp, easycomm=running.easycomm)
         return restart
 
     def _config_changed(self, new: Config) -> None:

@@ -23,6 +23,7 @@ COMMAND_MODULES: tuple[str, ...] = (
     "tracking_commands",
     "elements_command",
     "config_command",
+    "control_command",
 )
 
 
