@@ -54,6 +54,7 @@ class TcpStats:
     refused: int = 0  #: peers not allowed, or over the client limit
     dropped: int = 0  #: watching clients dropped for not reading
     lost: int = 0  #: published strings lost because the loop fell PUBLISHED_BACKLOG behind
+    delivered: int = 0  #: published strings handed to the watchers
     max_buffered: int = 0  #: the most bytes ever waiting for one client
 
 
@@ -342,6 +343,7 @@ class NovaTcpServer:
                     continue
                 self._queue(client, data)
                 self._pump(client)
+            self.stats.delivered += 1
 
     def _close(self, client: _Client, reason: str, accepted: bool | None = None) -> None:
         if client.closed:
