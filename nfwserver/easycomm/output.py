@@ -154,12 +154,17 @@ class EasyCommOutput:
     # -- life cycle -----------------------------------------------------------------------------------
     def _run(self) -> None:
         period = 1.0 / self.config.rate_hz
+        due = self.clock.monotonic()
         while not self._stop.is_set():
             try:
                 self.step()
             except Exception:  # keep writing whatever happens
                 log.exception("EasyComm output failed")
-            if self.clock.wait(self._stop, period):
+            due += period  # a fixed schedule on the clock, so late wake-ups do not slow the rate
+            now = self.clock.monotonic()
+            if now - due > period:  # fell behind (a slow write): go on from now rather than burst
+                due = now
+            if self.clock.wait(self._stop, due - now):
                 break
 
     def start(self) -> None:

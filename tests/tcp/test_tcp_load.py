@@ -139,7 +139,7 @@ def _fuzz_items(rng: random.Random, n: int) -> list[bytes]:
     harmless = [b"SUMMARY", b"STATUS", b"summary", b"ANTAZ=12.5", b"ANTEL=-3", b"SAT=99999", b"TUNE", b"TRACK MAYBE"]
     ends = [b"\r", b"\n", b"\r\n", b"\x00"]
     out = []
-    for i in range(n):
+    for _ in range(n):
         kind = rng.random()
         if kind < 0.3:
             body = bytes(rng.randrange(256) for _ in range(rng.randrange(0, 200)))
