@@ -92,7 +92,10 @@ class EasyCommOutput:
         return range_rate_line(la.azimuth_deg, la.elevation_deg, la.range_rate_km_s)
 
     def step(self) -> None:
-        """One period's work: a position line, or the one stop line owed (worker thread)."""
+        """One period's work: a position line, or the one stop line owed (worker thread).  A closed port is
+        reopened (within the back-off) even with nothing to write, so a missing device shows at once."""
+        if self._port is None:
+            self._open()
         line = self.line_for(self._pending)
         if line is not None:
             if self._write(line):
