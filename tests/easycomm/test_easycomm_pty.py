@@ -60,6 +60,16 @@ def _output(station, path: Path, uplink: str = "range-rate", **kw) -> EasyCommOu
     return output
 
 
+def _start(output: EasyCommOutput) -> None:
+    """Start the worker and let it open the port and settle into its wait (it opens at once)."""
+    output.start()
+    deadline = time.monotonic() + 5.0
+    while not output.connected and time.monotonic() < deadline:
+        time.sleep(0.001)
+    assert output.connected
+    time.sleep(0.05)
+
+
 def _step(station, output: EasyCommOutput) -> None:
     """Tick once, then let the worker write exactly one line for that tick."""
     station.core.tick()
@@ -79,7 +89,7 @@ def test_lines_during_a_pass_match_the_spec_and_skyfield(tmp_path) -> None:
     output = _output(station, pty.path)
     station.core.set_track(True)
     station.core.set_tune(True)
-    output.start()
+    _start(output)
     try:
         for _ in range(8):
             _step(station, output)
@@ -121,7 +131,7 @@ def test_stop_lines_when_tracking_stops_and_at_los(tmp_path) -> None:
     pty = Pty(tmp_path / "ttyUSB0")
     output = _output(station, pty.path)
     station.core.set_track(True)
-    output.start()
+    _start(output)
     try:
         _step(station, output)
         station.core.set_track(False)
@@ -147,7 +157,7 @@ def test_doppler_mode_carries_the_channel_frequencies_and_modes(tmp_path) -> Non
     pty = Pty(tmp_path / "ttyUSB0")
     output = _output(station, pty.path, uplink="doppler")
     station.core.set_track(True)
-    output.start()
+    _start(output)
     try:
         for _ in range(4):
             _step(station, output)
