@@ -66,3 +66,15 @@ def test_the_simulate_example_uses_files_that_exist(monkeypatch, capsys) -> None
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].split("\t")[1].startswith("ISS AZ:")
     assert lines[-1].split("\t")[1].startswith("SO-50 AZ:")
+
+
+def test_the_tcp_and_easycomm_examples_are_valid_configuration() -> None:
+    from nfwserver.config import parse_config
+    from nfwserver.tcp import GREETING
+
+    section = README[README.index("## Reaching the station from outside"):README.index("## Command line")]
+    config = parse_config("".join(re.findall(r"```toml\n(.*?)```", section, re.S)))
+    assert config.tcp.enabled and config.tcp.port == 8090 and config.tcp.host == "127.0.0.1"
+    assert config.server.satellite == 25544 and config.server.tune and config.server.track
+    assert config.easycomm.enabled and config.easycomm.rate_hz == 2 and config.easycomm.uplink == "range-rate"
+    assert f"$ nc 127.0.0.1 8090\n{GREETING}\n" in section

@@ -3,7 +3,8 @@
 Data flow (docs/ARCHITECTURE.md): configuration and element sets fill the one live
 :class:`~nfwserver.core.state.StationState`; the publisher ticks the core's tracker on the clock; each
 tick's :class:`~nfwserver.core.sample.TickSample` goes to every adapter — Nova DDE, the other trackers'
-DDE dialects, PREDICT, the rotor and radio couplings, the session saver, the console.  Adapters read
+DDE dialects, PREDICT, Nova's TCP server (``station.tcp``), the EasyComm I serial output
+(``station.easycomm``), the rotor and radio couplings, the session saver, the console.  Adapters read
 the state and talk back through the core's ports; none holds a copy, so :meth:`Station.apply_config`
 changes the state once and every output follows on the next tick.
 
@@ -23,6 +24,7 @@ from nfwserver.app.element_refresher import ElementRefresher
 from nfwserver.app.element_sources import FetchResult, fetch_all
 from nfwserver.app.session_state import SessionSaver, SessionState, StateFile
 from nfwserver.app.station_catalog import configured_store, load_station_catalog
+from nfwserver.app.status_fields import device_status
 from nfwserver.clock import Clock
 from nfwserver.config.schema import Config
 from nfwserver.core.events import Direction
@@ -36,8 +38,10 @@ from nfwserver.dialects.orbitron import ORBITRON
 from nfwserver.dialects.predict_udp import PredictContext, PredictUdpServer
 from nfwserver.dialects.satpc32 import SATPC32
 from nfwserver.dialects.wxtrack import WXTRACK
+from nfwserver.easycomm.output import EasyCommOutput
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.rotor.coupling import RotorCoupling
+from nfwserver.tcp.server import NovaTcpServer
 from nfwserver.tracking.catalog import Catalog, UpdateSummary
 
 log = logging.getLogger(__name__)
@@ -74,6 +78,11 @@ class Station:
         self.rotor: RotorCoupling | None = make_rotor(config.rotor, self.core, clock)
         self.radio: RadioCoupling | None = make_radio(config.radio, self.core, clock)
         self.saver = SessionSaver(self.state_file, config.server.satellite) if self.state_file else None
+        self.easycomm: EasyCommOutput | None = (EasyCommOutput(config.easycomm, self.core.state, clock)
+                                                if config.easycomm.enabled else None)
+        self.tcp: NovaTcpServer | None = (
+            NovaTcpServer(self.core, config.tcp, device_status(self.rotor, self.radio, self.easycomm))
+            if config.tcp.enabled else None)
         self.watcher: ConfigWatcher | None = None
         self._unsubscribe: list = []
         self._started = False
@@ -111,7 +120,8 @@ class Station:
                 ("[server] services/topic/items", (running.server.services, running.server.topic,
                                                     running.server.items),
                  (new.server.services, new.server.topic, new.server.items)),
-                ("[dialects]", running.dialects, new.dialects)):
+                ("[dialects]", running.dialects, new.dialects), ("[tcp]", running.tcp, new.tcp),
+                ("[easycomm]", running.easycomm, new.easycomm)):
             if old != now:
                 restart.append(label)
         # What needs a restart keeps running as it was: remember it, so the next comparison is true.
@@ -122,7 +132,7 @@ class Station:
                                             port=running.radio.port),
                               server=replace(new.server, services=running.server.services,
                                              topic=running.server.topic, items=running.server.items),
-                              dialects=running.dialects)
+                              dialects=running.dialects, tcp=running.tcp, easycomm=running.easycomm)
         return restart
 
     def _config_changed(self, new: Config) -> None:
@@ -204,13 +214,20 @@ class Station:
         self._restore_session()
         if self.predict is not None:
             self.predict.start()
+        if self.tcp is not None:
+            try:
+                self.tcp.start()
+            except OSError:
+                if self.predict is not None:
+                    self.predict.stop()
+                raise
         if self.transport is None:
             self.transport, self.transport_note = default_transport()
         self._started = True
         self.nova.attach(self.transport)
         for dialect_server in self.dialect_servers:
             dialect_server.attach(self.transport)
-        for worker in (self.radio, self.rotor, self.saver):
+        for worker in (self.radio, self.rotor, self.saver, self.easycomm):
             if worker is not None:
                 self._unsubscribe.append(self.core.subscribe(worker.on_tick))
                 worker.start()
@@ -231,9 +248,11 @@ class Station:
             unsubscribe()
         if self.predict is not None:
             self.predict.stop()
+        if self.tcp is not None:
+            self.tcp.stop()
         for dialect_server in self.dialect_servers:
             dialect_server.detach()
-        for worker in (self.radio, self.rotor, self.saver):
+        for worker in (self.radio, self.rotor, self.saver, self.easycomm):
             if worker is not None:
                 worker.stop()
         self.nova.detach()

@@ -24,6 +24,8 @@ COMMANDS: tuple[tuple[str, str, str], ...] = (
     ("visible", "tracking_commands", "satellites above the horizon table at an instant"),
     ("elements", "elements_command", "update or list the stored element catalog"),
     ("config", "config_command", "configuration file: path, init, show"),
+    ("poke", "control_command", "send a Nova command to the running station (TCP)"),
+    ("status", "control_command", "one line of the running station's state (TCP)"),
 )
 
 #: Top-level options that take no value (so the word after them is not their argument).

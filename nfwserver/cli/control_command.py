@@ -1,0 +1,74 @@
+"""``nfwserver poke TEXT`` and ``nfwserver status``: control a running station over its TCP port.
+
+Host and port come from the configuration's ``[tcp]`` section (``--config`` honoured; ``--host`` and
+``--port`` override), so a second terminal or a cron job can switch a headless station:
+``nfwserver poke "TRACK ON"``.  The reply goes to stdout; ``ERROR ...`` replies and an unreachable
+station are one sentence on stderr with exit code 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from nfwserver.cli.arguments import number_in
+
+
+def _common(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--config", metavar="FILE", help="configuration file giving [tcp] host and port")
+    p.add_argument("--host", help="station address (default: [tcp] host, loopback for a wildcard)")
+    p.add_argument("--port", type=number_in(1, 65535, integer=True), help="station TCP port (default: [tcp] port)")
+    p.add_argument("--timeout", type=number_in(0, 600, low_open=True, unit="s"), default=5.0, metavar="SECONDS",
+                   help="give up after this long (default 5)")
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    p = subparsers.add_parser(
+        "poke", help="send a Nova command to the running station (TCP)",
+        description="Send one command to the running station over its TCP port: TUNE ON|OFF, TRACK ON|OFF, "
+        "SAT=<catalog number>, ANTAZ=<deg>, ANTEL=<deg> (or SUMMARY).")
+    p.add_argument("text", help='the command, e.g. "TRACK ON"')
+    _common(p)
+    p.set_defaults(func=poke)
+    s = subparsers.add_parser("status", help="one line of the running station's state (TCP)",
+                              description="Print the running station's STATUS line (key=value pairs).")
+    _common(s)
+    s.set_defaults(func=status)
+
+
+def _ask(args: argparse.Namespace, line: str) -> str:
+    from nfwserver.cli import CliError
+    from nfwserver.config import ConfigError, load_config
+    from nfwserver.tcp.client import StationUnreachable, ask, connect_host
+
+    try:
+        config = load_config(args.config)
+    except ConfigError as exc:
+        raise CliError(f"configuration refused: {exc}") from None
+    host = args.host or connect_host(config.tcp.host)
+    port = int(args.port or config.tcp.port)
+    try:
+        return ask(host, port, line, args.timeout)
+    except StationUnreachable as exc:
+        raise CliError(str(exc)) from None
+
+
+def poke(args: argparse.Namespace) -> int:
+    import sys
+
+    from nfwserver.cli import CliError
+
+    text = args.text.strip()
+    if not text or not text.isascii() or not text.isprintable() or len(text) > 256:
+        print("nfwserver poke: the command must be one line of printable ASCII (at most 256 characters)",
+              file=sys.stderr)
+        return 2
+    reply = _ask(args, text)
+    if reply.startswith("ERROR"):
+        raise CliError(f"the station refused {text!r}: {reply[5:].strip()}")
+    print(reply)
+    return 0
+
+
+def status(args: argparse.Namespace) -> int:
+    print(_ask(args, "STATUS"))
+    return 0

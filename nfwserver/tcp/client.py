@@ -1,0 +1,48 @@
+"""A one-question client for Nova's TCP protocol: connect, check the greeting, send a line, read the reply.
+
+Used by ``nfwserver poke`` and ``nfwserver status``; any script can do the same with three lines of
+socket code (README).  Timeouts are real seconds: this runs in a separate, short-lived process.
+"""
+
+from __future__ import annotations
+
+import socket
+
+from nfwserver.tcp.protocol import GREETING
+
+WILDCARDS = {"", "0.0.0.0", "::"}
+
+
+class StationUnreachable(Exception):
+    """No station answered; the message is one sentence for the user."""
+
+
+def connect_host(listen_host: str) -> str:
+    """Where to connect for a server listening on ``listen_host`` (a wildcard means this machine)."""
+    if listen_host in WILDCARDS:
+        return "::1" if listen_host == "::" else "127.0.0.1"
+    return listen_host
+
+
+def _read_line(stream, where: str) -> str:
+    raw = stream.readline(4096)
+    if not raw:
+        raise StationUnreachable(f"the station at {where} closed the connection "
+                                 "(is this machine's address in its [tcp] allow list?)")
+    return raw.decode("ascii", errors="replace").rstrip("\r\n")
+
+
+def ask(host: str, port: int, line: str, timeout_s: float = 5.0) -> str:
+    """Send ``line`` to the station at ``host``:``port`` and return its one-line reply."""
+    where = f"{host} port {port}"
+    try:
+        with socket.create_connection((host, port), timeout=timeout_s) as sock, sock.makefile("rb") as stream:
+            greeting = _read_line(stream, where)
+            if greeting != GREETING:
+                raise StationUnreachable(f"{where} answered {greeting[:60]!r}, not Nova's greeting")
+            sock.sendall(line.encode("ascii") + b"\r\n")
+            return _read_line(stream, where)
+    except OSError as exc:
+        reason = exc.strerror or str(exc) or type(exc).__name__
+        raise StationUnreachable(f"no station answers on {where} ({reason}); is `nfwserver run` running "
+                                 "with [tcp] enabled = true?") from None

@@ -1,0 +1,128 @@
+"""Nova's TCP command protocol, as text in and text out (no sockets: the server and tests use it).
+
+Nova for Windows' TCP server (Setup/TCP) greets each client with ``Hello, this is Nova for
+Windows.`` and answers ``SUMMARY`` with the same string its DDE item carries.  We keep that and add
+a few commands; every reply line ends with CR LF (added by the server).
+
+=================  ==========================================================================
+line               reply
+=================  ==========================================================================
+``SUMMARY``        the current Nova string (:meth:`StationCore.current_text`); an empty line
+                   before ``TUNE ON``, after ``TUNE OFF`` and while nothing can be computed
+Nova's commands    ``TUNE ON|OFF``, ``TRACK ON|OFF``, ``SAT=n``, ``ANTAZ=deg``, ``ANTEL=deg``
+                   through :meth:`StationCore.command`: ``OK`` when the command was accepted and
+                   took effect, else ``ERROR <reason>``.  Decision: an accepted command that had
+                   no effect (``TRACK ON`` without a station or satellite, which OrbitDRV ignores)
+                   also answers ``ERROR <why it was ignored>``, because a script that asked for
+                   tracking needs to know it is not happening.  DDE clients still get an
+                   acknowledgement for it; only this protocol reports it.
+``STATUS``         one line of ``key=value`` pairs separated by single blanks (values never
+                   contain blanks): satellite, name, tune, track, radio_tuning, status (the
+                   status word, hex), interface (version), az/el/rr/ah of the last tick when
+                   there is a position, then the fields of the ``extra`` callable (rotor and
+                   radio state, given by the station).
+``WATCH``          ``OK``, then every string the station publishes, one per line, until the client
+                   sends any line (an empty one too); a non-empty line is then handled as usual.
+``QUIT``           ``OK``, then the server closes the connection.
+=================  ==========================================================================
+
+Keywords are accepted in any case with blanks around them.  An empty line outside ``WATCH`` gets
+no reply.  Every command is recorded in the event stream with the peer as ``client``.
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+from nfwserver.core.events import Direction
+from nfwserver.core.nova_protocol import format_azimuth, format_elevation, format_range_rate
+from nfwserver.core.station_core import StationCore
+
+GREETING = "Hello, this is Nova for Windows."
+StatusFields = Callable[[], Mapping[str, object]]
+
+
+class Action(enum.Enum):
+    REPLY = "reply"  #: send the lines, carry on
+    WATCH = "watch"  #: send the lines, then stream published strings
+    QUIT = "quit"  #: send the lines, then close
+
+
+@dataclass(frozen=True)
+class Reply:
+    lines: tuple[str, ...]
+    action: Action = Action.REPLY
+
+
+def _value(value: object) -> str:
+    """A STATUS value without blanks or control characters."""
+    if isinstance(value, bool):
+        return "on" if value else "off"
+    if value is None:
+        return "-"
+    text = "".join(ch if ch.isprintable() and not ch.isspace() else "_" for ch in str(value))
+    return text or "-"
+
+
+def _one_line(text: str) -> str:
+    """``text`` as one printable line (a reason may quote what the client sent)."""
+    return " ".join("".join(ch if ch.isprintable() else " " for ch in text).split())
+
+
+class NovaTcpProtocol:
+    """Answers one line at a time for the station ``core``; ``extra`` adds STATUS fields."""
+
+    def __init__(self, core: StationCore, extra: StatusFields | None = None) -> None:
+        self.core = core
+        self.extra = extra
+
+    def _record(self, peer: str, text: str, detail: str = "") -> None:
+        self.core.events.add(self.core.clock.now(), Direction.IN, "request", text, client=peer, accepted=True,
+                             detail=detail)
+
+    def handle(self, line: str, peer: str) -> Reply | None:
+        """The reply to ``line`` (without its terminator) from ``peer``; None for an empty line."""
+        word = line.strip(" \t").upper()
+        if not word:
+            return None
+        if word == "SUMMARY":
+            text = self.core.current_text()
+            self._record(peer, "SUMMARY", text)
+            return Reply((text,))
+        if word == "STATUS":
+            self._record(peer, "STATUS")
+            return Reply((self.status_line(),))
+        if word == "WATCH":
+            self._record(peer, "WATCH")
+            return Reply(("OK",), Action.WATCH)
+        if word == "QUIT":
+            self._record(peer, "QUIT")
+            return Reply(("OK",), Action.QUIT)
+        result = self.core.command(line, source=peer)
+        return Reply(("OK",) if result.ok else (f"ERROR {_one_line(result.note or 'refused')}",))
+
+    @staticmethod
+    def too_long(limit: int) -> Reply:
+        return Reply((f"ERROR line longer than {limit} bytes refused",))
+
+    def status_line(self) -> str:
+        snap = self.core.snapshot()
+        state = snap.state
+        fields: dict[str, object] = {
+            "satellite": state.catalog_number, "name": snap.dde_name, "tune": state.dde_output,
+            "track": state.tracking, "radio_tuning": state.radio_tuning, "status": f"0x{snap.status:04X}",
+            "interface": snap.interface_version,
+        }
+        sample = snap.last_sample
+        if sample is not None and sample.look_angles is not None and sample.catalog_number == state.catalog_number:
+            la = sample.look_angles
+            fields.update(az=format_azimuth(la.azimuth_deg), el=format_elevation(la.elevation_deg),
+                          rr=format_range_rate(la.range_rate_km_s), ah="Y" if sample.above_horizon else "N")
+        if self.extra is not None:
+            try:
+                fields.update(self.extra())
+            except Exception as exc:  # a broken extra field must not cost the client its answer
+                fields["extra_error"] = type(exc).__name__
+        return " ".join(f"{_value(key)}={_value(value)}" for key, value in fields.items())
