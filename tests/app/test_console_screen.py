@@ -135,7 +135,8 @@ def test_realtime_values_use_the_satellites_own_downlink_and_agree_with_skyfield
     async def scenario() -> None:
         app = NfwConsole(station.core, schedules={ISS: "000A128B"})
         async with app.run_test(size=(120, 36)) as pilot:
-            await settle(app, pilot)
+            await settle(app, pilot, until=lambda: all(
+                word in static_text(app, "state") for word in ("Doppler", "path loss", "Sub-sat", "AH Y")))
             state = static_text(app, "state")
             now = station.clock.now()
         ts = load.timescale(builtin=True)
