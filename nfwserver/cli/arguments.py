@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 import math
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from datetime import datetime, timedelta, timezone
 
 from nfwserver.tracking.observer import Observer, parse_observer
@@ -32,9 +32,9 @@ COMMANDS: tuple[tuple[str, str, str], ...] = (
 _FLAGS = {"-v", "--verbose", "-vv", "-vvv", "--version", "-h", "--help"}
 
 
-def command_word(argv: list[str] | tuple[str, ...] | object) -> str | None:
+def command_word(argv: Iterable[str]) -> str | None:
     """The command named in ``argv`` (the first word that is not a top-level option), or None."""
-    for word in argv:  # type: ignore[attr-defined]
+    for word in argv:
         if word in _FLAGS or (word.startswith("-v") and set(word[1:]) == {"v"}):
             continue
         return None if word.startswith("-") else word

@@ -63,7 +63,9 @@ def search(index: Sequence[Entry], query: str, first: Sequence[int] = (), limit:
                 break
             shown.append(entry)
         return shown, len(index)
-    exact, prefix, other = [], [], []
+    exact: list = []
+    prefix: list = []
+    other: list = []
     digits = text.isdigit()
     for e in index:
         if digits and str(e.catalog_number).startswith(text):

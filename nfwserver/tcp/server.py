@@ -28,6 +28,7 @@ import selectors
 import socket
 import threading
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from nfwserver.config.schema import TcpConfig
@@ -104,7 +105,7 @@ class NovaTcpServer:
         self._listener: socket.socket | None = None
         self._wake_r: socket.socket | None = None
         self._wake_w: socket.socket | None = None
-        self._unsubscribe = None
+        self._unsubscribe: Callable[[], None] | None = None
         self._refusals = RateLimitedLog(log, core.clock, 60.0)
 
     # -- what others read ------------------------------------------------------------------------

@@ -112,4 +112,5 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
             done |= hid & (best_f[active] <= 0.0) & ok & (step < 120.0) & (model < _HOPELESS_DEG)
         c[active] = np.where(ok, newton, 0.5 * (lo + hi))
         active = active[~done]
-    return Solution(*(x[undo] for x in (t_out, el_out, az_out, f_out, el_rate_out, best_f, best_t)), rounds)
+    return Solution(t_out[undo], el_out[undo], az_out[undo], f_out[undo], el_rate_out[undo], best_f[undo],
+                    best_t[undo], rounds)

@@ -108,6 +108,7 @@ def screen(satrecs: list, frame: TopocentricFrame, horizon: HorizonTable, jd0: f
         part = satrecs[i0 : i0 + chunk]
         err, r, v = SatrecArray(part).sgp4(jd, fr)
         pos, vel = teme_to_itrs(r, v, jd, fr, ut1_utc)
+        assert vel is not None  # velocities were given
         del r, v
         ok = err == 0
         x, y, z = pos[..., 0], pos[..., 1], pos[..., 2]

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from datetime import datetime, timezone
+from typing import Any
 
 from nfwserver.tracking.constants import DAYS_PER_JULIAN_CENTURY, JD_J2000, SECONDS_PER_DAY
 
@@ -33,8 +34,10 @@ def julian_date(when: datetime) -> tuple[float, float]:
     return _JD_2000 + delta.days, (delta.seconds + delta.microseconds * 1e-6) / SECONDS_PER_DAY
 
 
-def gmst1982(jd_ut1: float, fraction_ut1: float = 0.0) -> tuple[float, float]:
+def gmst1982(jd_ut1: Any, fraction_ut1: Any = 0.0) -> tuple[Any, Any]:
     """Greenwich mean sidereal angle (radians, 0..2pi) and its rate (radians per UT1 day).
+
+    Takes floats or numpy arrays (element-wise, broadcasting) and returns the same kind.
 
     The IAU 1982 expression that defines SGP4's TEME frame (AIAA 2006-6753 appendix C), in the
     same arithmetic as skyfield's ``theta_GMST1982`` so both agree to the last bit.
