@@ -24,6 +24,9 @@ from nfwserver.cli.arguments import COMMANDS, command_word, join_negative_values
 COMMAND_MODULES: tuple[str, ...] = tuple(dict.fromkeys(module for _, module, _ in COMMANDS))
 
 
+__all__ = ["CliError", "build_parser", "main"]
+
+
 class CliError(Exception):
     """A runtime problem to report in one sentence (exit code 1)."""
 

@@ -6,3 +6,16 @@ Nova's, updated from the Nova core's ticks.  :mod:`nfwserver.dialects.predict_ud
 socket protocol (:mod:`~nfwserver.dialects.predict_protocol`; listings in
 :mod:`~nfwserver.dialects.predict_listing`).
 """
+
+from nfwserver.lazy_exports import lazy_exports  # noqa: E402
+
+_EXPORTS = {
+    "DialectServer": "dde_service",
+    "ORBITRON": "orbitron",
+    "SATPC32": "satpc32",
+    "WXTRACK": "wxtrack",
+    "PredictUdpServer": "predict_udp",
+    "PredictContext": "predict_udp",
+}
+__all__ = sorted(_EXPORTS)
+__getattr__ = lazy_exports(__name__, _EXPORTS)

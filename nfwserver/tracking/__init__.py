@@ -10,3 +10,23 @@ number, update semantics, DDE names), ``observer`` and ``maidenhead`` (station p
 from nfwserver.tracking.sgp4_selfcheck import ensure_working_sgp4
 
 SGP4_CHOICE = ensure_working_sgp4()  # before any tracking module imports sgp4's classes
+
+from nfwserver.lazy_exports import lazy_exports  # noqa: E402
+
+_EXPORTS = {
+    "Catalog": "catalog",
+    "Satellite": "catalog",
+    "ElementSet": "elements",
+    "load_elements": "elements",
+    "load_element_file": "elements",
+    "Observer": "observer",
+    "parse_observer": "observer",
+    "HorizonTable": "horizon",
+    "LookAngleCalculator": "look_angles",
+    "LookAngles": "look_angles",
+    "find_passes": "passes",
+    "Pass": "passes",
+    "doppler_shift_hz": "doppler",
+}
+__all__ = sorted(_EXPORTS)
+__getattr__ = lazy_exports(__name__, _EXPORTS)
