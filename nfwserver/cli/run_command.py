@@ -105,8 +105,8 @@ def _make_console(station: Any, config: Any, hint: str) -> Any:
 
     return NfwConsole(station.core, station.transport_note, hint, radio=station.radio, rotor=station.rotor,
                       favourites=config.favourites or (25544, 27607, 43017, 44909, 7530),
-                      clients=station.nova.client_count, tcp=getattr(station, "tcp", None),
-                      easycomm=getattr(station, "easycomm", None), config_file=config.path or "")
+                      clients=station.nova.client_count, tcp=station.tcp, easycomm=station.easycomm,
+                      config_file=config.path or "", schedules=config.schedules)
 
 
 def _stop_on_signals(stop: threading.Event) -> None:

@@ -193,6 +193,28 @@ def _names(setting: Setting, value: Any, base: Path | None) -> dict[int, str]:
     return names
 
 
+def _schedules(setting: Setting, value: Any, base: Path | None) -> dict[int, str]:
+    from nfwserver.tracking.derived import parse_schedule
+
+    if not isinstance(value, dict):
+        raise ValueError("must be a table of catalog number = \"SCHEDULE\" (e.g. 7530 = \"000B128A\")")
+    schedules: dict[int, str] = {}
+    problems = []
+    for key, text in value.items():
+        try:
+            if not key.isdigit() or not 0 < int(key) < 1_000_000_000:
+                raise ValueError(f"{key!r} is not a catalog number")
+            if not isinstance(text, str):
+                raise ValueError("must be a string")
+            parse_schedule(text)
+            schedules[int(key)] = text.strip()
+        except ValueError as exc:
+            problems.append(f"[satellites] schedules.{key}: {exc}")
+    if problems:
+        raise ManyProblems(problems)
+    return schedules
+
+
 #: Keys of one ``[[satellites.channels]]`` entry: (key, example value, help).
 CHANNEL_KEYS: tuple[tuple[str, Any, str], ...] = (
     ("catalog_number", 25544, "the satellite (required)"),
@@ -263,7 +285,7 @@ CONVERTERS: dict[str, Converter] = {
     "bool": _bool, "int": _int, "number": _number, "choice": _choice, "text": _text, "texts": _texts,
     "choices": _choices, "catnr": _catnr, "catnrs": _catnrs, "host": _host, "networks": _networks,
     "urls": _urls, "file": _file, "files": _files, "store": _store, "location": _location,
-    "points": _points, "names": _names, "channels": _channels, "device": _text,
+    "points": _points, "names": _names, "schedules": _schedules, "channels": _channels, "device": _text,
 }
 
 

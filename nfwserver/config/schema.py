@@ -115,6 +115,8 @@ class Config:
     elements: ElementsConfig = field(default_factory=ElementsConfig)
     server: ServerConfig = field(default_factory=ServerConfig)
     dde_names: dict[int, str] = field(default_factory=lambda: default("satellites", "names"))
+    #: InstantTrack mode schedules by catalog number (``000B128A``: phases in 256ths, then the mode)
+    schedules: dict[int, str] = field(default_factory=lambda: default("satellites", "schedules"))
     favourites: tuple[int, ...] = default("satellites", "favourites")  #: satellites whose passes the console lists
     radio: RadioConfig = field(default_factory=RadioConfig)
     rotor: RotorConfig = field(default_factory=RotorConfig)

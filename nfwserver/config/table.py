@@ -111,6 +111,8 @@ SETTINGS: tuple[Setting, ...] = (
        "dde_names", example={"25544": "ISS", "27607": "SO-50"}),
     _S("satellites", "favourites", "catnrs", [], "satellites whose passes the console lists", "favourites",
        example=[25544, 27607, 43017]),
+    _S("satellites", "schedules", "schedules", {}, "InstantTrack mode schedules by catalog number: three-digit "
+       "phases (0-255) each followed by the mode then in force", "schedules", example={"7530": "000B128A"}),
     _S("satellites", "channels", "channels", [], "radio channels for Doppler tuning, as [[satellites.channels]] "
        "tables; they add to or replace the built-in ones (ISS, SO-50, AO-91, RS-44, AO-7)", "channels"),
     # [radio]

@@ -177,3 +177,14 @@ def test_easycomm_problems(text, reason) -> None:
 def test_a_device_may_be_absent_at_start() -> None:
     """A USB adaptor may be plugged in later: the output copes, so the configuration does not require it."""
     assert parse_config('[easycomm]\nenabled = true\ndevice = "/dev/does-not-exist"\n').easycomm.enabled
+
+
+def test_mode_schedules_are_checked_and_reach_the_config() -> None:
+    # InstantTrack: a schedule is three-digit phases (256ths of an orbit) each followed by the mode in force.
+    from nfwserver.config import ConfigError, parse_config
+
+    config = parse_config('[satellites]\nschedules = { 7530 = "000B128A" }\n')
+    assert config.schedules == {7530: "000B128A"}
+    for bad in ('{ 7530 = "B000" }', '{ 7530 = "128A000B" }', '{ AO7 = "000B" }', '"000B"'):
+        with pytest.raises(ConfigError, match=r"\[satellites\] schedules"):
+            parse_config(f"[satellites]\nschedules = {bad}\n")

@@ -51,6 +51,15 @@ def predict_peer(state: StationState | None = None, clock: VirtualClock | None =
     server = PredictUdpServer(ctx, "127.0.0.1", 0)
     server.start()
     client = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    # A day-long listing is ~1,440 datagrams sent as fast as they are computed (as PREDICT does); on a busy
+    # machine the default receive buffer overflows before this reader gets the processor, so give it room.
+    for option in (getattr(socket, "SO_RCVBUFFORCE", None), socket.SO_RCVBUF):
+        if option is not None:
+            try:
+                client.setsockopt(socket.SOL_SOCKET, option, 16 * 2**20)
+                break
+            except OSError:
+                continue
     client.bind(("127.0.0.1", client_port))
     client.settimeout(5.0)
     try:
