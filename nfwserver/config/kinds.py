@@ -173,46 +173,38 @@ def _points(setting: Setting, value: Any, base: Path | None) -> HorizonTable:
     return HorizonTable([(float(a), float(e)) for a, e in value])
 
 
-def _names(setting: Setting, value: Any, base: Path | None) -> dict[int, str]:
+def _by_catalog_number(key: str, value: Any, form: str, convert: Callable[[str], str]) -> dict[int, str]:
+    """A ``[satellites] <key>`` table of catalog number = text, each text checked by ``convert``."""
     if not isinstance(value, dict):
-        raise ValueError("must be a table of catalog number = \"NAME\"")
-    names: dict[int, str] = {}
+        raise ValueError(f"must be a table of catalog number = {form}")
+    result: dict[int, str] = {}
     problems = []
-    for key, name in value.items():
+    for number, text in value.items():
         try:
-            if not key.isdigit() or not 0 < int(key) < 1_000_000_000:
-                raise ValueError(f"{key!r} is not a catalog number")
-            number = int(key)
-            if not isinstance(name, str):
+            if not number.isdigit() or not 0 < int(number) < 1_000_000_000:
+                raise ValueError(f"{number!r} is not a catalog number")
+            if not isinstance(text, str):
                 raise ValueError("must be a string")
-            names[number] = validate_dde_name(name)
+            result[int(number)] = convert(text)
         except ValueError as exc:
-            problems.append(f"[satellites] names.{key}: {exc}")
+            problems.append(f"[satellites] {key}.{number}: {exc}")
     if problems:
         raise ManyProblems(problems)
-    return names
+    return result
+
+
+def _names(setting: Setting, value: Any, base: Path | None) -> dict[int, str]:
+    return _by_catalog_number("names", value, '"NAME"', validate_dde_name)
 
 
 def _schedules(setting: Setting, value: Any, base: Path | None) -> dict[int, str]:
     from nfwserver.tracking.derived import parse_schedule
 
-    if not isinstance(value, dict):
-        raise ValueError("must be a table of catalog number = \"SCHEDULE\" (e.g. 7530 = \"000B128A\")")
-    schedules: dict[int, str] = {}
-    problems = []
-    for key, text in value.items():
-        try:
-            if not key.isdigit() or not 0 < int(key) < 1_000_000_000:
-                raise ValueError(f"{key!r} is not a catalog number")
-            if not isinstance(text, str):
-                raise ValueError("must be a string")
-            parse_schedule(text)
-            schedules[int(key)] = text.strip()
-        except ValueError as exc:
-            problems.append(f"[satellites] schedules.{key}: {exc}")
-    if problems:
-        raise ManyProblems(problems)
-    return schedules
+    def checked(text: str) -> str:
+        parse_schedule(text)
+        return text.strip()
+
+    return _by_catalog_number("schedules", value, '"SCHEDULE" (e.g. 7530 = "000B128A")', checked)
 
 
 #: Keys of one ``[[satellites.channels]]`` entry: (key, example value, help).
