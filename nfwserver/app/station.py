@@ -81,7 +81,8 @@ class Station:
         self.easycomm: EasyCommOutput | None = (EasyCommOutput(config.easycomm, self.core.state, clock)
                                                 if config.easycomm.enabled else None)
         self.tcp: NovaTcpServer | None = (
-            NovaTcpServer(self.core, config.tcp, device_status(self.rotor, self.radio, self.easycomm))
+            NovaTcpServer(self.core, config.tcp, device_status(self.rotor, self.radio, self.easycomm),
+                          set_flip=self.rotor.set_flip_mode if self.rotor is not None else None)
             if config.tcp.enabled else None)
         self.watcher: ConfigWatcher | None = None
         self._unsubscribe: list = []

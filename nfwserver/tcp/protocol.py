@@ -24,6 +24,8 @@ Nova's commands    ``TUNE ON|OFF``, ``TRACK ON|OFF``, ``SAT=n``, ``ANTAZ=deg``, 
 ``WATCH``          ``OK``, then every string the station publishes, one per line, until the client
                    sends any line (an empty one too); a non-empty line is then handled as usual.
 ``QUIT``           ``OK``, then the server closes the connection.
+``FLIP AUTO|ON|OFF`` FlipAnts' inverted tracking forced on (function 7F), off (7E) or chosen per
+                   pass; ``ERROR`` when the station has no rotor.
 =================  ==========================================================================
 
 Keywords are accepted in any case with blanks around them.  An empty line outside ``WATCH`` gets
@@ -74,9 +76,11 @@ def _one_line(text: str) -> str:
 class NovaTcpProtocol:
     """Answers one line at a time for the station ``core``; ``extra`` adds STATUS fields."""
 
-    def __init__(self, core: StationCore, extra: StatusFields | None = None) -> None:
+    def __init__(self, core: StationCore, extra: StatusFields | None = None,
+                 set_flip: Callable[[str], None] | None = None) -> None:
         self.core = core
         self.extra = extra
+        self.set_flip = set_flip  #: the rotor's flip-mode port (None without a rotor)
 
     def _record(self, peer: str, text: str, detail: str = "") -> None:
         self.core.events.add(self.core.clock.now(), Direction.IN, "request", text, client=peer, accepted=True,
@@ -100,8 +104,20 @@ class NovaTcpProtocol:
         if word == "QUIT":
             self._record(peer, "QUIT")
             return Reply(("OK",), Action.QUIT)
+        if word.split()[0] == "FLIP":
+            return self._flip(word, peer)
         result = self.core.command(line, source=peer)
         return Reply(("OK",) if result.ok else (f"ERROR {_one_line(result.note or 'refused')}",))
+
+    def _flip(self, word: str, peer: str) -> Reply:
+        parts = word.split()
+        self._record(peer, word)
+        if self.set_flip is None:
+            return Reply(("ERROR no rotor is configured",))
+        if len(parts) != 2 or parts[1] not in ("AUTO", "ON", "OFF"):
+            return Reply(("ERROR FLIP needs AUTO, ON or OFF",))
+        self.set_flip(parts[1].lower())
+        return Reply(("OK",))
 
     @staticmethod
     def too_long(limit: int) -> Reply:

@@ -86,10 +86,10 @@ class NovaTcpServer:
 
     def __init__(self, core: StationCore, config: TcpConfig, extra: StatusFields | None = None, *,
                  output_limit: int = DEFAULT_OUTPUT_LIMIT, send_buffer_bytes: int | None = None,
-                 max_clients: int = MAX_CLIENTS) -> None:
+                 max_clients: int = MAX_CLIENTS, set_flip: Callable[[str], None] | None = None) -> None:
         self.core = core
         self.config = config
-        self.protocol = NovaTcpProtocol(core, extra)
+        self.protocol = NovaTcpProtocol(core, extra, set_flip)
         self.output_limit = output_limit
         self.send_buffer_bytes = send_buffer_bytes
         self.max_clients = max_clients

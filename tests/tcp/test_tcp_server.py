@@ -196,3 +196,25 @@ def test_stop_closes_every_client(tcp_station) -> None:
         except (TimeoutError, ConnectionResetError):
             pytest.fail("the server did not close the connection")
         c.close()
+
+
+def test_flip_sets_the_rotors_inverted_tracking_mode(tcp_station, client) -> None:
+    # FlipAnts: function 7F forces inverted tracking on, 7E off; "auto" chooses per pass.
+    from nfwserver.rotor.geometry import RotorGeometry
+    from tests.dde.conftest import ISS_PASS
+    from tests.rotor.conftest import rotor_station
+
+    assert client.ask("FLIP ON") == "ERROR no rotor is configured"  # this station has no rotor
+    clock, core, _, _, coupling, _ = rotor_station(ISS_PASS.aos, RotorGeometry.preset("north-stop+flip"))
+    server = NovaTcpServer(core, LOOPBACK_ONLY, set_flip=coupling.set_flip_mode)
+    server.start()
+    try:
+        with_rotor = LineClient(server.address)
+        with_rotor.read_line()
+        for command, mode in (("flip on", "on"), ("FLIP OFF", "off"), ("FLIP auto", "auto")):
+            assert with_rotor.ask(command) == "OK" and coupling.flip_mode == mode
+        assert with_rotor.ask("FLIP SIDEWAYS") == "ERROR FLIP needs AUTO, ON or OFF"
+        assert coupling.flip_mode == "auto"
+        with_rotor.close()
+    finally:
+        server.stop()
