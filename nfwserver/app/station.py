@@ -17,6 +17,7 @@ threads.  :meth:`start` and :meth:`stop` are idempotent.
 from __future__ import annotations
 
 import logging
+from dataclasses import replace
 
 from nfwserver.app.config_watcher import ConfigWatcher
 from nfwserver.app.devices import make_radio, make_rotor
@@ -126,8 +127,6 @@ class Station:
             if old != now:
                 restart.append(label)
         # What needs a restart keeps running as it was: remember it, so the next comparison is true.
-        from dataclasses import replace
-
         self.config = replace(new, elements=running.elements, rotor=running.rotor,
                               radio=replace(new.radio, backend=running.radio.backend, host=running.radio.host,
                                             port=running.radio.port),
