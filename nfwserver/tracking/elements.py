@@ -181,7 +181,7 @@ def _load_three_line_file(lines: list[str], source: str, result: LoadResult) -> 
     names, ones, twos = lines[0::3], [x.rstrip() for x in lines[1::3]], lines[2::3]
     match = _TLE_LIKE.match
     if not (all([x.startswith("1 ") and match(x) for x in ones]) and all([x.startswith("2") for x in twos])
-            and all([_could_be_name(x) and not x.startswith("2 ") and not match(x.rstrip())
+            and all([_could_be_name(x) and not x.startswith("2 ")
                      and not amsat.is_satellite_line(x) and not _is_csv_header(x) for x in names])):
         return False
     pending: list = [(sanitize_element_name(_clean_name(name)), 3 * k + 1, one, two.rstrip())
