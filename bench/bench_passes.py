@@ -125,8 +125,10 @@ def main() -> None:
     print("## Pass prediction against skyfield\n")
     print("Whole processes (interpreter, imports, loading the elements, the search), the first N objects of "
           "tests/data/active.txt, 24 h from 52.2N 0.12E, flat horizon; nfwserver and skyfield `find_events` "
-          f"alternate in one run; median wall time, peak RSS from `/usr/bin/time -v`. Load average at the end: "
-          f"{load_avg:.1f} on {os.cpu_count()} cores.\n")
+          f"alternate in one run; median wall time, peak RSS from `/usr/bin/time -v`. Both print only the number "
+          f"of events found: `find_passes` returns a `PassList` (columns; a `Pass` record is built when one is "
+          f"read), skyfield arrays per satellite. Load average at the end: {load_avg:.1f} on {os.cpu_count()} "
+          f"cores.\n")
     print("| satellites | nfwserver, one process | skyfield | ratio | peak RSS nfwserver / skyfield | "
           "passes / skyfield events |")
     print("|---|---|---|---|---|---|")

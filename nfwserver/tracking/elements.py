@@ -18,19 +18,21 @@ cannot hold (non-finite numbers, epochs outside 1957..2056) are rejected
 from __future__ import annotations
 
 import csv
+import gc
 import json
 import os
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from datetime import datetime
+from datetime import datetime, timedelta
 from pathlib import Path
 
 from sgp4.api import WGS72, Satrec
 
 from nfwserver.tracking import amsat, omm
 from nfwserver.tracking.element_names import MAX_NAME_LENGTH, sanitize_element_name
-from nfwserver.tracking.tle import TleError, TleFields, format_tle, parse_tle
+from nfwserver.tracking.tle import TleError, TleFields, epoch_from_tle, format_tle, parse_tle
+from nfwserver.tracking.tle_bulk import read_canonical
 
 
 @dataclass(frozen=True, slots=True)
@@ -155,20 +157,58 @@ def load_elements(data: str | bytes, source: str = "<text>") -> LoadResult:
 
 def _load_text(data: str, source: str, result: LoadResult) -> None:
     lines = data.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    gc_was_on = gc.isenabled()
+    gc.disable()  # tens of thousands of new objects, no cycles: collections would only cost time
+    try:
+        if not _load_three_line_file(lines, source, result):
+            _load_lines(lines, source, result)
+    finally:
+        if gc_was_on:
+            gc.enable()
+
+
+def _load_three_line_file(lines: list[str], source: str, result: LoadResult) -> bool:
+    """Load a file made only of (name, line 1, line 2) triples, CelesTrak's usual form, in bulk.
+
+    Returns False, having loaded nothing, when the file is anything else; :func:`_load_lines`
+    then reads it line by line.  The tests below are the ones that line-by-line reading applies
+    to such a file, so both ways give the same sets and rejections.
+    """
+    while lines and not lines[-1].strip():
+        lines = lines[:-1]
+    if not lines or len(lines) % 3:
+        return False
+    names, ones, twos = lines[0::3], [x.rstrip() for x in lines[1::3]], lines[2::3]
+    match = _TLE_LIKE.match
+    if not (all([x.startswith("1 ") and match(x) for x in ones]) and all([x.startswith("2") for x in twos])
+            and all([_could_be_name(x) and not x.startswith("2 ")
+                     and not amsat.is_satellite_line(x) and not _is_csv_header(x) for x in names])):
+        return False
+    pending: list = [(sanitize_element_name(_clean_name(name)), 3 * k + 1, one, two.rstrip())
+                     for k, (name, one, two) in enumerate(zip(names, ones, twos))]
+    _build_tles(pending, source, result)
+    return True
+
+
+def _load_lines(lines: list[str], source: str, result: LoadResult) -> None:
     i = 0
     n = len(lines)
+    pending: list = []  # TLE pairs (and their structural rejections) not yet built, in file order
     while i < n:
         line = lines[i].rstrip()
         if _TLE_LIKE.match(line):
-            i = _take_tle(lines, i, source, result)
+            i = _take_tle(lines, i, source, pending)
             continue
         if amsat.is_satellite_line(line):
+            _build_tles(pending, source, result)
             i = _take_amsat(lines, i, source, result)
             continue
         if _is_csv_header(line):
+            _build_tles(pending, source, result)
             i = _take_csv(lines, i, source, result)
             continue
         i += 1
+    _build_tles(pending, source, result)
 
 
 #: What building a set from hostile values can raise besides TleError (sgp4, float/int conversion).
@@ -185,7 +225,8 @@ def _accept(result: LoadResult, source: str, line: int, prefix: str, build: Call
         result.rejected.append(Rejection(source, line, f"{prefix}these elements cannot be used ({exc})"))
 
 
-def _take_tle(lines: list[str], i: int, source: str, result: LoadResult) -> int:
+def _take_tle(lines: list[str], i: int, source: str, pending: list) -> int:
+    """Queue the TLE pair at ``lines[i]`` (with its name line) or its structural rejection."""
     line1 = lines[i].rstrip()
     name = ""
     start = i + 1
@@ -193,19 +234,57 @@ def _take_tle(lines: list[str], i: int, source: str, result: LoadResult) -> int:
         name = sanitize_element_name(_clean_name(lines[i - 1]))
         start = i
     if not line1.startswith("1 "):
-        result.rejected.append(Rejection(source, i + 1, "TLE line 2 without a preceding line 1"))
+        pending.append(Rejection(source, i + 1, "TLE line 2 without a preceding line 1"))
         return i + 1
     if i + 1 >= len(lines) or not lines[i + 1].startswith("2"):
-        result.rejected.append(Rejection(source, i + 1, "TLE line 1 without a following line 2"))
+        pending.append(Rejection(source, i + 1, "TLE line 1 without a following line 2"))
         return i + 1
-    line2 = lines[i + 1].rstrip()
-
-    def build() -> ElementSet:
-        fields = parse_tle(line1, line2)
-        return ElementSet.from_fields(name, fields, source, start, lines=(line1.rstrip(), line2.rstrip()))
-
-    _accept(result, source, start, f"{name}: " if name else "", build)
+    pending.append((name, start, line1, lines[i + 1].rstrip()))
     return i + 2
+
+
+def _build_tles(pending: list, source: str, result: LoadResult) -> None:
+    """Build the queued TLE sets: canonical ones checked and read in bulk (:mod:`~nfwserver.tracking.tle_bulk`),
+    the rest one by one by :func:`~nfwserver.tracking.tle.parse_tle`, which names what is wrong."""
+    if not pending:
+        return
+    pairs = [p for p in pending if not isinstance(p, Rejection)]
+    good, values = read_canonical([p[2] for p in pairs], [p[3] for p in pairs])
+    rows = zip(*(values[c].tolist() for c in _BULK_COLUMNS)) if values else iter(())
+    good_list = good.tolist()
+    years: dict[int, datetime] = {}
+    k = 0
+    for item in pending:
+        if isinstance(item, Rejection):
+            result.rejected.append(item)
+            continue
+        name, start, line1, line2 = item
+        row = next(rows, None)
+        if good_list[k]:
+            year2, day, cat, inc, raan, ecc, argp, ma, mm, bstar, rev = row
+            base = years.get(year2)
+            if base is None:
+                base = years[year2] = epoch_from_tle(year2, 1.0)
+            try:
+                result.sets.append(ElementSet(
+                    name, cat, line1[9:17].strip(), base + timedelta(days=day - 1.0), inc, raan, ecc, argp, ma, mm,
+                    bstar, rev, line1, line2, Satrec.twoline2rv(line1, line2, WGS72), source, start))
+                k += 1
+                continue
+            except _BAD_VALUE:
+                pass  # parse_tle below gives the reason
+        k += 1
+
+        def build(name: str = name, line1: str = line1, line2: str = line2, start: int = start) -> ElementSet:
+            return ElementSet.from_fields(name, parse_tle(line1, line2), source, start, lines=(line1, line2))
+
+        _accept(result, source, start, f"{name}: " if name else "", build)
+    pending.clear()
+
+
+#: Columns of tle_bulk.read_canonical used to build a set, in ElementSet's field order after the name.
+_BULK_COLUMNS = ("year2", "day", "catalog_number", "inclination", "raan", "eccentricity", "arg_perigee",
+                 "mean_anomaly", "mean_motion", "bstar", "rev_number")
 
 
 def _take_amsat(lines: list[str], i: int, source: str, result: LoadResult) -> int:

@@ -10,14 +10,11 @@ Order of work (every step batched over all satellites of the search):
    TCA is the highest of the refined maxima and the pass's own ends (a pass under a sloping
    horizon may peak at its AOS or LOS).
 
-Times are seconds after ``t0`` (the start of the search span) until :func:`assemble` turns them
-into aware UTC datetimes.
+Times are seconds after the start of the search span; :func:`assemble` hands back columns for a
+:class:`~nfwserver.tracking.pass_records.PassList`, with times in seconds after the window start.
 """
 
 from __future__ import annotations
-
-from dataclasses import dataclass
-from datetime import datetime, timedelta
 
 import numpy as np
 
@@ -27,28 +24,6 @@ from nfwserver.tracking.pass_screen import Brackets
 
 #: Key spacing per satellite when sorting (sat, t) pairs as one float (s; far above any span).
 _KEY = 1e8
-
-
-@dataclass(frozen=True, slots=True)
-class Pass:
-    """One pass of one satellite over the horizon table (slots: catalogs give tens of thousands)."""
-
-    catalog_number: int
-    aos: datetime | None  #: rise above the horizon table (None: earlier than the search reached)
-    tca: datetime  #: maximum elevation
-    los: datetime | None  #: set below the horizon table (None: later than the search reached)
-    max_elevation_deg: float
-    aos_azimuth_deg: float | None
-    los_azimuth_deg: float | None
-    aos_before_start: bool = False  #: the pass was in progress at the window start
-    los_after_end: bool = False  #: the pass is still in progress at the window end
-
-    @property
-    def duration_s(self) -> float | None:
-        """LOS - AOS in seconds, when both are known."""
-        if self.aos is None or self.los is None:
-            return None
-        return (self.los - self.aos).total_seconds()
 
 
 def _events(ev: PairEvaluator, br: Brackets, flat: bool):
@@ -97,9 +72,10 @@ def _pair(sat: np.ndarray, t: np.ndarray, rising: np.ndarray) -> tuple[np.ndarra
     return p_sat, p_rise, p_set
 
 
-def assemble(ev: PairEvaluator, br: Brackets, flat: bool, catalog_numbers: list[int], t0: datetime,
-             span: float, win_lo: float, win_hi: float) -> list[Pass]:
-    """Passes overlapping ``[win_lo, win_hi]`` (s after ``t0``) from the brackets of a search."""
+def assemble(ev: PairEvaluator, br: Brackets, flat: bool, catalog_numbers: np.ndarray, span: float, win_lo: float,
+             win_hi: float) -> dict[str, np.ndarray]:
+    """Passes overlapping ``[win_lo, win_hi]`` (s after the search start) from the brackets of a search,
+    as :class:`~nfwserver.tracking.pass_records.PassList` columns (unsorted)."""
     sat, t, rising, az, el, el_rate, tops = _events(ev, br, flat)
     order = np.lexsort((t, sat))
     sat, t, rising, az, el, el_rate = sat[order], t[order], rising[order], az[order], el[order], el_rate[order]
@@ -109,7 +85,7 @@ def assemble(ev: PairEvaluator, br: Brackets, flat: bool, catalog_numbers: list[
     keep = (hi >= win_lo) & (lo <= win_hi)
     p_sat, p_rise, p_set, lo, hi = p_sat[keep], p_rise[keep], p_set[keep], lo[keep], hi[keep]
     if not len(p_sat):
-        return []
+        return {}
     porder = np.lexsort((lo, p_sat))
     p_sat, p_rise, p_set, lo, hi = p_sat[porder], p_rise[porder], p_set[porder], lo[porder], hi[porder]
     lo_c, hi_c = np.maximum(lo, 0.0), np.minimum(hi, span)
@@ -154,7 +130,7 @@ def assemble(ev: PairEvaluator, br: Brackets, flat: bool, catalog_numbers: list[
     cp, ct, ce = cp[top], ct[top], ce[top]
     better = ce > best_el[cp]
     best_el[cp[better]], best_t[cp[better]] = ce[better], ct[better]
-    return _records(p_sat, p_rise, p_set, t, az, best_t, best_el, catalog_numbers, t0, win_lo, win_hi)
+    return _records(p_sat, p_rise, p_set, t, az, best_t, best_el, catalog_numbers, win_lo)
 
 
 def _owner(p_sat: np.ndarray, lo: np.ndarray, hi: np.ndarray, sat: np.ndarray, a: np.ndarray,
@@ -169,22 +145,12 @@ def _owner(p_sat: np.ndarray, lo: np.ndarray, hi: np.ndarray, sat: np.ndarray, a
     return np.where(ok, i, -1)
 
 
-def _records(p_sat, p_rise, p_set, t, az, tca_t, tca_el, catalog_numbers, t0: datetime, win_lo: float,
-             win_hi: float) -> list[Pass]:
-    passes = []
-    t_list, az_list = t.tolist(), az.tolist()
-    for s, r, st, tc, el in zip(p_sat.tolist(), p_rise.tolist(), p_set.tolist(), tca_t.tolist(), tca_el.tolist()):
-        a = t_list[r] if r >= 0 else None
-        b = t_list[st] if st >= 0 else None
-        passes.append(Pass(
-            catalog_number=catalog_numbers[s],
-            aos=t0 + timedelta(seconds=a) if a is not None else None,
-            tca=t0 + timedelta(seconds=tc),
-            los=t0 + timedelta(seconds=b) if b is not None else None,
-            max_elevation_deg=el,
-            aos_azimuth_deg=az_list[r] if r >= 0 else None,
-            los_azimuth_deg=az_list[st] if st >= 0 else None,
-            aos_before_start=a is None or a < win_lo,
-            los_after_end=b is None or b > win_hi,
-        ))
-    return passes
+def _records(p_sat, p_rise, p_set, t, az, tca_t, tca_el, catalog_numbers: np.ndarray, win_lo: float
+             ) -> dict[str, np.ndarray]:
+    """PassList columns (times in s after the window start, ``win_lo`` after the search start)."""
+    rise, fall = p_rise >= 0, p_set >= 0
+    ri, si = np.maximum(p_rise, 0), np.maximum(p_set, 0)
+    return {"catalog_number": catalog_numbers[p_sat],
+            "aos_s": np.where(rise, t[ri] - win_lo, np.nan), "tca_s": tca_t - win_lo,
+            "los_s": np.where(fall, t[si] - win_lo, np.nan), "max_elevation_deg": tca_el,
+            "aos_azimuth_deg": np.where(rise, az[ri], np.nan), "los_azimuth_deg": np.where(fall, az[si], np.nan)}

@@ -42,7 +42,7 @@ _LEO_RATE = 1.2e-3
 #: Sampling step (s) under a flat horizon for a satellite at ``_LEO_RATE``.
 _FLAT_STEP_S = 1200.0
 #: Sat-time pairs per compiled screen call (bounds the screen's memory).
-_SCREEN_PAIRS = 40_000
+_SCREEN_PAIRS = 10000
 
 
 @dataclass

@@ -37,12 +37,13 @@ from nfwserver.tracking.constants import MINUTES_PER_DAY, SECONDS_PER_DAY
 from nfwserver.tracking.frames import TopocentricFrame
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer
-from nfwserver.tracking.pass_assemble import Pass, assemble
+from nfwserver.tracking.pass_assemble import assemble
 from nfwserver.tracking.pass_kinematics import PairEvaluator
+from nfwserver.tracking.pass_records import Pass, PassList
 from nfwserver.tracking.pass_screen import screen
 from nfwserver.tracking.timescale import julian_date
 
-__all__ = ["Pass", "find_passes"]
+__all__ = ["Pass", "PassList", "find_passes"]
 
 _FLAT = HorizonTable()
 #: Satellites with periods up to this (s) form the low group.
@@ -52,21 +53,17 @@ _SLOW_REV_PER_DAY = 1.5
 #: Coarse grid steps (s) of the three groups: low, geosynchronous-like, the rest.
 _LOW_STEP_S, _SLOW_STEP_S, _OTHER_STEP_S = 1200.0, 3600.0, 1200.0
 #: Satellites searched together (bounds the memory of one search).
-_CHUNK = 600
+_CHUNK = 200
 
 #: Fork-time hand-over of the work to worker processes (Satrec objects cannot be pickled); set only
 #: for the duration of one parallel :func:`find_passes` call.
 _FORK_JOB: tuple | None = None
 
 
-def _fork_worker(indices: list[int]) -> list[Pass]:
+def _fork_worker(indices: list[int]) -> PassList:
     assert _FORK_JOB is not None
     satrecs, args = _FORK_JOB
     return find_passes([satrecs[i] for i in indices], *args)
-
-
-def _sort_key(p: Pass) -> tuple[datetime, int]:
-    return (p.aos or p.tca, p.catalog_number)
 
 
 def find_passes(
@@ -78,10 +75,11 @@ def find_passes(
     ut1_utc: float = 0.0,
     fine_step_s: float = 60.0,
     workers: int = 1,
-) -> list[Pass]:
+) -> PassList:
     """Passes of ``satellites`` (``sgp4`` Satrecs, or objects with a ``.satrec``) between ``start`` and ``end``.
 
-    Returns the passes overlapping the window, sorted by AOS (TCA when AOS is unknown).  See the
+    Returns the passes overlapping the window, sorted by AOS (TCA when AOS is unknown), as a
+    :class:`~nfwserver.tracking.pass_records.PassList` (a read-only sequence of :class:`Pass`).  See the
     module docstring for the method and for passes cut by the window.  ``fine_step_s`` is the
     sampling step for low eccentric orbits and under non-flat horizons; slower satellites are
     sampled proportionally more coarsely.
@@ -104,16 +102,15 @@ def find_passes(
                     parts = pool.map(_fork_worker, chunks)
             finally:
                 _FORK_JOB = None
-            merged = [p for part in parts for p in part]
-            merged.sort(key=_sort_key)
-            return merged
+            return PassList.concat(parts[0].start, parts[0].window_s, parts)
     horizon = horizon or _FLAT
     if start.tzinfo is None:
         start = start.replace(tzinfo=timezone.utc)
     if end.tzinfo is None:
         end = end.replace(tzinfo=timezone.utc)
+    window_s = (end - start).total_seconds()
     if end <= start or not satellites:
-        return []
+        return PassList(start, max(window_s, 0.0))
     satrecs = [getattr(s, "satrec", s) for s in satellites]
     no = np.array([sr.no_kozai for sr in satrecs])  # rad/min
     ecc = np.array([sr.ecco for sr in satrecs])
@@ -122,7 +119,8 @@ def find_passes(
     short = periods <= _SHORT_PERIOD_S
     slow = ~short & (rev_per_day < _SLOW_REV_PER_DAY) & (ecc < 0.05)
     other = ~short & ~slow
-    passes: list[Pass] = []
+    catalog_numbers = np.array([int(sr.satnum) for sr in satrecs], dtype=np.int64)
+    parts: list[dict[str, np.ndarray]] = []
     # The rest is split by period so that each part looks back and ahead only as far as it needs.
     for group, step in ((short, _LOW_STEP_S), (slow, _SLOW_STEP_S), (other & (periods <= 8 * 3600.0), _OTHER_STEP_S),
                         (other & (periods > 8 * 3600.0) & (periods <= 13 * 3600.0), _OTHER_STEP_S),
@@ -132,15 +130,15 @@ def find_passes(
             idx = members[c0 : c0 + _CHUNK]
             look = np.where((ecc[idx] < 0.05) & short[idx], 0.5, 1.0) * periods[idx]
             extension = float(min(np.max(look), SECONDS_PER_DAY))
-            passes += _search([satrecs[i] for i in idx], observer, start, end, horizon, ut1_utc, fine_step_s,
-                              step, extension)
-    passes.sort(key=_sort_key)
-    return passes
+            parts.append(_search([satrecs[i] for i in idx], catalog_numbers[idx], observer, start, end, horizon,
+                                 ut1_utc, fine_step_s, step, extension))
+    return PassList.concat(start, window_s, parts)
 
 
-def _search(satrecs: list, observer: Observer, start: datetime, end: datetime, horizon: HorizonTable,
-            ut1_utc: float, fine_step_s: float, coarse_step_s: float, extension: float) -> list[Pass]:
-    """Passes of one group of satellites searched over ``[start - extension, end + extension]``."""
+def _search(satrecs: list, catalog_numbers: np.ndarray, observer: Observer, start: datetime, end: datetime,
+            horizon: HorizonTable, ut1_utc: float, fine_step_s: float, coarse_step_s: float,
+            extension: float) -> dict[str, np.ndarray]:
+    """Passes (PassList columns) of one group of satellites searched over ``[start - extension, end + extension]``."""
     t0 = start - timedelta(seconds=extension)
     window_s = (end - start).total_seconds()
     span = window_s + 2.0 * extension
@@ -148,5 +146,4 @@ def _search(satrecs: list, observer: Observer, start: datetime, end: datetime, h
     ev = PairEvaluator(satrecs, observer, jd0, fr0, ut1_utc, horizon)
     brackets = screen(satrecs, TopocentricFrame(observer), horizon, jd0, fr0, span, coarse_step_s, fine_step_s,
                       ut1_utc, ev)
-    return assemble(ev, brackets, horizon.is_flat, [int(sr.satnum) for sr in satrecs], t0, span, extension,
-                    extension + window_s)
+    return assemble(ev, brackets, horizon.is_flat, catalog_numbers, span, extension, extension + window_s)
