@@ -260,7 +260,7 @@ def _build_tles(pending: list, source: str, result: LoadResult) -> None:
             continue
         name, start, line1, line2 = item
         row = next(rows, None)
-        if good_list[k]:
+        if good_list[k] and row is not None:
             year2, day, cat, inc, raan, ecc, argp, ma, mm, bstar, rev = row
             base = years.get(year2)
             if base is None:

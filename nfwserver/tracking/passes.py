@@ -99,10 +99,10 @@ def find_passes(
             try:
                 chunks = [list(range(k, len(satrecs_all), workers)) for k in range(workers)]
                 with multiprocessing.get_context("fork").Pool(workers) as pool:
-                    parts = pool.map(_fork_worker, chunks)
+                    worker_parts = pool.map(_fork_worker, chunks)
             finally:
                 _FORK_JOB = None
-            return PassList.concat(parts[0].start, parts[0].window_s, parts)
+            return PassList.concat(worker_parts[0].start, worker_parts[0].window_s, worker_parts)
     horizon = horizon or _FLAT
     if start.tzinfo is None:
         start = start.replace(tzinfo=timezone.utc)

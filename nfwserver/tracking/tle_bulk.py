@@ -25,7 +25,7 @@ _ALPHA5[np.frombuffer(b"ABCDEFGHJKLMNPQRSTUVWXYZ", dtype=np.uint8)] = np.arange(
 def _digits(a: np.ndarray, lo: int, hi: int) -> tuple[np.ndarray, np.ndarray]:
     """(all digits?, integer value) of columns ``lo:hi``."""
     d = a[:, lo:hi].astype(np.int64) - 48
-    ok = ((d >= 0) & (d <= 9)).all(axis=1)
+    ok = np.asarray(((d >= 0) & (d <= 9)).all(axis=1))
     return ok, (d * 10 ** np.arange(hi - lo - 1, -1, -1, dtype=np.int64)).sum(axis=1)
 
 
