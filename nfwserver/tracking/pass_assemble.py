@@ -2,11 +2,12 @@
 
 Order of work (every step batched over all satellites of the search):
 
-1. crossings and hidden peaks are refined together (:func:`nfwserver.tracking.pass_refine.solve`);
+1. crossings, hidden peaks and culminations are refined together
+   (:func:`nfwserver.tracking.pass_refine.solve`);
 2. hidden peaks that rise above the horizon give two more crossings each, refined next;
 3. rises and sets are paired per satellite (a set with no rise before it in the search is a
    pass whose AOS lies before the search span, a final rise one whose LOS lies after it);
-4. passes overlapping the window keep their culmination brackets; those are refined, and the
+4. passes overlapping the window keep the maxima refined in their culmination brackets; the
    TCA is the highest of the refined maxima and the pass's own ends (a pass under a sloping
    horizon may peak at its AOS or LOS).
 
@@ -28,12 +29,16 @@ _KEY = 1e8
 
 def _events(ev: PairEvaluator, br: Brackets, flat: bool):
     """Refined crossings (sat, t, rising, az, el, el rate) and the maxima of the hidden peaks that rose."""
-    cr, pk = br.crossings, br.peaks
-    nc = len(cr)
-    kind = np.concatenate((np.full(nc, CROSSING), np.full(len(pk), TOP if flat else F_TOP)))
-    sol = solve(ev, np.concatenate((cr.sat, pk.sat)), np.concatenate((cr.a, pk.a)), np.concatenate((cr.b, pk.b)),
-                np.concatenate((cr.ga, pk.ga)), np.concatenate((cr.gb, pk.gb)), kind,
-                np.concatenate((np.zeros(nc, dtype=bool), np.ones(len(pk), dtype=bool))))
+    cr, pk, cu = br.crossings, br.peaks, br.culminations
+    nc, npk = len(cr), len(pk)
+    kind = np.concatenate((np.full(nc, CROSSING), np.full(npk, TOP if flat else F_TOP), np.full(len(cu), TOP)))
+    sat_, a, b, ga, gb = (np.concatenate((getattr(cr, x), getattr(pk, x), getattr(cu, x)))
+                          for x in ("sat", "a", "b", "ga", "gb"))
+    sol = solve(ev, sat_, a, b, ga, gb, kind,
+                np.concatenate((np.zeros(nc, dtype=bool), np.ones(npk, dtype=bool), np.zeros(len(cu), dtype=bool))))
+    culminations = (sol.t[nc + npk:], sol.el[nc + npk:])
+    sol.best_f, sol.best_t, sol.t, sol.el, sol.f_accel = (x[: nc + npk] for x in (
+        sol.best_f, sol.best_t, sol.t, sol.el, sol.f_accel))
     sat, t, rising = cr.sat, sol.t[:nc], cr.ga <= 0.0
     az, el, el_rate = sol.az[:nc], sol.el[:nc], sol.el_rate[:nc]
     up = np.flatnonzero(sol.best_f[nc:] > 0.0)
@@ -41,9 +46,13 @@ def _events(ev: PairEvaluator, br: Brackets, flat: bool):
     if len(up):
         ps, top_t, f_top = pk.sat[up], sol.best_t[nc:][up], sol.best_f[nc:][up]
         m = len(up)
+        # First guesses from the parabola through the top: f_top + f''/2 dt^2 = 0.
+        with np.errstate(invalid="ignore", divide="ignore"):
+            half = np.sqrt(2.0 * f_top / -sol.f_accel[nc:][up])
         s2 = solve(ev, np.concatenate((ps, ps)), np.concatenate((pk.a[up], top_t)),
                    np.concatenate((top_t, pk.b[up])), np.concatenate((np.full(m, -1.0), f_top)),
-                   np.concatenate((f_top, np.full(m, -1.0))), np.full(2 * m, CROSSING))
+                   np.concatenate((f_top, np.full(m, -1.0))), np.full(2 * m, CROSSING),
+                   guess=np.concatenate((top_t - half, top_t + half)))
         sat = np.concatenate((sat, ps, ps))
         t = np.concatenate((t, s2.t))
         rising = np.concatenate((rising, np.ones(m, dtype=bool), np.zeros(m, dtype=bool)))
@@ -52,7 +61,7 @@ def _events(ev: PairEvaluator, br: Brackets, flat: bool):
         el_rate = np.concatenate((el_rate, s2.el_rate))
     if not flat:
         tops = (tops[0][:0], tops[1][:0], tops[2][:0])  # f's maximum is not the elevation's
-    return sat, t, rising, az, el, el_rate, tops
+    return sat, t, rising, az, el, el_rate, tops, culminations
 
 
 def _pair(sat: np.ndarray, t: np.ndarray, rising: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -76,7 +85,7 @@ def assemble(ev: PairEvaluator, br: Brackets, flat: bool, catalog_numbers: np.nd
              win_hi: float) -> dict[str, np.ndarray]:
     """Passes overlapping ``[win_lo, win_hi]`` (s after the search start) from the brackets of a search,
     as :class:`~nfwserver.tracking.pass_records.PassList` columns (unsorted)."""
-    sat, t, rising, az, el, el_rate, tops = _events(ev, br, flat)
+    sat, t, rising, az, el, el_rate, tops, (cu_t, cu_el) = _events(ev, br, flat)
     order = np.lexsort((t, sat))
     sat, t, rising, az, el, el_rate = sat[order], t[order], rising[order], az[order], el[order], el_rate[order]
     p_sat, p_rise, p_set = _pair(sat, t, rising)
@@ -102,8 +111,7 @@ def assemble(ev: PairEvaluator, br: Brackets, flat: bool, catalog_numbers: np.nd
     owner = _owner(p_sat, lo_c, hi_c, cu.sat, cu.a, cu.b)
     cand_pass = [owner[owner >= 0]]
     sel = owner >= 0
-    s1 = solve(ev, cu.sat[sel], cu.a[sel], cu.b[sel], cu.ga[sel], cu.gb[sel], np.full(int(sel.sum()), TOP))
-    cand_t, cand_el = [s1.t], [s1.el]
+    cand_t, cand_el = [cu_t[sel]], [cu_el[sel]]
     tp = _owner(p_sat, lo_c, hi_c, tops[0], tops[1], tops[1])
     cand_pass.append(tp[tp >= 0])
     cand_t.append(tops[1][tp >= 0])

@@ -39,6 +39,8 @@ class Kinematics:
     f_accel: np.ndarray
     s_rate: np.ndarray
     s_accel: np.ndarray
+    az_rate: np.ndarray  #: d(azimuth)/dt (deg/s)
+    el_accel: np.ndarray  #: d2(elevation)/dt2 (deg/s^2)
 
 
 class PairEvaluator:
@@ -88,7 +90,7 @@ class PairEvaluator:
         """Angles and derivatives at each pair (``sat`` intp, ``t`` float seconds; see :meth:`teme`)."""
         if not len(sat):
             empty = np.empty(0)
-            return Kinematics(*(empty for _ in range(8)))
+            return Kinematics(*(empty for _ in range(10)))
         r, v, err = self.teme(sat, t, grouped)
         fr = self.fr0 + t / SECONDS_PER_DAY
         pos, vel = teme_to_itrs(r, v, self.jd0, fr, self.ut1_utc)
@@ -136,6 +138,6 @@ def topocentric_derivatives(frame: TopocentricFrame, horizon: HorizonTable, pos:
     bad = err != 0
     if bad.any():
         f[bad] = -np.inf
-        for a in (el, el1, f_rate, f_accel, s1, s2):
+        for a in (el, el1, el2, f_rate, f_accel, s1, s2, az1):
             a[bad] = np.nan
-    return Kinematics(el, az, el1 * _DEG, f, f_rate, f_accel, s1, s2)
+    return Kinematics(el, az, el1 * _DEG, f, f_rate, f_accel, s1, s2, az1 * _DEG, el2 * _DEG)

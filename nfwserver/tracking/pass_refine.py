@@ -10,7 +10,10 @@ One solver serves three problems, mixed freely in one batch:
 Each round evaluates every unfinished bracket at once (:class:`PairEvaluator`: one compiled
 SGP4 call per satellite), takes a Newton step with the analytic derivative, and falls back to
 bisection when the step would leave the bracket (or, for a maximum, when the curvature has the
-wrong sign).  A bracket is finished when its Newton step is below the tolerance or its width is;
+wrong sign).  A bracket is finished when its Newton step is below the tolerance or its width is,
+or when the step is small and the error quadratic convergence predicts for it (from the analytic
+f'' of a crossing, or the steps seen so far towards a maximum) is far below the tolerance: the
+root is then the Newton step's end, with the values there from a second-order Taylor series;
 finished brackets leave the batch, so the hard ones (grazing passes, long high passes) iterate
 as long as they need without slowing the rest.  Hidden-peak brackets are also dropped as soon as
 a local quadratic model shows the peak stays more than 2 degrees below the horizon.
@@ -30,6 +33,13 @@ CROSSING, TOP, F_TOP = 0, 1, 2
 CROSSING_TOL_S = 1e-4
 TOP_TOL_S = 1e-3
 _MAX_ROUNDS = 80
+#: A Newton step is taken as final when it is below this (s) and the error its quadratic
+#: convergence predicts for it is below ``_SAFETY`` times the tolerance.
+_QUADRATIC_S = 2.0
+_SAFETY = 0.01
+#: Largest accepted final Newton step (s) towards a maximum (the elevation there comes from a
+#: second-order Taylor series of sin(elevation), exact to ~1e-9 over such a step).
+_TOP_STEP_S = 0.05
 #: A hidden peak whose modelled height stays this far below the horizon (deg) is given up.
 _HOPELESS_DEG = -2.0
 
@@ -45,14 +55,16 @@ class Solution:
     el_rate: np.ndarray  #: d(elevation)/dt at ``t`` (deg/s)
     best_f: np.ndarray  #: the largest f seen while iterating (deg)
     best_t: np.ndarray  #: where it was seen (s)
+    f_accel: np.ndarray  #: d2f/dt2 at ``t`` (deg/s^2)
     rounds: int  #: iterations the slowest bracket needed
 
 
 def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: np.ndarray, gb: np.ndarray,
-          kind: np.ndarray, hidden: np.ndarray | None = None) -> Solution:
+          kind: np.ndarray, hidden: np.ndarray | None = None, guess: np.ndarray | None = None) -> Solution:
     """Refine brackets ``[a, b]`` of satellites ``sat``; ``ga``/``gb`` hold the sign-carrying values at
     the ends (f for crossings, the rising/falling rate for maxima).  ``hidden`` marks hidden-peak
-    brackets, which may be abandoned early."""
+    brackets, which may be abandoned early; ``guess`` holds first guesses (NaN: none), else the
+    secant of the end values is the first guess."""
     n = len(sat)
     # Work in satellite order, so every round's batch is already grouped by satellite.
     perm = np.argsort(sat, kind="stable")
@@ -61,6 +73,7 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
     sat, kind = sat[perm], kind[perm]
     a, b, ga, gb = a[perm], b[perm], ga[perm], gb[perm]
     hidden = None if hidden is None else hidden[perm]
+    guess = None if guess is None else guess[perm]
     a, b = a.astype(float).copy(), b.astype(float).copy()
     ga = np.nan_to_num(ga.astype(float), nan=0.0, neginf=-180.0, posinf=180.0)
     gb = np.nan_to_num(gb.astype(float), nan=0.0, neginf=-180.0, posinf=180.0)
@@ -68,14 +81,18 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
     tol = np.where(kind == CROSSING, CROSSING_TOL_S, TOP_TOL_S)
     with np.errstate(invalid="ignore", divide="ignore"):
         c = np.where(gb != ga, (a * gb - b * ga) / (gb - ga), 0.5 * (a + b))
+    if guess is not None:
+        c = np.where(np.isfinite(guess), guess, c)
     c = np.where(np.isfinite(c), np.clip(c, np.minimum(a, b), np.maximum(a, b)), 0.5 * (a + b))
     t_out = c.copy()
     el_out = np.full(n, np.nan)
     az_out = np.full(n, np.nan)
     f_out = np.full(n, -np.inf)
     el_rate_out = np.full(n, np.nan)
+    f_accel_out = np.full(n, np.nan)
     best_f = np.full(n, -np.inf)
     best_t = c.copy()
+    prev_step = np.full(n, np.inf)  # the previous round's Newton step (inf after a bisection)
     active = np.arange(n)
     rounds = 0
     while len(active) and rounds < _MAX_ROUNDS:
@@ -88,6 +105,7 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
         g1 = np.where(kd == CROSSING, k.f_rate, np.where(kd == TOP, k.s_accel, k.f_accel))
         el_out[active], az_out[active], f_out[active], t_out[active] = k.el, k.az, f, ca
         el_rate_out[active] = k.el_rate
+        f_accel_out[active] = k.f_accel
         better = f > best_f[active]
         best_f[active] = np.where(better, f, best_f[active])
         best_t[active] = np.where(better, ca, best_t[active])
@@ -103,7 +121,30 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
         ok = np.isfinite(newton) & (newton > lo) & (newton < hi) & ((kd == CROSSING) | (g1 < 0.0))
         step = np.abs(newton - ca)
         tl = tol[active]
-        done = (ok & (step < tl)) | (hi - lo < tl) | (g == 0.0) | ~np.isfinite(g)
+        # Newton's error after this step is ~C step^2: C = |f''/2f'| for a crossing (analytic), and
+        # step / previous step^2 as observed for any kind once two Newton steps were taken.
+        ps = prev_step[active]
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            c_seen = np.where(kd == CROSSING, np.abs(k.f_accel / (2.0 * k.f_rate)), step / (ps * ps))
+        predicted = c_seen * step * step
+        cross = kd == CROSSING
+        close = ok & (step < np.where(cross, _QUADRATIC_S, _TOP_STEP_S)) & (predicted < _SAFETY * tl) & (
+            cross | ((kd == TOP) & (step < 0.25 * ps)))
+        done = (ok & (step < tl)) | close | (hi - lo < tl) | (g == 0.0) | ~np.isfinite(g)
+        if close.any():  # the values at the accepted root, carried over from ``ca`` by Taylor's formula
+            dt = np.where(close, newton - ca, 0.0)
+            sel = active[close]
+            el_cross = k.el + (k.el_rate + 0.5 * k.el_accel * dt) * dt
+            s_top = np.sin(np.radians(k.el)) + (k.s_rate + 0.5 * k.s_accel * dt) * dt
+            el_top = np.degrees(np.arcsin(np.clip(s_top, -1.0, 1.0)))
+            el_out[sel] = np.where(kd == CROSSING, el_cross, np.maximum(el_top, k.el))[close]
+            az_out[sel] = ((k.az + k.az_rate * dt) % 360.0)[close]
+            f_out[sel] = np.where(kd[close] == CROSSING, 0.0, f[close] + el_out[sel] - k.el[close])
+            el_rate_out[sel] = (k.el_rate + k.el_accel * dt)[close]
+            up = f_out[sel] > best_f[sel]
+            best_f[sel[up]] = f_out[sel[up]]
+            best_t[sel[up]] = newton[close][up]
+        prev_step[active] = np.where(ok, step, np.inf)
         t_out[active] = np.where(ok & done, newton, ca)
         hid = hidden[active]
         if hid.any():
@@ -113,4 +154,4 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
         c[active] = np.where(ok, newton, 0.5 * (lo + hi))
         active = active[~done]
     return Solution(t_out[undo], el_out[undo], az_out[undo], f_out[undo], el_rate_out[undo], best_f[undo],
-                    best_t[undo], rounds)
+                    best_t[undo], f_accel_out[undo], rounds)
