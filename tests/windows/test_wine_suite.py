@@ -23,6 +23,7 @@ from pathlib import Path
 
 import pytest
 
+from nfwserver.dde.post_advise_stats import parse_summary
 from tests.windows.station_config import write_station_config
 
 ROOT = Path(__file__).resolve().parent.parent.parent
@@ -97,6 +98,9 @@ def test_launcher_station_serves_20_clients_at_10_hz_for_60_s_and_disconnects_th
                 proc.kill()
     assert station.returncode == 0, stderr[-3000:]
     assert "serving real DDE (DDEML)" in stderr
+    # The station logged its DDEML cost when it stopped: one DdePostAdvise per tick, most at 20 links.
+    cost = parse_summary((tmp_path / "station.log").read_text(encoding="utf-8", errors="replace"))
+    assert cost is not None and cost["links"] == 20 and cost["steady_count"] >= 300, cost
     results = [r for out in outs for r in json.loads(out.read_text())]
     assert len(results) == 20 and all(r["error"] is None for r in results), results
     assert sorted(r["service"] for r in results) == ["NFW32"] * 10 + ["NFW_SERVER"] * 10
