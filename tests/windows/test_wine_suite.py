@@ -149,6 +149,15 @@ def test_wine_md_windows_rotor_client_and_station_radio_reach_linux_hamlib(tmp_p
     sat = EarthSatellite(active[at], active[at + 1], ts=ts)
     alt, azimuth, _ = (sat - wgs84.latlon(20.0, -12.0, 0.0)).at(ts.now()).altaz()
     assert abs(el - alt.degrees) < 0.3 and abs(az - azimuth.degrees) < 0.3, (az, el, azimuth.degrees, alt.degrees)
-    pos = [float(v) for v in rotctld.query("p", lines=2)]
-    assert abs(pos[0] - az) < 0.11 and abs(pos[1] - el) < 0.11  # the Linux rotor points where DDE said
+    # The Linux rotor points where DDE said.  rotctld's dummy rotor slews at 6 deg/s from 0/0 (Hamlib's
+    # rot_dummy.c), so reaching AZ 180 takes 30 s after the client's P: wait for it (up to 60 s).
+    import time
+
+    deadline = time.monotonic() + 60
+    while True:
+        pos = [float(v) for v in rotctld.query("p", lines=2)]
+        if (abs(pos[0] - az) < 0.11 and abs(pos[1] - el) < 0.11) or time.monotonic() > deadline:
+            break
+        time.sleep(0.5)
+    assert abs(pos[0] - az) < 0.11 and abs(pos[1] - el) < 0.11, (pos, az, el)
     assert abs(radio_hz - 1_537_700_000) < 1_537_700_000 * 1 / 299792.458  # tuned: within 1 km/s of Doppler
