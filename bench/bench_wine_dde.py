@@ -29,6 +29,7 @@ from pathlib import Path
 
 from nfwserver.dde.post_advise_stats import parse_summary
 from tests.windows.station_config import write_station_config
+from tests.windows.wine_session import kill_session
 
 ROOT = Path(__file__).resolve().parent.parent
 WINE = ROOT / "tools" / "wine"
@@ -76,7 +77,8 @@ def run_case(conversations: int, window_s: float, work: Path) -> CaseResult:
     station = subprocess.Popen(
         [str(WINE / "nfwserver"), "run", "--headless", "--config", winpath(config), "--log-file", winpath(log),
          "--duration", f"{budget + window_s + linger:.0f}"],
-        cwd=ROOT, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env)
+        cwd=ROOT, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env,
+        start_new_session=True)
     outs = [case / f"clients{i}.json" for i in range(programs)]
     clients = []
     for i, out in enumerate(outs):
@@ -85,7 +87,8 @@ def run_case(conversations: int, window_s: float, work: Path) -> CaseResult:
             [str(WINE / "run"), "python", winpath(ROOT / "tests" / "windows" / "dde_clients.py"),
              "--clients", str(count), "--seconds", str(window_s), "--start-at", f"{start_at:.3f}",
              "--connect-timeout", f"{budget:.0f}", "--wait-disconnect", f"{linger + 60:.0f}", "--out", winpath(out)],
-            cwd=ROOT, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env))
+            cwd=ROOT, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env,
+            start_new_session=True))
         time.sleep(0.2)  # a little apart: many Wine processes starting at the same instant crowd wineserver
     load = 0.0
     try:
@@ -95,9 +98,8 @@ def run_case(conversations: int, window_s: float, work: Path) -> CaseResult:
             client.wait(timeout=budget + window_s + linger + 120)
         _, stderr = station.communicate(timeout=120)
     finally:
-        for proc in (*clients, station):
-            if proc.poll() is None:
-                proc.kill()
+        for proc in (*clients, station):  # on failure: the launchers and the Windows programs under them
+            kill_session(proc)
     failures, rates = [], []
     if station.returncode != 0:
         failures.append(f"station exit {station.returncode}: {stderr[-500:]}")

@@ -25,6 +25,7 @@ import pytest
 
 from nfwserver.dde.post_advise_stats import parse_summary
 from tests.windows.station_config import write_station_config
+from tests.windows.wine_session import kill_session
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 WINE = ROOT / "tools" / "wine"
@@ -55,10 +56,12 @@ def wine_run(*args: str, timeout: float) -> subprocess.CompletedProcess[str]:
 
 
 def start_station(config: Path, duration_s: float, log: Path) -> subprocess.Popen[str]:
+    """The station in a session of its own, so that :func:`kill_session` ends python.exe too."""
     return subprocess.Popen(
         [str(WINE / "nfwserver"), "run", "--headless", "--config", winpath(config), "--log-file", winpath(log),
          "--duration", str(duration_s)],
         cwd=ROOT, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        start_new_session=True,
     )
 
 
@@ -87,15 +90,14 @@ def test_launcher_station_serves_20_clients_at_10_hz_for_60_s_and_disconnects_th
         [str(WINE / "run"), "python", winpath(ROOT / "tests" / "windows" / "dde_clients.py"), "--clients", "2",
          "--seconds", "60", "--wait-disconnect", "45", "--out", winpath(out)],
         cwd=ROOT, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-        env={**os.environ, "NFW_WINE_TIMEOUT": "200"}) for out in outs]
+        env={**os.environ, "NFW_WINE_TIMEOUT": "200"}, start_new_session=True) for out in outs]
     try:
         for program in programs:
             program.communicate(timeout=220)
         stdout, stderr = station.communicate(timeout=60)
     finally:
         for proc in (*programs, station):
-            if proc.poll() is None:
-                proc.kill()
+            kill_session(proc)
     assert station.returncode == 0, stderr[-3000:]
     assert "serving real DDE (DDEML)" in stderr
     # The station logged its DDEML cost when it stopped: one DdePostAdvise per tick, most at 20 links.
@@ -135,8 +137,7 @@ def test_wine_md_windows_rotor_client_and_station_radio_reach_linux_hamlib(tmp_p
         assert client.returncode == 0 and out.exists(), client.stdout[-2000:] + client.stderr[-2000:]
         radio_hz = int(rigctld.query("f")[0])
     finally:
-        station.kill()
-        station.wait(30)
+        kill_session(station)
     result = json.loads(out.read_text())
     match = re.search(r" AZ:(\S+) EL:(\S+) ", result["last"])
     assert match and re.match(NOVA, result["last"])
