@@ -1,9 +1,10 @@
 """Run every ``bench/bench_*.py`` and write their Markdown sections to ``docs/BENCHMARKS.md``.
 
 Usage: ``python -m bench [NAME ...]`` (names without the ``bench_`` prefix select a subset; the
-file is then updated only for those sections).  Each benchmark module is run as its own process
-(``python -m bench.bench_NAME``) and prints one Markdown section, starting with a ``## `` heading,
-on stdout.
+file is then updated only for those sections; ``-`` and ``_`` are the same in names).  Each benchmark
+module is run as its own process (``python -m bench.bench_NAME``) and prints one Markdown section,
+starting with a ``## `` heading, on stdout; a benchmark that prints nothing leaves its section as it was.
+Benchmarks in ``OPT_IN`` run only when named: ``wine-dde`` needs a Wine prefix (tools/wine/setup).
 """
 
 from __future__ import annotations
@@ -18,7 +19,9 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs" / "BENCHMARKS.md"
-HEADER = "# Benchmarks\n\nRegenerate with `python -m bench` (a subset: `python -m bench NAME ...`).\n"
+OPT_IN = ("wine_dde",)  #: run only when named
+HEADER = ("# Benchmarks\n\nRegenerate with `python -m bench` (a subset: `python -m bench NAME ...`; the Wine "
+          "section: `NFW_WINE_HOME=... python -m bench wine-dde`).\n")
 
 
 def _machine() -> str:
@@ -38,7 +41,7 @@ def _sections(text: str) -> dict[str, str]:
 
 def main(argv: list[str]) -> int:
     names = sorted(p.stem[len("bench_") :] for p in (ROOT / "bench").glob("bench_*.py"))
-    chosen = argv or names
+    chosen = [name.replace("-", "_") for name in argv] or [n for n in names if n not in OPT_IN]
     unknown = [n for n in chosen if n not in names]
     if unknown:
         print(f"unknown benchmark(s): {', '.join(unknown)}; have: {', '.join(names)}", file=sys.stderr)
@@ -47,15 +50,16 @@ def main(argv: list[str]) -> int:
     for name in chosen:
         print(f"running bench_{name} ...", file=sys.stderr)
         started = time.monotonic()
-        proc = subprocess.run(
-            [sys.executable, "-m", f"bench.bench_{name}"], cwd=ROOT, capture_output=True, text=True
+        proc = subprocess.run(  # its stderr (progress, failures) goes straight to ours
+            [sys.executable, "-m", f"bench.bench_{name}"], cwd=ROOT, stdout=subprocess.PIPE, text=True
         )
         if proc.returncode != 0:
-            sys.stderr.write(proc.stderr)
             print(f"bench_{name} failed (exit {proc.returncode})", file=sys.stderr)
             return 1
-        for heading, body in _sections(proc.stdout).items():
-            old[heading] = body
+        sections = _sections(proc.stdout)
+        if not sections:
+            print(f"  bench_{name} printed no section: its section is kept as it was", file=sys.stderr)
+        old.update(sections)
         print(f"  done in {time.monotonic() - started:.1f} s", file=sys.stderr)
     stamp = time.strftime("%Y-%m-%d", time.gmtime())
     text = HEADER + f"\nLast run {stamp}. {_machine()}\n\n" + "\n".join(old[h] for h in sorted(old))

@@ -27,33 +27,15 @@ import sys
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 
 from nfwserver.dde import ddeml
 from nfwserver.dde.ddeml_dispatch import DdemlDispatcher
+from nfwserver.dde.post_advise_stats import PostAdviseStats
 from nfwserver.dde.transport import DdeServerHandler
 
 log = logging.getLogger(__name__)
 
 _WAKE = ddeml.WM_APP + 0x4E
-
-
-@dataclass
-class PostAdviseStats:
-    """Wall time of ``DdePostAdvise`` calls (s): DDEML runs our ``XTYP_ADVREQ`` for every loop inside it."""
-
-    count: int = 0
-    total_s: float = 0.0
-    max_s: float = 0.0
-
-    def add(self, seconds: float) -> None:
-        self.count += 1
-        self.total_s += seconds
-        self.max_s = max(self.max_s, seconds)
-
-    @property
-    def mean_s(self) -> float:
-        return self.total_s / self.count if self.count else 0.0
 
 
 class _User32Api:  # pragma: no cover - Windows only
@@ -236,14 +218,15 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
     def post_advise(self, topic: str, item: str) -> None:
         def do() -> None:
             start = time.perf_counter()
-            if self._wine_atoms and self._dispatcher is not None:
+            links = self._dispatcher.advise_links(item) if self._dispatcher is not None else 0
+            if self._wine_atoms:
                 # Wine's DdePostAdvise takes one reference on the item's global atom for all the
                 # WM_DDE_DATA it posts, while every client releases one: after the first client the
                 # atom is gone and the others drop their data.  Add the references Windows would.
-                for _ in range(self._dispatcher.advise_links(item) - 1):
+                for _ in range(links - 1):
                     self._kernel32.GlobalAddAtomW(item)
             ok = self.u.DdePostAdvise(self.inst, self._string(topic), self._string(item))
-            self.post_advise_stats.add(time.perf_counter() - start)
+            self.post_advise_stats.add(time.perf_counter() - start, links)
             if not ok:
                 err = self.u.DdeGetLastError(self.inst)
                 raise OSError(f"DdePostAdvise {topic}/{item} failed with DMLERR 0x{err:04X}")
@@ -259,3 +242,4 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
 
         self._call(do, wait=False)
         self._thread.join(5.0)
+        log.info("%s", self.post_advise_stats.summary())  # the DDE thread has stopped adding

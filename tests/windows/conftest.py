@@ -7,8 +7,12 @@ from __future__ import annotations
 
 import re
 import sys
+from collections.abc import Callable
+from typing import TypeVar
 
 import pytest
+
+T = TypeVar("T")
 
 #: Nova's DDE string, from the spec's own words: name, AZ/EL one decimal, RR ten decimals, AH Y/N.
 NOVA = re.compile(r"^\S{1,12} AZ:\d{1,3}\.\d EL:-?\d{1,2}\.\d RR:-?\d+\.\d{10} AH:[YN]$")
@@ -39,6 +43,28 @@ def request_after_refusal(client, conv: int, item: str) -> str:
         if wine_version() is None:
             raise
         return client.request_text(conv, item)
+
+
+def on_linked_item(client, transaction: Callable[[], T], tries: int = 3) -> T:
+    """Run ``transaction()``: a poke or request on an item the same conversation holds a warm advise
+    link on.  Wine 8.0's client DDEML may take the link's own ``WM_DDE_DATA`` notification (no data),
+    when it arrives while the transaction waits, for the transaction's answer: a poke then reports
+    result 0 though the server acknowledged it (``WDML_HandlePokeReply`` in Wine's ``dde_client.c``
+    tests ``!= WM_DDE_ACK && wrong window`` where ``||`` is meant, and the item matches), a request
+    gets a NULL handle (docs/PLATFORMS.md).  Under Wine a transaction reported refused is run again
+    once the late answer has been dispatched, up to ``tries`` times, each try needing a proper
+    answer; on Windows the first answer counts."""
+    from nfwserver.dde.ddeml_client import DdeRefused
+
+    attempts = tries if wine_version() is not None else 1
+    for attempt in range(attempts):
+        try:
+            return transaction()
+        except DdeRefused:
+            if attempt == attempts - 1:
+                raise
+            client.pump(0.2)  # the real answer arrives now, with no transaction waiting for it
+    raise AssertionError("unreachable")
 
 
 @pytest.fixture(scope="session")

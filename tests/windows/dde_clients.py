@@ -1,13 +1,16 @@
 """A Windows program: N real DDEML clients holding hot advise loops on a running station.
 
-``python dde_clients.py --clients 20 --seconds 60 --out FILE [--wait-disconnect 40]``
+``python dde_clients.py --clients 20 --seconds 60 --out FILE [--wait-disconnect 40] [--start-at EPOCH]``
 
 Each client is a conversation of its own (the server sees N clients): half connect to ``NFW32``,
 half to ``NFW_SERVER`` (retrying while the station starts), poke ``TUNE ON`` and start a hot
 advise loop on ``NFW_SERVER``.  They share one DDEML instance on this program's one thread:
 Wine 8.0's DDEML finds instances by thread, so several instances on one thread misroute their
 callbacks, and many threads connecting at once lose conversations (docs/PLATFORMS.md).
-The strings delivered during a common window of ``--seconds`` are counted per conversation.
+The strings delivered during a common window of ``--seconds`` are counted per conversation; the
+window starts once every conversation is up, or with ``--start-at`` at that wall-clock time (Unix
+seconds, shared by several programs: ``python -m bench wine-dde``; ``late`` says a program was not
+connected by then and started its window late).
 With ``--wait-disconnect`` the program then waits until the station ends every conversation
 (``XTYP_DISCONNECT``).  Results go to ``--out`` as JSON, one record per client.
 """
@@ -47,6 +50,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seconds", type=float, default=60.0)
     parser.add_argument("--connect-timeout", type=float, default=60.0)
     parser.add_argument("--wait-disconnect", type=float, default=0.0)
+    parser.add_argument("--start-at", type=float, default=0.0, help="window start, Unix seconds")
     parser.add_argument("--out", required=True)
     args = parser.parse_args(argv)
     records = [{"client": i, "service": SERVICES[i % 2], "error": None} for i in range(args.clients)]
@@ -62,6 +66,9 @@ def main(argv: list[str] | None = None) -> int:
         Path(args.out).write_text(json.dumps(records, indent=1))
         return 1
     pump = clients[0].pump  # one thread: pumping dispatches every instance's messages
+    late = time.time() > args.start_at if args.start_at else False
+    if args.start_at and not late:
+        pump(args.start_at - time.time())
     start_counts = [c.advise_counts[v] for c, v in zip(clients, convs)]
     shared.received.clear()
     start = time.monotonic()
@@ -70,6 +77,7 @@ def main(argv: list[str] | None = None) -> int:
     for record, c, conv, n0 in zip(records, clients, convs, start_counts):
         record["advise"] = c.advise_counts[conv] - n0
         record["window_s"] = window
+        record["late"] = late
         record["still_connected"] = conv not in c.disconnected
         data = [d for _, d in c.received if d]
         record["sample"] = data[-1].split(b"\x00")[0].decode("cp1252") if data else ""

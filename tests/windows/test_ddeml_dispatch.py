@@ -124,3 +124,36 @@ def test_execute_command_conversion() -> None:
     assert execute_command(b"T\x00") in (b"T\x00",)  # one ANSI character reads the same either way
     assert execute_command("TUNE ON".encode("utf-16-le") + b"\x00\x00", unicode_instance=False) \
         == "TUNE ON".encode("utf-16-le") + b"\x00\x00"
+
+
+def test_post_advise_stats_line_counts_links_like_ddeml_and_reads_back() -> None:
+    """The station's stop line: every DdePostAdvise call, and the calls at the usual link count,
+    whose link count is the dispatcher's (the links DDEML holds after ADVSTART/ADVSTOP/DISCONNECT)."""
+    from nfwserver.dde.post_advise_stats import PostAdviseStats, parse_summary
+
+    server, api, dispatch = _setup()
+    topic, item = api.hsz("NFW_DATA"), api.hsz("nfw_server")
+    for hconv in (77, 78, 79):
+        assert _connect(api, dispatch, hconv=hconv)
+        assert dispatch(ddeml.XTYP_ADVSTART, CF_TEXT, hconv, topic, item, 0) == 1
+    dispatch(ddeml.XTYP_ADVSTART, CF_TEXT, 77, topic, item, 0)  # a restart keeps one link
+    assert dispatch.advise_links("NFW_SERVER") == 3 and dispatch.advise_links("OTHER") == 0
+    stats = PostAdviseStats()
+    assert parse_summary(stats.summary()) == {"count": 0, "mean_ms": 0.0, "max_ms": 0.0}
+    for seconds in (0.002, 0.004, 0.003):
+        stats.add(seconds, dispatch.advise_links("NFW_SERVER"))
+    dispatch(ddeml.XTYP_ADVSTOP, CF_TEXT, 78, topic, item, 0)
+    dispatch(ddeml.XTYP_DISCONNECT, 0, 79, 0, 0, 0)
+    assert dispatch.advise_links("NFW_SERVER") == 1
+    stats.add(0.011, dispatch.advise_links("NFW_SERVER"))
+    stats.add(0.001, dispatch.advise_links("NFW_DATA"))  # the station posts every item, linked or not
+    stats.add(0.003, dispatch.advise_links("NFW_DATA"))
+    line = stats.summary()
+    assert line == ("DdePostAdvise: 6 calls, mean 4.000 ms, max 11.000 ms; "
+                    "at 3 advise links (3 calls): mean 3.000 ms, max 4.000 ms; "
+                    "at no link (2 calls): mean 2.000 ms, max 3.000 ms")
+    log = f"INFO other\nINFO {PostAdviseStats().summary()}\nINFO {line}\nINFO stopped\n"
+    assert parse_summary(log) == {"count": 6, "mean_ms": 4.0, "max_ms": 11.0, "links": 3, "steady_count": 3,
+                                  "steady_mean_ms": 3.0, "steady_max_ms": 4.0, "idle_count": 2,
+                                  "idle_mean_ms": 2.0, "idle_max_ms": 3.0}
+    assert parse_summary("no such line") is None

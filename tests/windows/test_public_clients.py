@@ -11,7 +11,7 @@ import time
 
 import pytest
 
-from tests.windows.conftest import NOVA, request_after_refusal, wine_version
+from tests.windows.conftest import NOVA, on_linked_item, request_after_refusal, wine_version
 
 pytestmark = [
     pytest.mark.windows,
@@ -61,7 +61,7 @@ def test_wisp_interval_zero_holds_a_warm_link_and_requests_per_notification(stat
         seen = len(wisp.received)
         assert wisp.pump(2.0, until=lambda seen=seen: len(wisp.received) > seen)
         assert wisp.received[-1][1] is None  # warm: a notification without data
-        texts.append(wisp.request_text(conv, "NFW_SERVER"))
+        texts.append(on_linked_item(wisp, lambda: wisp.request_text(conv, "NFW_SERVER")))
     assert all(NOVA.match(t) for t in texts[1:])
 
 
@@ -69,14 +69,15 @@ def test_delphi_tddeclientconv_warm_link_requests_and_poke_with_nul(station, cli
     delphi = client(ansi=True)
     conv = delphi.connect("NFW_SERVER", "NFW_DATA")
     delphi.start_advise(conv, "NFW_SERVER", hot=False, timeout_ms=1000)  # ADVSTART|XTYPF_NODATA, 1000 ms
-    first = delphi.request(conv, "NFW_SERVER")  # the immediate request
+    first = on_linked_item(delphi, lambda: delphi.request(conv, "NFW_SERVER"))  # the immediate request
     assert first.split(b"\x00")[0] in (b"",) or NOVA.match(first.split(b"\x00")[0].decode("cp1252"))
-    delphi.poke(conv, "NFW_SERVER", b"TUNE ON\x00")  # PokeData sends the text with its NUL
+    on_linked_item(delphi, lambda: delphi.poke(conv, "NFW_SERVER", b"TUNE ON\x00"))  # PokeData: text + NUL
     strings = []
     for _ in range(4):
         seen = len(delphi.received)
         assert delphi.pump(2.0, until=lambda seen=seen: len(delphi.received) > seen)
-        strings.append(delphi.request(conv, "NFW_SERVER").split(b"\x00")[0].decode("cp1252"))  # cut at NUL
+        reply = on_linked_item(delphi, lambda: delphi.request(conv, "NFW_SERVER"))
+        strings.append(reply.split(b"\x00")[0].decode("cp1252"))  # cut at NUL
     assert all(NOVA.match(s) for s in strings[1:])
 
 

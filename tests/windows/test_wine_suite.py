@@ -23,7 +23,9 @@ from pathlib import Path
 
 import pytest
 
+from nfwserver.dde.post_advise_stats import parse_summary
 from tests.windows.station_config import write_station_config
+from tests.windows.wine_session import kill_session
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 WINE = ROOT / "tools" / "wine"
@@ -54,10 +56,12 @@ def wine_run(*args: str, timeout: float) -> subprocess.CompletedProcess[str]:
 
 
 def start_station(config: Path, duration_s: float, log: Path) -> subprocess.Popen[str]:
+    """The station in a session of its own, so that :func:`kill_session` ends python.exe too."""
     return subprocess.Popen(
         [str(WINE / "nfwserver"), "run", "--headless", "--config", winpath(config), "--log-file", winpath(log),
          "--duration", str(duration_s)],
         cwd=ROOT, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        start_new_session=True,
     )
 
 
@@ -65,6 +69,7 @@ def test_windows_suite_passes_under_wine_with_nothing_skipped(tmp_path) -> None:
     report = tmp_path / "junit.xml"
     done = wine_run("python", "-m", "pytest", "tests/windows", "-p", "no:randomly", "-q", "-rs",
                     "--ignore=tests/windows/test_wine_suite.py", "--ignore=tests/windows/test_platform_transport.py",
+                    "--ignore=tests/windows/test_wine_session.py",
                     f"--junitxml={winpath(report)}", timeout=240)
     assert report.exists(), done.stdout[-3000:] + done.stderr[-3000:]
     suite = ET.parse(report).getroot()
@@ -86,17 +91,19 @@ def test_launcher_station_serves_20_clients_at_10_hz_for_60_s_and_disconnects_th
         [str(WINE / "run"), "python", winpath(ROOT / "tests" / "windows" / "dde_clients.py"), "--clients", "2",
          "--seconds", "60", "--wait-disconnect", "45", "--out", winpath(out)],
         cwd=ROOT, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-        env={**os.environ, "NFW_WINE_TIMEOUT": "200"}) for out in outs]
+        env={**os.environ, "NFW_WINE_TIMEOUT": "200"}, start_new_session=True) for out in outs]
     try:
         for program in programs:
             program.communicate(timeout=220)
         stdout, stderr = station.communicate(timeout=60)
     finally:
         for proc in (*programs, station):
-            if proc.poll() is None:
-                proc.kill()
+            kill_session(proc)
     assert station.returncode == 0, stderr[-3000:]
     assert "serving real DDE (DDEML)" in stderr
+    # The station logged its DDEML cost when it stopped: one DdePostAdvise per tick, most at 20 links.
+    cost = parse_summary((tmp_path / "station.log").read_text(encoding="utf-8", errors="replace"))
+    assert cost is not None and cost["links"] == 20 and cost["steady_count"] >= 300, cost
     results = [r for out in outs for r in json.loads(out.read_text())]
     assert len(results) == 20 and all(r["error"] is None for r in results), results
     assert sorted(r["service"] for r in results) == ["NFW32"] * 10 + ["NFW_SERVER"] * 10
@@ -131,8 +138,7 @@ def test_wine_md_windows_rotor_client_and_station_radio_reach_linux_hamlib(tmp_p
         assert client.returncode == 0 and out.exists(), client.stdout[-2000:] + client.stderr[-2000:]
         radio_hz = int(rigctld.query("f")[0])
     finally:
-        station.kill()
-        station.wait(30)
+        kill_session(station)
     result = json.loads(out.read_text())
     match = re.search(r" AZ:(\S+) EL:(\S+) ", result["last"])
     assert match and re.match(NOVA, result["last"])
@@ -145,6 +151,15 @@ def test_wine_md_windows_rotor_client_and_station_radio_reach_linux_hamlib(tmp_p
     sat = EarthSatellite(active[at], active[at + 1], ts=ts)
     alt, azimuth, _ = (sat - wgs84.latlon(20.0, -12.0, 0.0)).at(ts.now()).altaz()
     assert abs(el - alt.degrees) < 0.3 and abs(az - azimuth.degrees) < 0.3, (az, el, azimuth.degrees, alt.degrees)
-    pos = [float(v) for v in rotctld.query("p", lines=2)]
-    assert abs(pos[0] - az) < 0.11 and abs(pos[1] - el) < 0.11  # the Linux rotor points where DDE said
+    # The Linux rotor points where DDE said.  rotctld's dummy rotor slews at 6 deg/s from 0/0 (Hamlib's
+    # rot_dummy.c), so reaching AZ 180 takes 30 s after the client's P: wait for it (up to 60 s).
+    import time
+
+    deadline = time.monotonic() + 60
+    while True:
+        pos = [float(v) for v in rotctld.query("p", lines=2)]
+        if (abs(pos[0] - az) < 0.11 and abs(pos[1] - el) < 0.11) or time.monotonic() > deadline:
+            break
+        time.sleep(0.5)
+    assert abs(pos[0] - az) < 0.11 and abs(pos[1] - el) < 0.11, (pos, az, el)
     assert abs(radio_hz - 1_537_700_000) < 1_537_700_000 * 1 / 299792.458  # tuned: within 1 km/s of Doppler

@@ -1,0 +1,40 @@
+"""Ending a Wine launcher together with the Windows program under it (Linux side).
+
+``tools/wine/run`` and ``tools/wine/nfwserver`` run the program under ``timeout``, which puts it in a
+process group of its own, and the launcher may be gone while the program still runs; killing the
+launcher's pid or group then leaves ``python.exe`` serving (a station keeps ``NFW32`` registered
+until its ``--duration`` ends, into whatever runs next).  Start launchers with
+``start_new_session=True`` and end them with :func:`kill_session`: every process of that session.
+Wine's own ``wineserver`` runs in a session of its own and is not touched.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+from pathlib import Path
+
+
+def session_members(sid: int) -> list[int]:
+    """Pids of the live (not zombie) processes whose session id is ``sid`` (from /proc)."""
+    pids = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):
+            continue  # the process ended meanwhile
+        if int(fields[3]) == sid and fields[0] != "Z":  # after "pid (comm)": state ppid pgrp session ...
+            pids.append(int(stat.parent.name))
+    return pids
+
+
+def kill_session(proc: subprocess.Popen, timeout_s: float = 30.0) -> None:
+    """SIGKILL every process in ``proc``'s session (``proc`` was started with ``start_new_session``)."""
+    for pid in session_members(proc.pid):
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+    if proc.poll() is None:
+        proc.wait(timeout_s)
