@@ -4,6 +4,10 @@ Usage: ``python -m bench [NAME ...]`` (names without the ``bench_`` prefix selec
 file is then updated only for those sections).  Each benchmark module is run as its own process
 (``python -m bench.bench_NAME``) and prints one Markdown section, starting with a ``## `` heading,
 on stdout.
+
+Opt-in benchmarks (:data:`OPT_IN`) are not part of the plain ``python -m bench`` run and do not write
+docs/BENCHMARKS.md: ``python -m bench reliability [OPTIONS]`` runs the hostile-input and fault campaign
+(bench/bench_reliability.py) with its output on the terminal and its options passed on.
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs" / "BENCHMARKS.md"
+OPT_IN = ("reliability",)  #: run only when named first, with their own options; their figures go elsewhere
 HEADER = "# Benchmarks\n\nRegenerate with `python -m bench` (a subset: `python -m bench NAME ...`).\n"
 
 
@@ -37,11 +42,15 @@ def _sections(text: str) -> dict[str, str]:
 
 
 def main(argv: list[str]) -> int:
-    names = sorted(p.stem[len("bench_") :] for p in (ROOT / "bench").glob("bench_*.py"))
+    if argv and argv[0] in OPT_IN:
+        return subprocess.run([sys.executable, "-m", f"bench.bench_{argv[0]}", *argv[1:]], cwd=ROOT).returncode
+    names = sorted(p.stem[len("bench_") :] for p in (ROOT / "bench").glob("bench_*.py")
+                   if p.stem[len("bench_") :] not in OPT_IN)
     chosen = argv or names
     unknown = [n for n in chosen if n not in names]
     if unknown:
-        print(f"unknown benchmark(s): {', '.join(unknown)}; have: {', '.join(names)}", file=sys.stderr)
+        print(f"unknown benchmark(s): {', '.join(unknown)}; have: {', '.join(names)} "
+              f"(and, alone with its options: {', '.join(OPT_IN)})", file=sys.stderr)
         return 2
     old = _sections(OUT.read_text()) if OUT.exists() else {}
     for name in chosen:

@@ -213,5 +213,6 @@ def run_daemon_kills(tally: Tally, rig: StationRig, kills: int) -> None:
             time.sleep(0.02)
         rig.check(tally, settle_s=0.2)
     stats = station.publisher.stats
-    tally.extra.update({"outages seen by rotor and radio": seen_down, "back after (max)": f"{max(delays):.2f} s" if delays else "-",
+    tally.extra.update({"outages seen by rotor and radio": seen_down,
+                        "back after (max)": f"{max(delays):.2f} s" if delays else "-",
                         "publish ticks late by more than 0.25 s": sum(1 for x in stats.lateness_s if x > 0.25)})

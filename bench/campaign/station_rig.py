@@ -39,6 +39,7 @@ class TcpWatcher:
     def __init__(self, address: tuple[str, int]) -> None:
         self.sock = socket.create_connection(address, timeout=5.0)
         self.lines: list[str] = []
+        self.lock = threading.Lock()
         self._buffer = b""
         while self._buffer.count(b"\r\n") < 1:
             self._buffer += self.sock.recv(4096)
@@ -66,8 +67,19 @@ class TcpWatcher:
                 break
             self._buffer += chunk
             *done, self._buffer = self._buffer.split(b"\r\n")
-            self.lines += [line.decode("ascii", errors="replace") for line in done]
+            with self.lock:
+                self.lines += [line.decode("ascii", errors="replace") for line in done]
         self.closed = True
+
+    def take(self) -> list[str]:
+        """The lines received so far; they are forgotten (the campaign's own memory stays bounded)."""
+        with self.lock:
+            lines, self.lines = self.lines, []
+        return lines
+
+    def put_back(self, lines: list[str]) -> None:
+        with self.lock:
+            self.lines = lines + self.lines
 
     def close(self) -> None:
         self.closed = True
@@ -84,8 +96,10 @@ class StationRig:
         self.daemons_wanted = daemons and hamlib_available()
         self.rot = self.rig = None
         self.station: Station | None = None
-        self.published: list[str] = []
-        self.dde_received: list[str] = []
+        self.published: list[str] = []  #: strings published since the last check
+        self.dde_received: list[str] = []  #: strings the DDE watcher received since the last check
+        self.published_total = self.dde_total = self._dde_missing = 0
+        self._lock = threading.Lock()
         self.store_path = self.workdir / "elements.txt"
         self.state_path = self.workdir / "state.json"
 
@@ -112,11 +126,11 @@ class StationRig:
         self.station = Station(config, SystemClock(), transport=self.system.server_transport())
         self.station.start()
         self.dde = self.system.connect("NFW32", "NFW_DATA", "campaign-watcher")
-        self.dde.on_receive = lambda r: self.dde_received.append(r.text) if r.kind == "data" else None
+        self.dde.on_receive = self._on_dde
         self.dde.start_advise("NFW_SERVER")
         self.control = self.system.connect("NFW32", "NFW_DATA", "campaign-control")
         self.tcp_watcher = TcpWatcher(self.station.tcp.address)
-        self.station.core.subscribe(lambda s: self.published.append(s.text) if s.text else None)
+        self.station.core.subscribe(self._on_tick)
         self.control.poke("NFW_SERVER", "TUNE ON")
         return self
 
@@ -127,6 +141,18 @@ class StationRig:
         for daemon in (self.rot, self.rig):
             if daemon is not None:
                 daemon.kill()
+
+    def _on_tick(self, sample) -> None:
+        if sample.text:
+            with self._lock:
+                self.published.append(sample.text)
+                self.published_total += 1
+
+    def _on_dde(self, received) -> None:
+        if received.kind == "data":
+            with self._lock:
+                self.dde_received.append(received.text)
+                self.dde_total += 1
 
     # -- what the families use ---------------------------------------------------------------------------
     @property
@@ -153,33 +179,45 @@ class StationRig:
         return [name for name, thread in wanted.items() if thread is None or not thread.is_alive()]
 
     def check(self, tally: Tally, settle_s: float = 0.6) -> None:
-        """Crash: a dead thread or no published string for ``settle_s``; loss: a watcher missed strings."""
+        """Crash: a dead thread or no published string for ``settle_s``; loss: a watcher missed strings.
+        What was compared is forgotten, so the campaign's own memory does not grow with the run."""
         self.restore()
-        before = len(self.published)
-        failures = self.station.publisher.stats.failures
+        before = self.published_total
         time.sleep(settle_s)
-        if len(self.published) == before:
+        if self.published_total == before:
             tally.crash(f"the station published nothing for {settle_s} s")
-        if self.station.publisher.stats.failures:
+        failures = self.station.publisher.stats.failures
+        if failures:
             tally.crash(f"{failures} publish ticks failed")
         dead = self.threads_alive()
         if dead:
             tally.crash(f"threads not running: {', '.join(dead)}")
         if self.tcp_watcher.closed:
             tally.loss("the TCP WATCH client was disconnected")
-        published = list(self.published)
-        time.sleep(0.3)  # the TCP loop hands strings on a moment after they are published
-        received = list(self.dde_received)
-        missing_dde = len(published) - len(received)  # the DDE adapter posts before the recorder runs
+        with self._lock:
+            published, self.published = self.published, []
+            received, self.dde_received = self.dde_received, []
+            missing_dde = self.published_total - self.dde_total - self._dde_missing  # the adapter posts first
         if missing_dde > 0:
+            self._dde_missing += missing_dde
             tally.loss(f"the DDE advise client missed {missing_dde} strings", missing_dde)
-        missing_tcp = sum((Counter(published) - Counter(self.tcp_watcher.lines)).values())
+        time.sleep(0.3)  # the TCP loop hands strings on a moment after they are published
+        lines = self.tcp_watcher.take()
+        missing_tcp = sum((Counter(published) - Counter(lines)).values())
         if missing_tcp:
             tally.loss(f"the TCP WATCH client missed {missing_tcp} of {len(published)} strings", missing_tcp)
-        tally.extra["strings published"] = len(published)
+        later = Counter(lines) - Counter(published)  # published after the swap: compared next time
+        keep: list[str] = []
+        for line in reversed(lines):  # the newest lines are the ones published after the swap
+            if later[line] > 0:
+                later[line] -= 1
+                keep.append(line)
+        self.tcp_watcher.put_back(keep[::-1])
+        tally.extra["strings published"] = int(tally.extra.get("strings published", 0)) + len(published)
         # DDE advise data is the item's value when it is posted: a poke between a tick and its post (TUNE OFF,
         # SAT=) changes it, as on Windows.  Counted, not called a loss.
-        tally.extra["DDE deliveries differing from their tick"] = sum((Counter(published) - Counter(received)).values())
+        key = "DDE deliveries differing from their tick"
+        tally.extra[key] = int(tally.extra.get(key, 0)) + sum((Counter(published) - Counter(received)).values())
 
     def files_whole(self, tally: Tally) -> None:
         """Data lost: the element store or the state file is not whole (checked after the station stops)."""
