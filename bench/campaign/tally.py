@@ -22,14 +22,14 @@ from dataclasses import dataclass, field
 class Budget:
     """How much of each family to run: counts of inputs, and seconds for the real-time run."""
 
-    elements: int = 2000  #: fuzzed element files through load_elements
-    updates: int = 200  #: fuzzed element files through `elements update`
-    configs: int = 3000
-    pokes: int = 3000  #: DDE pokes; as many TCP lines
-    datagrams: int = 3000
-    hamlib_replies: int = 600
-    daemon_kills: int = 10  #: kills of each daemon
-    write_kills: int = 15  #: SIGKILLs of each writer (element store, state file)
+    elements: int = 20_000  #: fuzzed element files through load_elements
+    updates: int = 1000  #: fuzzed element files through `elements update`
+    configs: int = 20_000
+    pokes: int = 20_000  #: DDE pokes; as many TCP lines
+    datagrams: int = 20_000
+    hamlib_replies: int = 2400
+    daemon_kills: int = 20  #: kills of both daemons together
+    write_kills: int = 20  #: SIGKILLs of each writer (element store, state file)
     realtime_s: float = 600.0
     seed: int = 2026
 
