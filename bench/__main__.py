@@ -5,6 +5,9 @@ file is then updated only for those sections; ``-`` and ``_`` are the same in na
 module is run as its own process (``python -m bench.bench_NAME``) and prints one Markdown section,
 starting with a ``## `` heading, on stdout; a benchmark that prints nothing leaves its section as it was.
 Benchmarks in ``OPT_IN`` run only when named: ``wine-dde`` needs a Wine prefix (tools/wine/setup).
+``python -m bench reliability [OPTIONS]`` (``STANDALONE``) runs the hostile-input and fault campaign
+(bench/bench_reliability.py) with its output on the terminal and its options passed on; its figures go to
+docs/RELIABILITY.md by hand, not to docs/BENCHMARKS.md.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs" / "BENCHMARKS.md"
 OPT_IN = ("wine_dde",)  #: run only when named
+STANDALONE = ("reliability",)  #: run alone, named first, with their own options; they write no section
 HEADER = ("# Benchmarks\n\nRegenerate with `python -m bench` (a subset: `python -m bench NAME ...`; the Wine "
           "section: `NFW_WINE_HOME=... python -m bench wine-dde`).\n")
 
@@ -40,11 +44,15 @@ def _sections(text: str) -> dict[str, str]:
 
 
 def main(argv: list[str]) -> int:
-    names = sorted(p.stem[len("bench_") :] for p in (ROOT / "bench").glob("bench_*.py"))
+    if argv and argv[0] in STANDALONE:
+        return subprocess.run([sys.executable, "-m", f"bench.bench_{argv[0]}", *argv[1:]], cwd=ROOT).returncode
+    names = sorted(p.stem[len("bench_") :] for p in (ROOT / "bench").glob("bench_*.py")
+                   if p.stem[len("bench_") :] not in STANDALONE)
     chosen = [name.replace("-", "_") for name in argv] or [n for n in names if n not in OPT_IN]
     unknown = [n for n in chosen if n not in names]
     if unknown:
-        print(f"unknown benchmark(s): {', '.join(unknown)}; have: {', '.join(names)}", file=sys.stderr)
+        print(f"unknown benchmark(s): {', '.join(unknown)}; have: {', '.join(names)} "
+              f"(and, alone with its options: {', '.join(STANDALONE)})", file=sys.stderr)
         return 2
     old = _sections(OUT.read_text()) if OUT.exists() else {}
     for name in chosen:

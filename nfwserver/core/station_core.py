@@ -29,6 +29,7 @@ from nfwserver.core.state import DEFAULT_RATE_HZ, StateSnapshot, StationState
 from nfwserver.core.status import INTERFACE_VERSION, StatusBit
 from nfwserver.core.tracker import TickListener, Tracker
 from nfwserver.radio.transponder import Channel
+from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer
@@ -80,6 +81,9 @@ class StationCore:
         self.state = StationState(catalog, observer, horizon=horizon, ut1_utc_s=ut1_utc, rate_hz=rate_hz,
                                   channels=channels)
         self.tracker = Tracker(self.state, clock, self.events)
+        #: Refused commands: one warning per client at once, then a counted summary at most once a minute
+        #: (every refusal is still an event).
+        self._refusals = RateLimitedLog(log, clock, 60.0)
         if satellite is not None and not self.select_satellite(satellite, source="startup"):
             log.warning("satellite %s is not in the catalog; no satellite selected", satellite)
 
@@ -187,5 +191,6 @@ class StationCore:
         self.events.add(self.clock.now(), Direction.IN, "poke", text, conversation=conversation, client=source,
                         accepted=accepted, detail=reason or note or "")
         if not accepted:
-            log.warning("refused command %s from %s: %s", escape_for_log(text), escape_for_log(source), reason)
+            self._refusals.warning(f"refused:{source}", "refused command %s from %s: %s", escape_for_log(text),
+                                   escape_for_log(source), reason)
         return CommandResult(accepted, reason or note, self.tracker.status_word())

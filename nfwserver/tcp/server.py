@@ -203,12 +203,14 @@ class NovaTcpServer:
                 log.exception("TCP server loop failed; carrying on")
 
     def _drain_wake(self) -> None:
-        self._wake_pending = False
+        # Drain first, then clear the flag: a tick that sets the flag and sends its byte during the drain
+        # must not have its byte swallowed while the flag stays set (every later tick would skip the wake).
         try:
             while self._wake_r is not None and self._wake_r.recv(4096):
                 pass
         except OSError:
             pass
+        self._wake_pending = False
 
     def _accept(self) -> None:
         assert self._listener is not None and self._selector is not None

@@ -23,7 +23,7 @@ import json
 import os
 import re
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from datetime import datetime, timedelta
 from pathlib import Path
 
@@ -61,8 +61,15 @@ class ElementSet:
     @classmethod
     def from_fields(cls, name: str, fields: TleFields, source: str = "", line_number: int = 0,
                     lines: tuple[str, str] | None = None) -> ElementSet:
-        """Build from parsed values; ``lines`` are the original TLE lines when there were any."""
-        line1, line2 = lines if lines is not None else format_tle(fields)
+        """Build from parsed values; ``lines`` are the original TLE lines when there were any.
+
+        Lines generated here (AMSAT, OMM) hold the epoch on the TLE's 1e-8-day grid; the set takes that
+        epoch, so memory, the stored catalog and SGP4 agree on one value (an OMM epoch may be finer)."""
+        if lines is None:
+            line1, line2 = format_tle(fields)
+            fields = replace(fields, epoch=epoch_from_tle(int(line1[18:20]), float(line1[20:32])))
+        else:
+            line1, line2 = lines
         satrec = Satrec.twoline2rv(line1, line2, WGS72)
         return cls(
             name=sanitize_element_name(name), catalog_number=fields.catalog_number,
