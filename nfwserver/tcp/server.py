@@ -230,10 +230,10 @@ class NovaTcpServer:
                 reason = f"already {self.max_clients} clients"
             if reason is not None:
                 sock.close()
-                self.stats.refused += 1
                 self._refusals.warning(address[0], "TCP connection from %s refused: %s", peer, reason)
                 self.core.events.add(self.core.clock.now(), Direction.INFO, "note", f"connection refused: {reason}",
                                      client=peer, accepted=False)
+                self.stats.refused += 1  # counted once it is on record (log and event stream)
                 continue
             sock.setblocking(False)
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
