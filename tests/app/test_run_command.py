@@ -101,13 +101,15 @@ def test_a_console_failure_is_reported_in_one_sentence_and_the_station_keeps_ser
 
     def drive() -> None:
         # Once the console has failed and the run carries on headless, a DDE client still gets the feed.
-        assert _wait_real(lambda: log_file.exists() and "outputs:" in log_file.read_text())
-        client = system.connect("NFW32", "NFW_DATA")
-        client.on_receive = lambda r: received.append(r.text) if r.kind == "data" else None
-        client.start_advise("NFW_SERVER", CF_TEXT, hot=True)
-        client.poke("NFW_SERVER", "TUNE ON")
-        advance_until(clock, lambda: len(received) >= 5)
-        stop.set()
+        try:
+            assert _wait_real(lambda: log_file.exists() and "outputs:" in log_file.read_text())
+            client = system.connect("NFW32", "NFW_DATA")
+            client.on_receive = lambda r: received.append(r.text) if r.kind == "data" else None
+            client.start_advise("NFW_SERVER", CF_TEXT, hot=True)
+            client.poke("NFW_SERVER", "TUNE ON")
+            advance_until(clock, lambda: len(received) >= 5, real_timeout_s=60.0)
+        finally:
+            stop.set()  # whatever happened, the run must end (a failed wait shows in the asserts below)
 
     driver = threading.Thread(target=drive)
     driver.start()
