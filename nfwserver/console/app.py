@@ -30,6 +30,7 @@ from rich.text import Text
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
+from textual.css.query import NoMatches
 from textual.widgets import Footer, Input, RichLog, Static
 
 from nfwserver.console.pass_view import PassSearch, next_pass_text, pass_table, search_passes
@@ -131,8 +132,8 @@ class NfwConsole(App):
         self.query_one("#incoming-pane").border_title = "F3 incoming"
         self.query_one("#side").border_title = "Passes"
         self._unsubscribe = self.core.events.subscribe(self._enqueue)
-        self.set_interval(0.1, self._drain)
-        self.set_interval(0.25, self._refresh_state)
+        self.set_interval(0.1, partial(self._while_shown, self._drain))
+        self.set_interval(0.25, partial(self._while_shown, self._refresh_state))
         self._layout()
         self.call_after_refresh(self._write_notes)
         self._refresh_state()
@@ -186,6 +187,15 @@ class NfwConsole(App):
                 who = e.client or "server"
                 style = "red" if e.accepted is False else ("dim" if e.direction is Direction.INFO else "")
                 incoming.add(Text(f"{stamp} [{who}] {escape_for_log(e.text)}{mark}{detail}", style=style))
+
+    @staticmethod
+    def _while_shown(update: Callable[[], None]) -> None:
+        """Run a timer's screen update; a tick that lands while the app closes finds its widgets gone
+        (textual's NoMatches) and is skipped."""
+        try:
+            update()
+        except NoMatches:
+            pass
 
     def _note(self, text: str, style: str = "yellow") -> None:
         self.query_one("#incoming", ReflowLog).add(Text(f"{self.times.clock(self.core.clock.now())} {text}",
