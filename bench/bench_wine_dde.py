@@ -53,6 +53,7 @@ class CaseResult:
     window_s: float
     rates_hz: list[float]
     failures: list[str]
+    deliveries: dict[str, int]  #: what the window's deliveries carried: string, empty, no data (all programs)
     cost: dict[str, float]
     connect_s: float
     load_1min: float
@@ -61,7 +62,7 @@ class CaseResult:
 def connect_budget_s(programs: int) -> float:
     """Seconds allowed from launch until every program has its conversations (Wine Python starts
     take a few CPU seconds each; 2 cores)."""
-    return 25.0 + 2.5 * programs
+    return 20.0 + 1.0 * programs
 
 
 def run_case(conversations: int, window_s: float, work: Path) -> CaseResult:
@@ -101,20 +102,24 @@ def run_case(conversations: int, window_s: float, work: Path) -> CaseResult:
         for proc in (*clients, station):  # on failure: the launchers and the Windows programs under them
             kill_session(proc)
     failures, rates = [], []
+    deliveries = {"string": 0, "empty": 0, "no data": 0}
     if station.returncode != 0:
         failures.append(f"station exit {station.returncode}: {stderr[-500:]}")
     for out in outs:
         if not out.exists():
             failures.append(f"{out.name}: no result")
             continue
-        for record in json.loads(out.read_text()):
+        records = json.loads(out.read_text())
+        for key, value in (records[0].get("program_deliveries") or {}).items():
+            deliveries[key] += value
+        for record in records:
             if record["error"] is not None or record.get("late"):
                 failures.append(f"{out.name}: {record['error'] or 'connected after the window began'}")
                 continue
             rates.append(record["advise"] / record["window_s"])
     text = log.read_text(encoding="utf-8", errors="replace") if log.exists() else ""
     cost = parse_summary(text) or {}
-    return CaseResult(conversations, programs, window_s, rates, failures, cost, budget, load)
+    return CaseResult(conversations, programs, window_s, rates, failures, deliveries, cost, budget, load)
 
 
 def environment() -> str:
@@ -144,9 +149,9 @@ def report(results: list[CaseResult], env: str, window_s: float) -> str:
         "`DdePostAdvise` = its wall time in the station (the transport's log line at stop), which includes "
         "our `XTYP_ADVREQ` callback for every link and DDEML posting the data; the station posts both "
         "items (`NFW_SERVER`, `NFW_DATA`) each tick, so a tick's DDE cost is the two columns added.\n",
-        "| conversations (programs) | delivered per conversation: min / median / max | "
-        "`DdePostAdvise` at N links: mean / max | per link | post on the unlinked item | load (1 min) |",
-        "|---|---|---|---|---|---|",
+        "| conversations (programs) | delivered per conversation: min / median / max | deliveries carrying a "
+        "Nova string | `DdePostAdvise` at N links: mean / max | per link | post on the unlinked item | load (1 min) |",
+        "|---|---|---|---|---|---|---|",
     ]
     for r in results:
         if r.rates_hz:
@@ -160,7 +165,11 @@ def report(results: list[CaseResult], env: str, window_s: float) -> str:
         steady = f"{_ms(mean)} / {_ms(r.cost.get('steady_max_ms') if at_n else None)}"
         if not at_n and r.cost.get("links") is not None:
             steady += f" (most calls at {r.cost['links']:.0f} links)"
-        lines.append(f"| {r.conversations} ({r.programs}) | {rates} | {steady} | {per_link} | "
+        total = sum(r.deliveries.values())
+        carried = f"{r.deliveries['string']:,} of {total:,}"
+        if r.deliveries["no data"]:
+            carried += f" ({r.deliveries['no data']:,} without data)"
+        lines.append(f"| {r.conversations} ({r.programs}) | {rates} | {carried} | {steady} | {per_link} | "
                      f"{_ms(r.cost.get('idle_mean_ms'))} | {r.load_1min:.1f} |")
     lines.append("")
     for r in results:

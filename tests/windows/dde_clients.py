@@ -74,10 +74,15 @@ def main(argv: list[str] | None = None) -> int:
     start = time.monotonic()
     pump(args.seconds)
     window = time.monotonic() - start
+    # What the program's deliveries in the window carried (all its conversations together).
+    texts = [d.split(b"\x00")[0] if d else None for _, d in shared.received]
+    carried = {"string": sum(1 for t in texts if t), "empty": sum(1 for t in texts if t == b""),
+               "no data": sum(1 for t in texts if t is None)}
     for record, c, conv, n0 in zip(records, clients, convs, start_counts):
         record["advise"] = c.advise_counts[conv] - n0
         record["window_s"] = window
         record["late"] = late
+        record["program_deliveries"] = carried
         record["still_connected"] = conv not in c.disconnected
         data = [d for _, d in c.received if d]
         record["sample"] = data[-1].split(b"\x00")[0].decode("cp1252") if data else ""
