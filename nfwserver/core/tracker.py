@@ -85,8 +85,7 @@ class Tracker:
     def current_text(self) -> str:
         """What a request answers now: this tick's Nova string; "" before TUNE ON, after TUNE OFF,
         after a change of satellite until the next tick, and while the computation fails."""
-        with self._lock:
-            return self._text
+        return self._text  # replaced whole under the lock; reading one attribute needs none
 
     @property
     def arithmetic_error(self) -> ArithmeticErrorCode:

@@ -101,15 +101,17 @@ class NovaDdeService:
         self.core.events.add(sample.time, Direction.OUT, "publish", sample.text, detail=f"{loops} advise loop(s)")
 
     def _data(self, fmt: int) -> tuple[str, bytes]:
+        """The current string and its bytes in ``fmt``, encoded once per string (every advise loop of a
+        tick asks for the same bytes; reading the cached pair needs no lock: it is replaced whole)."""
         text = self.core.current_text()
-        with self._lock:
-            cached_text, cache = self._encoded
-            if cached_text != text:
-                cache = {}
-                self._encoded = (text, cache)
-            data = cache.get(fmt)
-            if data is None:
-                data = cache[fmt] = encode_text(text, fmt)
+        cached_text, cache = self._encoded
+        data = cache.get(fmt) if cached_text == text else None
+        if data is None:
+            data = encode_text(text, fmt)
+            with self._lock:
+                if self._encoded[0] != text:
+                    self._encoded = (text, {})
+                self._encoded[1][fmt] = data
         return text, data
 
     # -- DdeServerHandler ----------------------------------------------------------------------
