@@ -140,15 +140,18 @@ def _ms(value: float | None) -> str:
 def report(results: list[CaseResult], env: str, window_s: float) -> str:
     lines = [
         "## Real DDEML under Wine (tools/wine)\n",
-        f"Measured with `python -m bench wine-dde` under **{env}** (64-bit prefix, null graphics driver) on "
-        "the 2-core Linux machine above. **These are Wine figures, not Windows figures.** Station: "
+        f"Measured {time.strftime('%Y-%m-%d', time.gmtime())} with `python -m bench wine-dde` under **{env}** "
+        "(64-bit prefix, null graphics driver) on the 2-core Linux machine above. **These are Wine figures, not "
+        "Windows figures.** Station: "
         f"`tools/wine/nfwserver run --headless` at {RATE_HZ:g} Hz; clients: `tests/windows/dde_clients.py` under "
         "`tools/wine/run`, two conversations per program (`NFW32` and `NFW_SERVER`; Wine allows one per "
         "service per program), hot advise loops on `NFW_SERVER`, all counting over the same "
         f"{window_s:g} s window. Rate = strings a conversation received in the window / window. "
         "`DdePostAdvise` = its wall time in the station (the transport's log line at stop), which includes "
         "our `XTYP_ADVREQ` callback for every link and DDEML posting the data; the station posts both "
-        "items (`NFW_SERVER`, `NFW_DATA`) each tick, so a tick's DDE cost is the two columns added.\n",
+        "items (`NFW_SERVER`, `NFW_DATA`) each tick, so a tick's DDE cost is the two columns added. Load: the "
+        "1-minute load average in mid-window (the machine may be shared). A delivery without data is a "
+        "notification whose data was lost (docs/PLATFORMS.md, open problem).\n",
         "| conversations (programs) | delivered per conversation: min / median / max | deliveries carrying a "
         "Nova string | `DdePostAdvise` at N links: mean / max | per link | post on the unlinked item | load (1 min) |",
         "|---|---|---|---|---|---|---|",
