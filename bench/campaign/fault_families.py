@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import math
 import random
-import socket
 import threading
 import time
 
@@ -27,6 +26,7 @@ from nfwserver.rotor.geometry import RotorGeometry
 from nfwserver.rotor.kct_driver import KctDriver
 from nfwserver.rotor.kct_status import KctStatusBit
 from nfwserver.rotor.rotctld_backend import RotctldBackend
+from tests.hamlib_peer import ScriptedPeer
 
 GEOMETRY = RotorGeometry(0.0, 450.0, 0.0, 90.0)
 BAD_NUMBERS = ("nan", "inf", "-inf", "1e308", "-1e308", "1e999", "", "x", "0x10", "-0", "99999999999999999999", "NaN",
@@ -41,11 +41,8 @@ class HostilePeer:
     def __init__(self, seed: int) -> None:
         self.rng = random.Random(seed)
         self._lock = threading.Lock()
-        self.listener = socket.create_server(("127.0.0.1", 0))
-        self.port = self.listener.getsockname()[1]
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._serve, name="campaign-peer", daemon=True)
-        self._thread.start()
+        self.peer = ScriptedPeer(lambda command, _n: self.answer(command))
+        self.port = self.peer.port
 
     def answer(self, command: str) -> bytes | None:
         """Bytes to send for ``command``; b"" sends nothing, None closes the connection."""
@@ -76,43 +73,8 @@ class HostilePeer:
                 return b""  # silence: the client must time out
             return None
 
-    def _serve(self) -> None:
-        self.listener.settimeout(0.05)
-        while not self._stop.is_set():
-            try:
-                conn, _ = self.listener.accept()
-            except OSError:
-                continue
-            threading.Thread(target=self._talk, args=(conn,), daemon=True).start()
-
-    def _talk(self, conn: socket.socket) -> None:
-        pending = b""
-        conn.settimeout(0.2)
-        with conn:
-            while not self._stop.is_set():
-                try:
-                    chunk = conn.recv(4096)
-                except TimeoutError:
-                    continue
-                except OSError:
-                    return
-                if not chunk:
-                    return
-                pending += chunk
-                while b"\n" in pending:
-                    line, pending = pending.split(b"\n", 1)
-                    reply = self.answer(line.decode("ascii", "replace"))
-                    try:
-                        if reply is None:
-                            return
-                        conn.sendall(reply)
-                    except OSError:
-                        return
-
     def close(self) -> None:
-        self._stop.set()
-        self._thread.join(2)
-        self.listener.close()
+        self.peer.close()
 
 
 def _position_ok(position: tuple[float, float] | None) -> bool:
