@@ -10,11 +10,8 @@ import time
 
 import numpy as np
 
-from nfwserver.clock import SystemClock
-from nfwserver.core.publisher import Publisher
-from nfwserver.core.station_core import StationCore
 from nfwserver.tcp import NovaTcpServer
-from tests.dde.conftest import CATALOG, ISS, OBSERVER, make_station
+from tests.dde.conftest import ISS, make_station
 from tests.tcp.conftest import LOOPBACK_ONLY, LineClient, wait_for
 
 
@@ -104,36 +101,6 @@ def test_fifty_watchers_get_every_string_while_a_stalled_one_is_dropped(caplog) 
         for c in [*watchers, stalled]:
             c.close()
     finally:
-        server.stop()
-
-
-def test_publisher_lateness_with_fifty_watchers_and_a_stalled_one_in_real_time() -> None:
-    """A bounded real-time check (3 s at 10 Hz): the loop keeps its schedule; no tick is skipped."""
-    core = StationCore(CATALOG, OBSERVER, SystemClock(), rate_hz=10.0, satellite=ISS)
-    server = NovaTcpServer(core, LOOPBACK_ONLY, output_limit=1024, send_buffer_bytes=4096)
-    server.start()
-    core.set_tune(True)
-    publisher = Publisher(core, SystemClock())
-    try:
-        watchers = _watchers(server, 50)
-        stalled = LineClient(server.address, rcvbuf=2048)
-        stalled.send(b"WATCH\r\n")
-        assert wait_for(lambda: server.watcher_count() == 51)
-        readers = Readers(watchers)
-        publisher.start()
-        time.sleep(3.0)
-        publisher.stop()
-        assert wait_for(lambda: all(readers.count(c) == publisher.stats.ticks for c in watchers), timeout=10.0)
-        readers.close()
-        late_ms = np.array(publisher.stats.lateness_s) * 1e3
-        # No tick late by a whole period (none skipped), and typically on time; the 2 ms p99 target is
-        # measured by bench/bench_tcp.py, not asserted here (this runs beside other tests).
-        assert publisher.stats.ticks >= 29 and publisher.stats.skipped == 0
-        assert float(np.median(late_ms)) < 5.0, late_ms
-        for c in [*watchers, stalled]:
-            c.close()
-    finally:
-        publisher.stop()
         server.stop()
 
 
