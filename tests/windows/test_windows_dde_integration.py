@@ -79,6 +79,11 @@ def test_pywin32_dde_conversation(live_server) -> None:
         time.sleep(0.3)
         assert NOVA.match(conv.Request("NFW_SERVER").rstrip("\x00"))
         conv.Exec("TRACK ON")
+        # pywin32's Exec can return before the server's DDE thread has handled the execute under Wine
+        # (seen once in CI): allow the station up to 3 s of real DDE time to apply it.
+        deadline = time.monotonic() + 3.0
+        while not live_server.snapshot().state.tracking and time.monotonic() < deadline:
+            time.sleep(0.02)
         assert live_server.snapshot().state.tracking
     finally:
         server.Destroy()
