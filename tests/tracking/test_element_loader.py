@@ -71,6 +71,31 @@ def test_whole_active_catalog_loads_without_rejections() -> None:
     assert active[iss.line_number] == iss.line1
 
 
+def test_bulk_loaded_sets_are_ordinary_frozen_sets_with_the_model_sgp4_builds() -> None:
+    """A set read in bulk equals the one built field by field from the one-set parser, is frozen and
+    hashable, and its (lazily made) model propagates exactly like sgp4's own ``twoline2rv``."""
+    from dataclasses import FrozenInstanceError
+
+    from sgp4.api import WGS72
+
+    from nfwserver.tracking.elements import ElementSet
+    from nfwserver.tracking.tle import parse_tle
+
+    sets = load_elements(VISUAL).sets
+    assert len(sets) == len(LINES) // 3
+    for es in sets[:20]:
+        one_by_one = ElementSet.from_fields(es.name, parse_tle(es.line1, es.line2), es.source, es.line_number,
+                                            lines=(es.line1, es.line2))
+        assert type(es) is ElementSet and es == one_by_one and hash(es) == hash(one_by_one)
+        with pytest.raises(FrozenInstanceError):
+            es.name = "changed"  # type: ignore[misc]
+        reference = Satrec.twoline2rv(es.line1, es.line2, WGS72)
+        assert es.satrec is es.satrec  # made once
+        for minutes in (0.0, 97.5, 1440.0):
+            jd, fr = reference.jdsatepoch, reference.jdsatepochF + minutes / 1440.0
+            assert es.satrec.sgp4(jd, fr) == reference.sgp4(jd, fr)
+
+
 def test_two_and_three_line_forms_and_0_name_lines() -> None:
     _, l1, l2 = LINES[0:3]
     text = f"{l1}\n{l2}\n0 {LINES[3].strip()}\n{LINES[4]}\n{LINES[5]}\n"

@@ -73,3 +73,23 @@ def test_alpha5_numbers_and_exponent_forms() -> None:
         variants.append((_fix(one[:53] + bstar + one[61:]), two))
     assert _check(variants) == len(variants)
     assert read_canonical([one], [two])[1]["catalog_number"][0] == 123456
+
+
+def test_working_memory_is_bounded_whatever_the_catalog_size() -> None:
+    """Pairs are read in blocks: memory grows with the number of pairs only by the results (13 columns of
+    8 bytes), the joined text (twice 69 bytes a line, as str and as bytes) and small per-pair flags,
+    under 500 bytes a pair.  (Reading all pairs at once held several 69-column integer arrays, 1.9 kB
+    a pair.)"""
+    import tracemalloc
+
+    all_lines = LINES[: 3 * (len(LINES) // 3)]
+    one, two = all_lines[1::3], all_lines[2::3]
+    peaks = []
+    for repeat in (1, 5):
+        tracemalloc.start()
+        good, _ = read_canonical(one * repeat, two * repeat)
+        peaks.append(tracemalloc.get_traced_memory()[1])
+        tracemalloc.stop()
+        assert good.all()
+    per_pair = (peaks[1] - peaks[0]) / (4 * len(one))
+    assert per_pair < 500, per_pair
