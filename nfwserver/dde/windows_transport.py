@@ -218,7 +218,12 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
     def post_advise(self, topic: str, item: str) -> None:
         def do() -> None:
             start = time.perf_counter()
-            links = self._dispatcher.advise_links(item) if self._dispatcher is not None else 0
+            links = self._dispatcher.advise_links(item) if self._dispatcher is not None else -1
+            if links == 0:
+                # Nobody advises on the item: DDEML would post nothing.  Skipping the call also keeps
+                # Wine's DdePostAdvise from taking an item-atom reference that nobody releases.
+                self.post_advise_stats.add(time.perf_counter() - start, 0)
+                return
             if self._wine_atoms:
                 # Wine's DdePostAdvise takes one reference on the item's global atom for all the
                 # WM_DDE_DATA it posts, while every client releases one: after the first client the

@@ -111,3 +111,46 @@ def test_default_transport_is_real_ddeml_here() -> None:
         assert isinstance(transport, WindowsDdeTransport) and note == "serving real DDE (DDEML)"
     finally:
         transport.close()
+
+
+def _atom_references(name: str) -> int:
+    """Reference count of the global atom ``name`` (0 when there is none: DDEML's string handles are
+    local atoms, made global for the messages that carry them), read with ntdll's
+    ``NtQueryInformationAtom`` (AtomBasicInformation: USHORT ReferenceCount first)."""
+    import ctypes
+    from ctypes import wintypes
+
+    atom = ctypes.WinDLL("kernel32").GlobalFindAtomW(name)
+    if not atom:
+        return 0
+    buffer = ctypes.create_string_buffer(512)
+    ntdll = ctypes.WinDLL("ntdll")
+    ntdll.NtQueryInformationAtom.argtypes = [wintypes.WORD, ctypes.c_int, ctypes.c_void_p, wintypes.ULONG,
+                                             ctypes.POINTER(wintypes.ULONG)]
+    status = ntdll.NtQueryInformationAtom(atom, 0, buffer, len(buffer), None)
+    assert status == 0, f"NtQueryInformationAtom: 0x{status & 0xFFFFFFFF:08X}"
+    return ctypes.c_ushort.from_buffer(buffer).value
+
+
+def test_publishing_leaves_the_item_atoms_reference_counts_steady(live_server) -> None:
+    """Every tick posts both items; on the one nobody advises on, DDEML must not be asked to (Wine's
+    DdePostAdvise would take an atom reference per call that nobody releases), and on the one with a
+    hot link every reference taken for a post is released by the client that takes the data."""
+    from nfwserver.dde.ddeml_client import DdemlClient
+
+    client = DdemlClient()
+    try:
+        conv = client.connect("NFW32", "NFW_DATA")
+        client.poke(conv, "NFW_SERVER", "TUNE ON")
+        client.start_advise(conv, "NFW_SERVER", hot=True)
+        client.pump(0.5)
+        before = {name: _atom_references(name) for name in ("NFW_DATA", "NFW_SERVER")}
+        client.received.clear()
+        client.pump(2.0)  # about 20 ticks, each posting NFW_SERVER (linked) and NFW_DATA (not linked)
+        assert len([d for _, d in client.received if d]) >= 15
+        after = {name: _atom_references(name) for name in ("NFW_DATA", "NFW_SERVER")}
+        assert after["NFW_DATA"] == before["NFW_DATA"], (before, after)
+        assert abs(after["NFW_SERVER"] - before["NFW_SERVER"]) <= 1, (before, after)  # one post may be in flight
+        client.disconnect(conv)
+    finally:
+        client.close()
