@@ -38,9 +38,10 @@ def _create_like(tmp: Path, target: Path) -> int:
         st = None
     fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
     if st is not None:
-        with contextlib.suppress(OSError):
-            if hasattr(os, "fchown") and (st.st_uid, st.st_gid) != (os.geteuid(), os.getegid()):
-                os.fchown(fd, st.st_uid, st.st_gid)
+        if sys.platform != "win32":  # Windows has no owner ids to keep
+            with contextlib.suppress(OSError):
+                if (st.st_uid, st.st_gid) != (os.geteuid(), os.getegid()):
+                    os.fchown(fd, st.st_uid, st.st_gid)
         if hasattr(os, "fchmod"):
             os.fchmod(fd, stat.S_IMODE(st.st_mode))
         else:  # pragma: no cover - Windows: only the read-only bit exists
