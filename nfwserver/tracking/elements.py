@@ -71,6 +71,11 @@ class ElementSet:
             object.__setattr__(self, "_satrec", satrec)  # a cache: the same model every time
         return satrec
 
+    def transient_satrec(self) -> Satrec:
+        """The SGP4 model for one-off bulk work (a catalog-wide pass search): the one already made, or a
+        new one that is not kept, so a search over many sets holds only the models it is using."""
+        return self._satrec or Satrec.twoline2rv(self.line1, self.line2, WGS72)
+
     @classmethod
     def from_fields(cls, name: str, fields: TleFields, source: str = "", line_number: int = 0,
                     lines: tuple[str, str] | None = None) -> ElementSet:

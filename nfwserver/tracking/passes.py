@@ -111,15 +111,12 @@ def find_passes(
     window_s = (end - start).total_seconds()
     if end <= start or not satellites:
         return PassList(start, max(window_s, 0.0))
-    satrecs = [getattr(s, "satrec", s) for s in satellites]
-    no = np.array([sr.no_kozai for sr in satrecs])  # rad/min
-    ecc = np.array([sr.ecco for sr in satrecs])
+    no, ecc, catalog_numbers = _orbits(satellites)
     periods = 2.0 * math.pi / np.maximum(no, 1e-9) * 60.0  # s
     rev_per_day = no * MINUTES_PER_DAY / (2.0 * math.pi)
     short = periods <= _SHORT_PERIOD_S
     slow = ~short & (rev_per_day < _SLOW_REV_PER_DAY) & (ecc < 0.05)
     other = ~short & ~slow
-    catalog_numbers = np.array([int(sr.satnum) for sr in satrecs], dtype=np.int64)
     parts: list[dict[str, np.ndarray]] = []
     # The rest is split by period so that each part looks back and ahead only as far as it needs.
     for group, step in ((short, _LOW_STEP_S), (slow, _SLOW_STEP_S), (other & (periods <= 8 * 3600.0), _OTHER_STEP_S),
@@ -130,9 +127,29 @@ def find_passes(
             idx = members[c0 : c0 + _CHUNK]
             look = np.where((ecc[idx] < 0.05) & short[idx], 0.5, 1.0) * periods[idx]
             extension = float(min(np.max(look), SECONDS_PER_DAY))
-            parts.append(_search([satrecs[i] for i in idx], catalog_numbers[idx], observer, start, end, horizon,
-                                 ut1_utc, fine_step_s, step, extension))
+            models = [_model(satellites[i]) for i in idx]
+            parts.append(_search(models, catalog_numbers[idx], observer, start, end, horizon, ut1_utc, fine_step_s,
+                                 step, extension))
     return PassList.concat(start, window_s, parts)
+
+
+def _orbits(satellites: Sequence) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mean motion (rad/min, SGP4's ``no_kozai``), eccentricity and catalog number of every satellite, read
+    from an :class:`~nfwserver.tracking.elements.ElementSet`'s fields without making its SGP4 model."""
+    if all(hasattr(s, "mean_motion_rev_per_day") for s in satellites):
+        return (np.array([s.mean_motion_rev_per_day for s in satellites]) / (MINUTES_PER_DAY / (2.0 * math.pi)),
+                np.array([s.eccentricity for s in satellites]),
+                np.array([s.catalog_number for s in satellites], dtype=np.int64))
+    satrecs = [getattr(s, "satrec", s) for s in satellites]
+    return (np.array([sr.no_kozai for sr in satrecs]), np.array([sr.ecco for sr in satrecs]),
+            np.array([int(sr.satnum) for sr in satrecs], dtype=np.int64))
+
+
+def _model(satellite: object) -> object:
+    """The SGP4 model of ``satellite`` (an ``sgp4`` Satrec, or an object with a ``.satrec``), made only for
+    this search when the object can make one without keeping it (ElementSet.transient_satrec)."""
+    transient = getattr(satellite, "transient_satrec", None)
+    return transient() if transient is not None else getattr(satellite, "satrec", satellite)
 
 
 def _search(satrecs: list, catalog_numbers: np.ndarray, observer: Observer, start: datetime, end: datetime,

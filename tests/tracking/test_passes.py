@@ -164,3 +164,14 @@ print("same", len(serial))
                           timeout=100)
     assert done.returncode == 0, done.stderr
     assert done.stdout.startswith("same ")
+
+
+def test_element_sets_and_their_models_give_the_same_passes_and_no_model_is_kept() -> None:
+    """Element sets are grouped by their own fields and propagated by models made for the search only;
+    the passes are exactly those of the same satellites given as sgp4 Satrecs."""
+    sets = load_element_file(DATA / "active.txt").sets[:400]  # fresh sets: no model made yet
+    observer = OBSERVERS[0]
+    from_sets = find_passes(sets, observer, START, START + timedelta(hours=6))
+    assert all(s._satrec is None for s in sets)  # a catalog-wide search holds one chunk's models at a time
+    from_models = find_passes([s.satrec for s in sets], observer, START, START + timedelta(hours=6))
+    assert len(from_sets) > 100 and list(from_sets) == list(from_models)
