@@ -119,6 +119,7 @@ def find_passes(
     short = periods <= _SHORT_PERIOD_S
     slow = ~short & (rev_per_day < _SLOW_REV_PER_DAY) & (ecc < 0.05)
     other = ~short & ~slow
+    look_back = np.where((ecc < 0.05) & short, 0.5, 1.0) * periods  # s
     catalog_numbers = np.array([int(sr.satnum) for sr in satrecs], dtype=np.int64)
     parts: list[dict[str, np.ndarray]] = []
     # The rest is split by period so that each part looks back and ahead only as far as it needs.
@@ -126,10 +127,11 @@ def find_passes(
                         (other & (periods > 8 * 3600.0) & (periods <= 13 * 3600.0), _OTHER_STEP_S),
                         (other & (periods > 13 * 3600.0), _OTHER_STEP_S)):
         members = np.flatnonzero(group)
+        # Chunks of similar look-back, so that one eccentric orbit does not lengthen its chunk-mates' search.
+        members = members[np.argsort(look_back[members], kind="stable")]
         for c0 in range(0, len(members), _CHUNK):
             idx = members[c0 : c0 + _CHUNK]
-            look = np.where((ecc[idx] < 0.05) & short[idx], 0.5, 1.0) * periods[idx]
-            extension = float(min(np.max(look), SECONDS_PER_DAY))
+            extension = float(min(np.max(look_back[idx]), SECONDS_PER_DAY))
             parts.append(_search([satrecs[i] for i in idx], catalog_numbers[idx], observer, start, end, horizon,
                                  ut1_utc, fine_step_s, step, extension))
     return PassList.concat(start, window_s, parts)
