@@ -50,6 +50,7 @@ class Kinematics:
     el_accel: np.ndarray  #: d2(elevation)/dt2 (deg/s^2)
     az_accel: np.ndarray  #: d2(azimuth)/dt2 (deg/s^2)
     f_rate_err: np.ndarray  #: bound on the error of ``f_rate`` from SGP4's velocity (deg/s)
+    s_rate_err: np.ndarray  #: bound on the error of ``s_rate`` from SGP4's velocity (1/s)
     f_accel_err: np.ndarray  #: bound on the error of ``f_accel`` from the approximate acceleration (deg/s^2)
 
 
@@ -100,7 +101,7 @@ class PairEvaluator:
         """Angles and derivatives at each pair (``sat`` intp, ``t`` float seconds; see :meth:`teme`)."""
         if not len(sat):
             empty = np.empty(0)
-            return Kinematics(*(empty for _ in range(13)))
+            return Kinematics(*(empty for _ in range(14)))
         r, v, err = self.teme(sat, t, grouped)
         fr = self.fr0 + t / SECONDS_PER_DAY
         pos, vel = teme_to_itrs(r, v, self.jd0, fr, self.ut1_utc)
@@ -141,6 +142,7 @@ def topocentric_derivatives(frame: TopocentricFrame, horizon: HorizonTable, pos:
         hz = np.sqrt(q)
         f_accel_err = (_ACC_REL * _DEG) * (-g * np.sqrt(rad2)) / hz
         f_rate_err = np.full_like(hz, _VEL_ERR_KM_S * _DEG) / hz
+        s_rate_err = _VEL_ERR_KM_S * (1.0 + np.abs(s)) / rho
     el = np.degrees(np.arcsin(np.clip(s, -1.0, 1.0)))
     az = np.degrees(np.arctan2(e, n)) % 360.0
     f = el - horizon.min_elevation_array(az)
@@ -155,7 +157,7 @@ def topocentric_derivatives(frame: TopocentricFrame, horizon: HorizonTable, pos:
     bad = err != 0
     if bad.any():
         f[bad] = -np.inf
-        for a in (el, el1, el2, f_rate, f_accel, s1, s2, az1, az2, f_rate_err, f_accel_err):
+        for a in (el, el1, el2, f_rate, f_accel, s1, s2, az1, az2, f_rate_err, s_rate_err, f_accel_err):
             a[bad] = np.nan
     return Kinematics(el, az, el1 * _DEG, f, f_rate, f_accel, s1, s2, az1 * _DEG, el2 * _DEG, az2 * _DEG,
-                      f_rate_err, f_accel_err)
+                      f_rate_err, s_rate_err, f_accel_err)

@@ -47,6 +47,9 @@ _CROSSING_SAFETY = 0.5
 _TOP_STEP_S = 0.05
 #: Margin on the third derivative of f estimated from the change of f'' between two rounds.
 _JERK_MARGIN = 3.0
+#: Largest error of sin(elevation) (~radians of elevation) that a maximum's final step may bring from
+#: the error of s' (SGP4's velocity): 3.5e-8 rad = 2e-6 deg.
+_TOP_S_TOL = 3.5e-8
 #: A hidden peak whose modelled height stays this far below the horizon (deg) is given up.
 _HOPELESS_DEG = -2.0
 
@@ -150,7 +153,8 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
             cross_err = (k.f_rate_err + curve) * step / np.abs(k.f_rate)
         prev_t[active], prev_accel[active] = ca, k.f_accel
         close = ok & np.where(cross, (step < _QUADRATIC_S) & (cross_err < _CROSSING_SAFETY * tl),
-                              (kd == TOP) & (step < _TOP_STEP_S) & (predicted < _SAFETY * tl) & (step < 0.25 * ps))
+                              (kd == TOP) & (step < _TOP_STEP_S) & (predicted < _SAFETY * tl) & (step < 0.25 * ps)
+                              & (k.s_rate_err * step < _TOP_S_TOL * np.cos(np.radians(k.el))))
         done = (ok & (step < tl)) | close | (hi - lo < tl) | (g == 0.0) | ~np.isfinite(g)
         if close.any():  # the values at the accepted root, carried over from ``ca`` by Taylor's formula
             dt = np.where(close, newton - ca, 0.0)
