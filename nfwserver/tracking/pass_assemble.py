@@ -86,6 +86,31 @@ def _middle_of_pass(sat: np.ndarray, t: np.ndarray, rising: np.ndarray, cu: Inte
     return guess
 
 
+def _within_window(br: Brackets, win_lo: float, win_hi: float) -> Brackets:
+    """``br`` without the brackets of passes that cannot overlap ``[win_lo, win_hi]``, before refining.
+
+    A hidden peak holds its whole pass.  A set bracket ending before ``win_lo`` ends a pass that is
+    over before the window, and a rise bracket starting after ``win_hi`` starts one that begins
+    after it: both go, with the rise just before (set just after) them of the same satellite.
+    """
+    pk, cr = br.peaks, br.crossings
+    peaks = Intervals(*(x[(pk.b >= win_lo) & (pk.a <= win_hi)] for x in (pk.sat, pk.a, pk.b, pk.ga, pk.gb)))
+    n = len(cr)
+    if not n:
+        return Brackets(cr, peaks, br.culminations)
+    order = np.lexsort((cr.a, cr.sat))
+    sat, a, b, rising = cr.sat[order], cr.a[order], cr.b[order], cr.ga[order] <= 0.0
+    drop = (~rising & (np.maximum(a, b) < win_lo)) | (rising & (np.minimum(a, b) > win_hi))
+    same_prev = np.zeros(n, dtype=bool)
+    same_prev[1:] = sat[1:] == sat[:-1]
+    # the rise before a dropped early set, the set after a dropped late rise
+    drop[:-1] |= drop[1:] & ~rising[1:] & rising[:-1] & same_prev[1:]
+    drop[1:] |= drop[:-1] & rising[:-1] & ~rising[1:] & same_prev[1:]
+    keep = np.sort(order[~drop])
+    crossings = Intervals(*(x[keep] for x in (cr.sat, cr.a, cr.b, cr.ga, cr.gb)))
+    return Brackets(crossings, peaks, br.culminations)
+
+
 def _pair(sat: np.ndarray, t: np.ndarray, rising: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Passes as (sat, index of the rise or -1, index of the set or -1), events sorted by (sat, t)."""
     n = len(sat)
@@ -107,6 +132,7 @@ def assemble(ev: PairEvaluator, br: Brackets, flat: bool, catalog_numbers: np.nd
              win_hi: float) -> dict[str, np.ndarray]:
     """Passes overlapping ``[win_lo, win_hi]`` (s after the search start) from the brackets of a search,
     as :class:`~nfwserver.tracking.pass_records.PassList` columns (unsorted)."""
+    br = _within_window(br, win_lo, win_hi)
     sat, t, rising, az, el, el_rate, tops, (cu_t, cu_el) = _events(ev, br, flat)
     order = np.lexsort((t, sat))
     sat, t, rising, az, el, el_rate = sat[order], t[order], rising[order], az[order], el[order], el_rate[order]
