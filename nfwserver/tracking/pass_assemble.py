@@ -47,6 +47,11 @@ def _events(ev: PairEvaluator, br: Brackets, flat: bool):
     m = len(up)
     with np.errstate(invalid="ignore", divide="ignore"):
         half = np.sqrt(2.0 * f_top / -sol.f_accel[nc:][up])
+        if flat and ev.horizon.minimum == 0.0:
+            # The height above the horizontal plane follows a parabola over the whole pass far more
+            # closely than the elevation does (which is peaked for high passes).
+            half_up = np.sqrt(2.0 * sol.best_up[nc:][up] / -sol.best_up_accel[nc:][up])
+            half = np.where(np.isfinite(half_up), half_up, half)
     s2 = solve(ev, np.concatenate((cu.sat, ps, ps)), np.concatenate((cu.a, pk.a[up], top_t)),
                np.concatenate((cu.b, top_t, pk.b[up])), np.concatenate((cu.ga, np.full(m, -1.0), f_top)),
                np.concatenate((cu.gb, f_top, np.full(m, -1.0))),

@@ -51,6 +51,8 @@ class Kinematics:
     az_accel: np.ndarray  #: d2(azimuth)/dt2 (deg/s^2)
     f_rate_err: np.ndarray  #: bound on the error of ``f_rate`` from SGP4's velocity (deg/s)
     s_rate_err: np.ndarray  #: bound on the error of ``s_rate`` from SGP4's velocity (1/s)
+    up: np.ndarray  #: height above the observer's horizontal plane (km)
+    up_accel: np.ndarray  #: its second derivative (km/s^2)
     f_accel_err: np.ndarray  #: bound on the error of ``f_accel`` from the approximate acceleration (deg/s^2)
 
 
@@ -101,7 +103,7 @@ class PairEvaluator:
         """Angles and derivatives at each pair (``sat`` intp, ``t`` float seconds; see :meth:`teme`)."""
         if not len(sat):
             empty = np.empty(0)
-            return Kinematics(*(empty for _ in range(14)))
+            return Kinematics(*(empty for _ in range(16)))
         r, v, err = self.teme(sat, t, grouped)
         fr = self.fr0 + t / SECONDS_PER_DAY
         pos, vel = teme_to_itrs(r, v, self.jd0, fr, self.ut1_utc)
@@ -157,7 +159,7 @@ def topocentric_derivatives(frame: TopocentricFrame, horizon: HorizonTable, pos:
     bad = err != 0
     if bad.any():
         f[bad] = -np.inf
-        for a in (el, el1, el2, f_rate, f_accel, s1, s2, az1, az2, f_rate_err, s_rate_err, f_accel_err):
+        for a in (el, el1, el2, f_rate, f_accel, s1, s2, az1, az2, f_rate_err, s_rate_err, u, u2, f_accel_err):
             a[bad] = np.nan
     return Kinematics(el, az, el1 * _DEG, f, f_rate, f_accel, s1, s2, az1 * _DEG, el2 * _DEG, az2 * _DEG,
-                      f_rate_err, s_rate_err, f_accel_err)
+                      f_rate_err, s_rate_err, u, u2, f_accel_err)

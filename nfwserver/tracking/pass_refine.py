@@ -65,6 +65,8 @@ class Solution:
     el_rate: np.ndarray  #: d(elevation)/dt at ``t`` (deg/s)
     best_f: np.ndarray  #: the largest f seen while iterating (deg)
     best_t: np.ndarray  #: where it was seen (s)
+    best_up: np.ndarray  #: height above the horizontal plane there (km)
+    best_up_accel: np.ndarray  #: its second derivative there (km/s^2)
     f_accel: np.ndarray  #: d2f/dt2 at ``t`` (deg/s^2)
     rounds: int  #: iterations the slowest bracket needed
 
@@ -102,6 +104,8 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
     f_accel_out = np.full(n, np.nan)
     best_f = np.full(n, -np.inf)
     best_t = c.copy()
+    best_up = np.full(n, np.nan)
+    best_up_accel = np.full(n, np.nan)
     prev_step = np.full(n, np.inf)  # the previous round's Newton step (inf after a bisection)
     prev_t = np.full(n, np.nan)  # the previous round's time and f'' there (crossings)
     prev_accel = np.full(n, np.nan)
@@ -121,6 +125,8 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
         better = f > best_f[active]
         best_f[active] = np.where(better, f, best_f[active])
         best_t[active] = np.where(better, ca, best_t[active])
+        best_up[active] = np.where(better, k.up, best_up[active])
+        best_up_accel[active] = np.where(better, k.up_accel, best_up_accel[active])
         aa, bb, gaa = a[active], b[active], ga[active]
         same_as_a = (g > 0.0) == (gaa > 0.0)
         a[active] = aa = np.where(same_as_a, ca, aa)
@@ -179,4 +185,4 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
         c[active] = np.where(ok, newton, 0.5 * (lo + hi))
         active = active[~done]
     return Solution(t_out[undo], el_out[undo], az_out[undo], f_out[undo], el_rate_out[undo], best_f[undo],
-                    best_t[undo], f_accel_out[undo], rounds)
+                    best_t[undo], best_up[undo], best_up_accel[undo], f_accel_out[undo], rounds)
