@@ -36,7 +36,8 @@ def _events(ev: PairEvaluator, br: Brackets, flat: bool):
     nc, npk = len(cr), len(pk)
     kind = np.concatenate((np.full(nc, CROSSING), np.full(npk, TOP if flat else F_TOP)))
     sat_, a, b, ga, gb = (np.concatenate((getattr(cr, x), getattr(pk, x))) for x in ("sat", "a", "b", "ga", "gb"))
-    sol = solve(ev, sat_, a, b, ga, gb, kind, np.concatenate((np.zeros(nc, dtype=bool), np.ones(npk, dtype=bool))))
+    sol = solve(ev, sat_, a, b, ga, gb, kind, np.concatenate((np.zeros(nc, dtype=bool), np.ones(npk, dtype=bool))),
+                guess=np.concatenate((cr.guess, pk.guess)))
     sat, t, rising = cr.sat, sol.t[:nc], cr.ga <= 0.0
     az, el, el_rate = sol.az[:nc], sol.el[:nc], sol.el_rate[:nc]
     up = np.flatnonzero(sol.best_f[nc:] > 0.0)
@@ -99,7 +100,7 @@ def _within_window(br: Brackets, win_lo: float, win_hi: float) -> Brackets:
     after it: both go, with the rise just before (set just after) them of the same satellite.
     """
     pk, cr = br.peaks, br.crossings
-    peaks = Intervals(*(x[(pk.b >= win_lo) & (pk.a <= win_hi)] for x in (pk.sat, pk.a, pk.b, pk.ga, pk.gb)))
+    peaks = pk.select((pk.b >= win_lo) & (pk.a <= win_hi))
     n = len(cr)
     if not n:
         return Brackets(cr, peaks, br.culminations)
@@ -112,8 +113,7 @@ def _within_window(br: Brackets, win_lo: float, win_hi: float) -> Brackets:
     drop[:-1] |= drop[1:] & ~rising[1:] & rising[:-1] & same_prev[1:]
     drop[1:] |= drop[:-1] & rising[:-1] & ~rising[1:] & same_prev[1:]
     keep = np.sort(order[~drop])
-    crossings = Intervals(*(x[keep] for x in (cr.sat, cr.a, cr.b, cr.ga, cr.gb)))
-    return Brackets(crossings, peaks, br.culminations)
+    return Brackets(cr.select(keep), peaks, br.culminations)
 
 
 def _pair(sat: np.ndarray, t: np.ndarray, rising: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
