@@ -2,6 +2,7 @@
 
 Order of work (every step batched over all satellites of the search):
 
+0. brackets of passes that cannot overlap the window are dropped (:func:`_within_window`);
 1. crossings and hidden peaks are refined together (:func:`nfwserver.tracking.pass_refine.solve`);
 2. culminations are refined next, each from the middle of its (short) pass's refined rise and set
    as first guess, together with the two crossings of each hidden peak that rose above the horizon;

@@ -15,7 +15,9 @@ sloping horizon the step is ``fine_step_s`` (60 s) at a low orbit's rate.
 Between consecutive samples, the function ``f = elevation - horizon(azimuth)`` and its analytic
 rate give three kinds of bracket for :mod:`nfwserver.tracking.pass_refine`:
 
-- **crossings**: ``f`` changes sign (an AOS or a LOS);
+- **crossings**: ``f`` changes sign (an AOS or a LOS); under a flat horizon at 0 deg each gets a
+  first guess, the root of the cubic Hermite interpolant of the height above the observer's
+  horizontal plane (smooth, nearly sinusoidal, unlike the elevation);
 - **hidden peaks**: ``f`` is negative at both ends but turns from rising to falling in between,
   so a short pass may lie inside;
 - **culminations**: the elevation turns from rising to falling with ``f`` positive at an end

@@ -9,10 +9,11 @@ The search runs in three stages, each batched over every satellite of the catalo
 
 1. :mod:`~nfwserver.tracking.pass_screen`: a coarse grid proves most of the time invisible and
    brackets every crossing, every possible hidden short pass and every culmination;
-2. :mod:`~nfwserver.tracking.pass_refine`: safeguarded Newton iteration with analytic rates
-   refines all brackets together (crossings to 0.1 ms, maxima to 1 ms);
-3. :mod:`~nfwserver.tracking.pass_assemble`: rises and sets are paired into passes and each
-   pass gets its TCA.
+2. :mod:`~nfwserver.tracking.pass_refine`: safeguarded iteration with analytic derivatives
+   (second-order steps for crossings, Newton steps for maxima) refines the brackets of every
+   satellite together (crossings to 0.1 ms, maxima to 1 ms);
+3. :mod:`~nfwserver.tracking.pass_assemble`: crossings first, then the culminations from the
+   middle of their pass; rises and sets are paired into passes and each pass gets its TCA.
 
 Satellites are searched in groups of similar orbits (low, geosynchronous-like, the rest), each
 with its own grid step and look-back.  Passes already in progress at ``start`` are reported with
