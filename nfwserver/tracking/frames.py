@@ -48,22 +48,32 @@ def teme_to_itrs(r: np.ndarray, v: np.ndarray | None, jd, fr, ut1_utc: float = 0
 class TopocentricFrame:
     """An observer's east-north-up frame as numpy vectors, for many positions at once."""
 
-    __slots__ = ("origin", "east", "north", "up")
+    __slots__ = ("origin", "east", "north", "up", "_axes")
 
     def __init__(self, observer: Observer) -> None:
         self.origin = np.array(observer.itrs_km())
         self.east, self.north, self.up = (np.array(b) for b in observer.enu_basis())
+        self._axes = tuple(tuple(float(c) for c in b) for b in observer.enu_basis())
 
     def enu(self, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(east, north, up) components (km) of ``pos - origin`` for ITRS positions (..., 3)."""
-        d = pos - self.origin
-        return d @ self.east, d @ self.north, d @ self.up
+        return self.components(pos - self.origin)
+
+    def components(self, vectors: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(east, north, up) components of ITRS vectors (..., 3), in their unit (km, km/s, ...).
+
+        Written as sums of products rather than matrix products: numpy hands a large matrix product to
+        BLAS, whose worker threads then keep spinning on the other cores after a few microseconds of work.
+        """
+        x, y, z = vectors[..., 0], vectors[..., 1], vectors[..., 2]
+        (ex, ey, ez), (nx, ny, nz), (ux, uy, uz) = self._axes
+        return x * ex + y * ey + z * ez, x * nx + y * ny + z * nz, x * ux + y * uy + z * uz
 
     def look_angles(self, pos: np.ndarray, vel: np.ndarray | None = None
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
         """Azimuth (deg), elevation (deg), range (km), range rate (km/s; None without ``vel``)."""
         d = pos - self.origin
-        east, north, up = d @ self.east, d @ self.north, d @ self.up
+        east, north, up = self.components(d)
         rng = np.sqrt(east * east + north * north + up * up)
         az = np.degrees(np.arctan2(east, north)) % 360.0
         el = np.degrees(np.arcsin(up / rng))

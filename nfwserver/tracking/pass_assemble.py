@@ -2,9 +2,10 @@
 
 Order of work (every step batched over all satellites of the search):
 
-1. crossings, hidden peaks and culminations are refined together
-   (:func:`nfwserver.tracking.pass_refine.solve`);
-2. hidden peaks that rise above the horizon give two more crossings each, refined next;
+0. brackets of passes that cannot overlap the window are dropped (:func:`_within_window`);
+1. crossings and hidden peaks are refined together (:func:`nfwserver.tracking.pass_refine.solve`);
+2. culminations are refined next, each from the middle of its (short) pass's refined rise and set
+   as first guess, together with the two crossings of each hidden peak that rose above the horizon;
 3. rises and sets are paired per satellite (a set with no rise before it in the search is a
    pass whose AOS lies before the search span, a final rise one whose LOS lies after it);
 4. passes overlapping the window keep the maxima refined in their culmination brackets; the
@@ -21,47 +22,99 @@ import numpy as np
 
 from nfwserver.tracking.pass_kinematics import PairEvaluator
 from nfwserver.tracking.pass_refine import CROSSING, F_TOP, TOP, solve
-from nfwserver.tracking.pass_screen import Brackets
+from nfwserver.tracking.pass_screen import Brackets, Intervals
 
 #: Key spacing per satellite when sorting (sat, t) pairs as one float (s; far above any span).
 _KEY = 1e8
+#: Passes shorter than this (s) get the middle of their rise and set as the first guess of their TCA.
+_SHORT_PASS_S = 1800.0
 
 
 def _events(ev: PairEvaluator, br: Brackets, flat: bool):
-    """Refined crossings (sat, t, rising, az, el, el rate) and the maxima of the hidden peaks that rose."""
+    """Refined crossings (sat, t, rising, az, el, el rate), the maxima of the hidden peaks that rose,
+    and the refined culminations (t, el)."""
     cr, pk, cu = br.crossings, br.peaks, br.culminations
     nc, npk = len(cr), len(pk)
-    kind = np.concatenate((np.full(nc, CROSSING), np.full(npk, TOP if flat else F_TOP), np.full(len(cu), TOP)))
-    sat_, a, b, ga, gb = (np.concatenate((getattr(cr, x), getattr(pk, x), getattr(cu, x)))
-                          for x in ("sat", "a", "b", "ga", "gb"))
-    sol = solve(ev, sat_, a, b, ga, gb, kind,
-                np.concatenate((np.zeros(nc, dtype=bool), np.ones(npk, dtype=bool), np.zeros(len(cu), dtype=bool))))
-    culminations = (sol.t[nc + npk:], sol.el[nc + npk:])
-    sol.best_f, sol.best_t, sol.t, sol.el, sol.f_accel = (x[: nc + npk] for x in (
-        sol.best_f, sol.best_t, sol.t, sol.el, sol.f_accel))
+    kind = np.concatenate((np.full(nc, CROSSING), np.full(npk, TOP if flat else F_TOP)))
+    sat_, a, b, ga, gb = (np.concatenate((getattr(cr, x), getattr(pk, x))) for x in ("sat", "a", "b", "ga", "gb"))
+    sol = solve(ev, sat_, a, b, ga, gb, kind, np.concatenate((np.zeros(nc, dtype=bool), np.ones(npk, dtype=bool))),
+                guess=np.concatenate((cr.guess, pk.guess)))
     sat, t, rising = cr.sat, sol.t[:nc], cr.ga <= 0.0
     az, el, el_rate = sol.az[:nc], sol.el[:nc], sol.el_rate[:nc]
     up = np.flatnonzero(sol.best_f[nc:] > 0.0)
     tops = (pk.sat[up], sol.t[nc:][up], sol.el[nc:][up])
-    if len(up):
-        ps, top_t, f_top = pk.sat[up], sol.best_t[nc:][up], sol.best_f[nc:][up]
-        m = len(up)
-        # First guesses from the parabola through the top: f_top + f''/2 dt^2 = 0.
-        with np.errstate(invalid="ignore", divide="ignore"):
-            half = np.sqrt(2.0 * f_top / -sol.f_accel[nc:][up])
-        s2 = solve(ev, np.concatenate((ps, ps)), np.concatenate((pk.a[up], top_t)),
-                   np.concatenate((top_t, pk.b[up])), np.concatenate((np.full(m, -1.0), f_top)),
-                   np.concatenate((f_top, np.full(m, -1.0))), np.full(2 * m, CROSSING),
-                   guess=np.concatenate((top_t - half, top_t + half)))
+    # Second round: culminations (first guess: the middle of their pass's refined rise and set) and
+    # the crossings of the hidden peaks that rose (first guesses from the parabola through the top).
+    ps, top_t, f_top = pk.sat[up], sol.best_t[nc:][up], sol.best_f[nc:][up]
+    m = len(up)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        half = np.sqrt(2.0 * f_top / -sol.f_accel[nc:][up])
+        if flat and ev.horizon.minimum == 0.0:
+            # The height above the horizontal plane follows a parabola over the whole pass far more
+            # closely than the elevation does (which is peaked for high passes).
+            half_up = np.sqrt(2.0 * sol.best_up[nc:][up] / -sol.best_up_accel[nc:][up])
+            half = np.where(np.isfinite(half_up), half_up, half)
+    s2 = solve(ev, np.concatenate((cu.sat, ps, ps)), np.concatenate((cu.a, pk.a[up], top_t)),
+               np.concatenate((cu.b, top_t, pk.b[up])), np.concatenate((cu.ga, np.full(m, -1.0), f_top)),
+               np.concatenate((cu.gb, f_top, np.full(m, -1.0))),
+               np.concatenate((np.full(len(cu), TOP), np.full(2 * m, CROSSING))),
+               guess=np.concatenate((_middle_of_pass(sat, t, rising, cu), top_t - half, top_t + half)))
+    culminations = (s2.t[: len(cu)], s2.el[: len(cu)])
+    if m:
         sat = np.concatenate((sat, ps, ps))
-        t = np.concatenate((t, s2.t))
+        t = np.concatenate((t, s2.t[len(cu):]))
         rising = np.concatenate((rising, np.ones(m, dtype=bool), np.zeros(m, dtype=bool)))
-        az = np.concatenate((az, s2.az))
-        el = np.concatenate((el, s2.el))
-        el_rate = np.concatenate((el_rate, s2.el_rate))
+        az = np.concatenate((az, s2.az[len(cu):]))
+        el = np.concatenate((el, s2.el[len(cu):]))
+        el_rate = np.concatenate((el_rate, s2.el_rate[len(cu):]))
     if not flat:
         tops = (tops[0][:0], tops[1][:0], tops[2][:0])  # f's maximum is not the elevation's
     return sat, t, rising, az, el, el_rate, tops, culminations
+
+
+def _middle_of_pass(sat: np.ndarray, t: np.ndarray, rising: np.ndarray, cu: Intervals) -> np.ndarray:
+    """For each culmination bracket, the middle of the pass it lies in (a rise followed by a set
+    around one of its ends), when that pass is shorter than ``_SHORT_PASS_S`` and the middle lies in
+    the bracket; else NaN.  (The maximum of a short pass lies within seconds of its middle.)"""
+    guess = np.full(len(cu), np.nan)
+    if not len(t) or not len(cu):
+        return guess
+    order = np.lexsort((t, sat))
+    keys = sat[order] * _KEY + t[order]
+    t_s, up_s, sat_s = t[order], rising[order], sat[order]
+    n = len(keys)
+    for end in (cu.b, cu.a):
+        i = np.searchsorted(keys, cu.sat * _KEY + end)
+        r, s = np.clip(i - 1, 0, n - 1), np.clip(i, 0, n - 1)
+        inside = (i >= 1) & (i < n) & (sat_s[r] == cu.sat) & (sat_s[s] == cu.sat) & up_s[r] & ~up_s[s]
+        mid = 0.5 * (t_s[r] + t_s[s])
+        inside &= (t_s[s] - t_s[r] < _SHORT_PASS_S) & (mid > np.minimum(cu.a, cu.b)) & (mid < np.maximum(cu.a, cu.b))
+        guess = np.where(inside, mid, guess)
+    return guess
+
+
+def _within_window(br: Brackets, win_lo: float, win_hi: float) -> Brackets:
+    """``br`` without the brackets of passes that cannot overlap ``[win_lo, win_hi]``, before refining.
+
+    A hidden peak holds its whole pass.  A set bracket ending before ``win_lo`` ends a pass that is
+    over before the window, and a rise bracket starting after ``win_hi`` starts one that begins
+    after it: both go, with the rise just before (set just after) them of the same satellite.
+    """
+    pk, cr = br.peaks, br.crossings
+    peaks = pk.select((pk.b >= win_lo) & (pk.a <= win_hi))
+    n = len(cr)
+    if not n:
+        return Brackets(cr, peaks, br.culminations)
+    order = np.lexsort((cr.a, cr.sat))
+    sat, a, b, rising = cr.sat[order], cr.a[order], cr.b[order], cr.ga[order] <= 0.0
+    drop = (~rising & (np.maximum(a, b) < win_lo)) | (rising & (np.minimum(a, b) > win_hi))
+    same_prev = np.zeros(n, dtype=bool)
+    same_prev[1:] = sat[1:] == sat[:-1]
+    # the rise before a dropped early set, the set after a dropped late rise
+    drop[:-1] |= drop[1:] & ~rising[1:] & rising[:-1] & same_prev[1:]
+    drop[1:] |= drop[:-1] & rising[:-1] & ~rising[1:] & same_prev[1:]
+    keep = np.sort(order[~drop])
+    return Brackets(cr.select(keep), peaks, br.culminations)
 
 
 def _pair(sat: np.ndarray, t: np.ndarray, rising: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -85,6 +138,7 @@ def assemble(ev: PairEvaluator, br: Brackets, flat: bool, catalog_numbers: np.nd
              win_hi: float) -> dict[str, np.ndarray]:
     """Passes overlapping ``[win_lo, win_hi]`` (s after the search start) from the brackets of a search,
     as :class:`~nfwserver.tracking.pass_records.PassList` columns (unsorted)."""
+    br = _within_window(br, win_lo, win_hi)
     sat, t, rising, az, el, el_rate, tops, (cu_t, cu_el) = _events(ev, br, flat)
     order = np.lexsort((t, sat))
     sat, t, rising, az, el, el_rate = sat[order], t[order], rising[order], az[order], el[order], el_rate[order]

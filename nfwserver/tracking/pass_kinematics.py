@@ -8,9 +8,10 @@ pair: elevation and azimuth (deg), their rates (deg/s) and second derivatives (d
 through near-zenith passes, where the elevation itself has an almost sharp peak.
 
 Second derivatives use an approximate Earth-fixed acceleration (two-body gravity plus the
-centrifugal and Coriolis terms; J2 and drag, about 0.1 % of it, are left out).  They only steer
-Newton iterations, whose results are fixed by the first derivatives, so the approximation costs
-at most an extra iteration, never accuracy.  Times are seconds after a reference UTC instant.
+centrifugal and Coriolis terms; J2 and drag, at most ~0.5 % of it, are left out).  They steer the
+refinement's steps, and each pair carries bounds on the errors of ``f'`` (SGP4's velocity differs
+from the derivative of its position by up to ~2 m/s) and ``f''`` so that the refinement can tell
+when a step is final.  Times are seconds after a reference UTC instant.
 """
 
 from __future__ import annotations
@@ -25,6 +26,12 @@ from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer
 
 _DEG = 180.0 / np.pi
+#: Bound on the acceleration SGP4 adds to two-body gravity (J2 and its short-period terms, drag),
+#: relative to the two-body term (J2 alone gives at most ~3 * 1.5 * J2 = 0.5 % at the surface).
+_ACC_REL = 6e-3
+#: Bound (km/s) on how far SGP4's velocity differs from the time derivative of its position (its
+#: short-period terms are not differentiated exactly): measured up to 2.1 m/s over the catalog.
+_VEL_ERR_KM_S = 3e-3
 
 
 @dataclass
@@ -41,6 +48,12 @@ class Kinematics:
     s_accel: np.ndarray
     az_rate: np.ndarray  #: d(azimuth)/dt (deg/s)
     el_accel: np.ndarray  #: d2(elevation)/dt2 (deg/s^2)
+    az_accel: np.ndarray  #: d2(azimuth)/dt2 (deg/s^2)
+    f_rate_err: np.ndarray  #: bound on the error of ``f_rate`` from SGP4's velocity (deg/s)
+    s_rate_err: np.ndarray  #: bound on the error of ``s_rate`` from SGP4's velocity (1/s)
+    up: np.ndarray  #: height above the observer's horizontal plane (km)
+    up_accel: np.ndarray  #: its second derivative (km/s^2)
+    f_accel_err: np.ndarray  #: bound on the error of ``f_accel`` from the approximate acceleration (deg/s^2)
 
 
 class PairEvaluator:
@@ -90,7 +103,7 @@ class PairEvaluator:
         """Angles and derivatives at each pair (``sat`` intp, ``t`` float seconds; see :meth:`teme`)."""
         if not len(sat):
             empty = np.empty(0)
-            return Kinematics(*(empty for _ in range(10)))
+            return Kinematics(*(empty for _ in range(16)))
         r, v, err = self.teme(sat, t, grouped)
         fr = self.fr0 + t / SECONDS_PER_DAY
         pos, vel = teme_to_itrs(r, v, self.jd0, fr, self.ut1_utc)
@@ -110,9 +123,9 @@ def topocentric_derivatives(frame: TopocentricFrame, horizon: HorizonTable, pos:
     acc[:, 1] = g * y - 2.0 * w * vel[:, 0] + w * w * y
     acc[:, 2] = g * z
     d = pos - frame.origin
-    e, n, u = d @ frame.east, d @ frame.north, d @ frame.up
-    e1, n1, u1 = vel @ frame.east, vel @ frame.north, vel @ frame.up
-    e2, n2, u2 = acc @ frame.east, acc @ frame.north, acc @ frame.up
+    e, n, u = frame.components(d)
+    e1, n1, u1 = frame.components(vel)
+    e2, n2, u2 = frame.components(acc)
     q = e * e + n * n
     rho = np.sqrt(q + u * u)
     rho1 = (e * e1 + n * n1 + u * u1) / rho
@@ -126,6 +139,12 @@ def topocentric_derivatives(frame: TopocentricFrame, horizon: HorizonTable, pos:
         el2 = (s2 + s * el1 * el1) / cos_el
         az1 = (n * e1 - e * n1) / q
         az2 = (n * e2 - e * n2) / q - az1 * 2.0 * (e * e1 + n * n1) / q
+        # The acceleration left out (J2, drag) is under _ACC_REL of the two-body one; it enters f''
+        # divided by the horizontal distance (and scaled by the horizon's slope).
+        hz = np.sqrt(q)
+        f_accel_err = (_ACC_REL * _DEG) * (-g * np.sqrt(rad2)) / hz
+        f_rate_err = np.full_like(hz, _VEL_ERR_KM_S * _DEG) / hz
+        s_rate_err = _VEL_ERR_KM_S * (1.0 + np.abs(s)) / rho
     el = np.degrees(np.arcsin(np.clip(s, -1.0, 1.0)))
     az = np.degrees(np.arctan2(e, n)) % 360.0
     f = el - horizon.min_elevation_array(az)
@@ -135,9 +154,12 @@ def topocentric_derivatives(frame: TopocentricFrame, horizon: HorizonTable, pos:
         slope = horizon.slope_array(az)
         f_rate = (el1 - slope * az1) * _DEG
         f_accel = (el2 - slope * az2) * _DEG
+        f_accel_err = f_accel_err * (1.0 + np.abs(slope))
+        f_rate_err = f_rate_err * (1.0 + np.abs(slope))
     bad = err != 0
     if bad.any():
         f[bad] = -np.inf
-        for a in (el, el1, el2, f_rate, f_accel, s1, s2, az1):
+        for a in (el, el1, el2, f_rate, f_accel, s1, s2, az1, az2, f_rate_err, s_rate_err, u, u2, f_accel_err):
             a[bad] = np.nan
-    return Kinematics(el, az, el1 * _DEG, f, f_rate, f_accel, s1, s2, az1 * _DEG, el2 * _DEG)
+    return Kinematics(el, az, el1 * _DEG, f, f_rate, f_accel, s1, s2, az1 * _DEG, el2 * _DEG, az2 * _DEG,
+                      f_rate_err, s_rate_err, u, u2, f_accel_err)

@@ -8,14 +8,17 @@ One solver serves three problems, mixed freely in one batch:
 - ``F_TOP``: the maximum of ``f`` under a non-flat horizon, as the root of ``df/dt``.
 
 Each round evaluates every unfinished bracket at once (:class:`PairEvaluator`: one compiled
-SGP4 call per satellite), takes a Newton step with the analytic derivative, and falls back to
-bisection when the step would leave the bracket (or, for a maximum, when the curvature has the
-wrong sign).  A bracket is finished when its Newton step is below the tolerance or its width is,
-or when the step is small and the error quadratic convergence predicts for it (from the analytic
-f'' of a crossing, or the steps seen so far towards a maximum) is far below the tolerance: the
-root is then the Newton step's end, with the values there from a second-order Taylor series;
-finished brackets leave the batch, so the hard ones (grazing passes, long high passes) iterate
-as long as they need without slowing the rest.  Hidden-peak brackets are also dropped as soon as
+SGP4 call per satellite).  A crossing steps to the root of the second-order Taylor polynomial of
+``f`` (analytic f' and f''; cubic convergence), a maximum takes a Newton step; either falls back
+to bisection when the step would leave the bracket (or, for a maximum, when the curvature has the
+wrong sign).  A bracket is finished when its step is below the tolerance or its width is, or when
+the step is small and the error bounded for it is well below the tolerance: for a crossing the
+bounds on the errors of f' (SGP4's velocity is not the exact derivative of its position) and of
+f'' (approximate acceleration), and f''' estimated from two rounds; for a maximum the error that
+the quadratic convergence seen in its last two Newton steps predicts.  The root is then the
+step's end, with the values there from a second-order Taylor series; finished brackets leave the
+batch, so the hard ones (grazing passes, long high passes) iterate as long as they need without
+slowing the rest.  Hidden-peak brackets are also dropped as soon as
 a local quadratic model shows the peak stays more than 2 degrees below the horizon.
 Times are seconds after the search start; angles degrees.
 """
@@ -37,9 +40,16 @@ _MAX_ROUNDS = 80
 #: convergence predicts for it is below ``_SAFETY`` times the tolerance.
 _QUADRATIC_S = 2.0
 _SAFETY = 0.01
+#: A crossing's step is final when the error bounded for it is below this fraction of the tolerance.
+_CROSSING_SAFETY = 0.5
 #: Largest accepted final Newton step (s) towards a maximum (the elevation there comes from a
 #: second-order Taylor series of sin(elevation), exact to ~1e-9 over such a step).
 _TOP_STEP_S = 0.05
+#: Margin on the third derivative of f estimated from the change of f'' between two rounds.
+_JERK_MARGIN = 3.0
+#: Largest error of sin(elevation) (~radians of elevation) that a maximum's final step may bring from
+#: the error of s' (SGP4's velocity): 3.5e-8 rad = 2e-6 deg.
+_TOP_S_TOL = 3.5e-8
 #: A hidden peak whose modelled height stays this far below the horizon (deg) is given up.
 _HOPELESS_DEG = -2.0
 
@@ -55,6 +65,8 @@ class Solution:
     el_rate: np.ndarray  #: d(elevation)/dt at ``t`` (deg/s)
     best_f: np.ndarray  #: the largest f seen while iterating (deg)
     best_t: np.ndarray  #: where it was seen (s)
+    best_up: np.ndarray  #: height above the horizontal plane there (km)
+    best_up_accel: np.ndarray  #: its second derivative there (km/s^2)
     f_accel: np.ndarray  #: d2f/dt2 at ``t`` (deg/s^2)
     rounds: int  #: iterations the slowest bracket needed
 
@@ -92,7 +104,11 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
     f_accel_out = np.full(n, np.nan)
     best_f = np.full(n, -np.inf)
     best_t = c.copy()
+    best_up = np.full(n, np.nan)
+    best_up_accel = np.full(n, np.nan)
     prev_step = np.full(n, np.inf)  # the previous round's Newton step (inf after a bisection)
+    prev_t = np.full(n, np.nan)  # the previous round's time and f'' there (crossings)
+    prev_accel = np.full(n, np.nan)
     active = np.arange(n)
     rounds = 0
     while len(active) and rounds < _MAX_ROUNDS:
@@ -109,6 +125,8 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
         better = f > best_f[active]
         best_f[active] = np.where(better, f, best_f[active])
         best_t[active] = np.where(better, ca, best_t[active])
+        best_up[active] = np.where(better, k.up, best_up[active])
+        best_up_accel[active] = np.where(better, k.up_accel, best_up_accel[active])
         aa, bb, gaa = a[active], b[active], ga[active]
         same_as_a = (g > 0.0) == (gaa > 0.0)
         a[active] = aa = np.where(same_as_a, ca, aa)
@@ -118,18 +136,31 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
         lo, hi = np.minimum(aa, bb), np.maximum(aa, bb)
         with np.errstate(invalid="ignore", divide="ignore"):
             newton = ca - g / g1
+            # Crossings: the root of the second-order Taylor polynomial (Halley-like, cubic convergence).
+            disc = g1 * g1 - 2.0 * g * k.f_accel
+            quad = ca - 2.0 * g / (g1 + np.copysign(np.sqrt(np.maximum(disc, 0.0)), g1))
+            newton = np.where((kd == CROSSING) & (disc > 0.0) & np.isfinite(quad), quad, newton)
         ok = np.isfinite(newton) & (newton > lo) & (newton < hi) & ((kd == CROSSING) | (g1 < 0.0))
         step = np.abs(newton - ca)
         tl = tol[active]
-        # Newton's error after this step is ~C step^2: C = |f''/2f'| for a crossing (analytic), and
-        # step / previous step^2 as observed for any kind once two Newton steps were taken.
         ps = prev_step[active]
-        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            c_seen = np.where(kd == CROSSING, np.abs(k.f_accel / (2.0 * k.f_rate)), step / (ps * ps))
-        predicted = c_seen * step * step
         cross = kd == CROSSING
-        close = ok & (step < np.where(cross, _QUADRATIC_S, _TOP_STEP_S)) & (predicted < _SAFETY * tl) & (
-            cross | ((kd == TOP) & (step < 0.25 * ps)))
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            # A maximum's Newton step leaves an error ~C step^2, C = step / previous step^2 as observed
+            # once two Newton steps were taken.
+            predicted = step / (ps * ps) * step * step
+            # A crossing's step solves the second-order Taylor polynomial of f: its error comes from
+            # the error of f' (SGP4's velocity), of f'' (the approximate acceleration) and from f'''
+            # (the change of f'' since the previous round, with a margin).  Before a second round,
+            # Newton's C = |f''/2f'| stands in for the last two.
+            jerk = _JERK_MARGIN * np.abs((k.f_accel - prev_accel[active]) / (ca - prev_t[active]))
+            curve = np.where(np.isfinite(jerk), (0.5 * k.f_accel_err + jerk * step / 6.0) * step,
+                             0.5 * np.abs(k.f_accel) * step)
+            cross_err = (k.f_rate_err + curve) * step / np.abs(k.f_rate)
+        prev_t[active], prev_accel[active] = ca, k.f_accel
+        close = ok & np.where(cross, (step < _QUADRATIC_S) & (cross_err < _CROSSING_SAFETY * tl),
+                              (kd == TOP) & (step < _TOP_STEP_S) & (predicted < _SAFETY * tl) & (step < 0.25 * ps)
+                              & (k.s_rate_err * step < _TOP_S_TOL * np.cos(np.radians(k.el))))
         done = (ok & (step < tl)) | close | (hi - lo < tl) | (g == 0.0) | ~np.isfinite(g)
         if close.any():  # the values at the accepted root, carried over from ``ca`` by Taylor's formula
             dt = np.where(close, newton - ca, 0.0)
@@ -138,7 +169,7 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
             s_top = np.sin(np.radians(k.el)) + (k.s_rate + 0.5 * k.s_accel * dt) * dt
             el_top = np.degrees(np.arcsin(np.clip(s_top, -1.0, 1.0)))
             el_out[sel] = np.where(kd == CROSSING, el_cross, np.maximum(el_top, k.el))[close]
-            az_out[sel] = ((k.az + k.az_rate * dt) % 360.0)[close]
+            az_out[sel] = ((k.az + (k.az_rate + 0.5 * k.az_accel * dt) * dt) % 360.0)[close]
             f_out[sel] = np.where(kd[close] == CROSSING, 0.0, f[close] + el_out[sel] - k.el[close])
             el_rate_out[sel] = (k.el_rate + k.el_accel * dt)[close]
             up = f_out[sel] > best_f[sel]
@@ -154,4 +185,4 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
         c[active] = np.where(ok, newton, 0.5 * (lo + hi))
         active = active[~done]
     return Solution(t_out[undo], el_out[undo], az_out[undo], f_out[undo], el_rate_out[undo], best_f[undo],
-                    best_t[undo], f_accel_out[undo], rounds)
+                    best_t[undo], best_up[undo], best_up_accel[undo], f_accel_out[undo], rounds)

@@ -15,7 +15,9 @@ sloping horizon the step is ``fine_step_s`` (60 s) at a low orbit's rate.
 Between consecutive samples, the function ``f = elevation - horizon(azimuth)`` and its analytic
 rate give three kinds of bracket for :mod:`nfwserver.tracking.pass_refine`:
 
-- **crossings**: ``f`` changes sign (an AOS or a LOS);
+- **crossings**: ``f`` changes sign (an AOS or a LOS); under a flat horizon at 0 deg each gets a
+  first guess, the root of the cubic Hermite interpolant of the height above the observer's
+  horizontal plane (smooth, nearly sinusoidal, unlike the elevation);
 - **hidden peaks**: ``f`` is negative at both ends but turns from rising to falling in between,
   so a short pass may lie inside;
 - **culminations**: the elevation turns from rising to falling with ``f`` positive at an end
@@ -45,6 +47,9 @@ _FLAT_STEP_S = 1200.0
 _SCREEN_PAIRS = 10000
 
 
+INTERVAL_FIELDS = ("sat", "a", "b", "ga", "gb", "guess")
+
+
 @dataclass
 class Intervals:
     """Brackets ``[a, b]`` (s) of satellite ``sat`` with the bracketed function's values at the ends."""
@@ -54,10 +59,19 @@ class Intervals:
     b: np.ndarray
     ga: np.ndarray
     gb: np.ndarray
+    guess: np.ndarray  #: first guesses of the solution (s; NaN: none)
 
     @staticmethod
     def concat(parts: list[Intervals]) -> Intervals:
-        return Intervals(*(np.concatenate([getattr(p, k) for p in parts]) for k in ("sat", "a", "b", "ga", "gb")))
+        return Intervals(*(np.concatenate([getattr(p, k) for p in parts]) for k in INTERVAL_FIELDS))
+
+    @staticmethod
+    def empty() -> Intervals:
+        return Intervals(np.empty(0, np.intp), *(np.empty(0) for _ in range(5)))
+
+    def select(self, which: np.ndarray) -> Intervals:
+        """The intervals picked by a mask or index array."""
+        return Intervals(*(getattr(self, k)[which] for k in INTERVAL_FIELDS))
 
     def __len__(self) -> int:
         return len(self.sat)
@@ -71,8 +85,13 @@ class Brackets:
 
 
 def _classify(sat: np.ndarray, t: np.ndarray, f: np.ndarray, f_rate: np.ndarray, el_rate: np.ndarray,
-              link: np.ndarray, kept: np.ndarray) -> Brackets:
-    """Brackets between samples ``i`` and ``i + 1`` wherever ``link[i]`` (same satellite, adjacent)."""
+              link: np.ndarray, kept: np.ndarray, up: np.ndarray | None = None,
+              up_rate: np.ndarray | None = None) -> Brackets:
+    """Brackets between samples ``i`` and ``i + 1`` wherever ``link[i]`` (same satellite, adjacent).
+
+    With the height above the horizontal plane ``up`` (km) and its rate (km/s) at the samples (a
+    flat horizon at 0 deg, where a crossing is a root of ``up``), crossings get a first guess.
+    """
     i = np.flatnonzero(link)
     j = i + 1
     fa, fb = f[i], f[j]
@@ -81,11 +100,35 @@ def _classify(sat: np.ndarray, t: np.ndarray, f: np.ndarray, f_rate: np.ndarray,
     peak = turn & (fa <= 0.0) & (fb <= 0.0) & kept[i] & np.isfinite(fa) & np.isfinite(fb)
     culm = (el_rate[i] >= 0.0) & (el_rate[j] <= 0.0) & ((fa > 0.0) | (fb > 0.0))
 
-    def pick(mask: np.ndarray, values: np.ndarray) -> Intervals:
+    def pick(mask: np.ndarray, values: np.ndarray, guess: np.ndarray | None = None) -> Intervals:
         k = i[mask]
-        return Intervals(sat[k], t[k], t[k + 1], values[k], values[k + 1])
+        return Intervals(sat[k], t[k], t[k + 1], values[k], values[k + 1],
+                         np.full(len(k), np.nan) if guess is None else guess)
 
-    return Brackets(pick(cross, f), pick(peak, f_rate), pick(culm, el_rate))
+    guess = None
+    if up is not None and up_rate is not None:
+        k = i[cross]
+        guess = _hermite_root(t[k], t[k + 1], up[k], up[k + 1], up_rate[k], up_rate[k + 1])
+    return Brackets(pick(cross, f, guess), pick(peak, f_rate), pick(culm, el_rate))
+
+
+def _hermite_root(a: np.ndarray, b: np.ndarray, ya: np.ndarray, yb: np.ndarray, da: np.ndarray,
+                  db: np.ndarray) -> np.ndarray:
+    """The root in ``[a, b]`` of the cubic Hermite interpolant of values ``y`` and rates ``d``
+    (signs of ``ya`` and ``yb`` differ): a few Newton steps from the secant, kept inside."""
+    h = b - a
+    p0, p1, m0, m1 = ya, yb, da * h, db * h
+    # y(x) = c0 + c1 x + c2 x^2 + c3 x^3 on x in [0, 1]
+    c0, c1 = p0, m0
+    c2 = -3.0 * p0 - 2.0 * m0 + 3.0 * p1 - m1
+    c3 = 2.0 * p0 + m0 - 2.0 * p1 + m1
+    with np.errstate(invalid="ignore", divide="ignore"):
+        x = np.clip(p0 / (p0 - p1), 0.0, 1.0)
+        for _ in range(4):
+            y = c0 + x * (c1 + x * (c2 + x * c3))
+            dy = c1 + x * (2.0 * c2 + 3.0 * x * c3)
+            x = np.clip(x - y / dy, 0.0, 1.0)
+    return np.where(np.isfinite(x), a + x * h, np.nan)
 
 
 def screen(satrecs: list, frame: TopocentricFrame, horizon: HorizonTable, jd0: float, fr0: float,
@@ -142,31 +185,35 @@ def screen(satrecs: list, frame: TopocentricFrame, horizon: HorizonTable, jd0: f
         coarse_only = per_sat == 1
         if coarse_only.any():
             sel = np.flatnonzero(coarse_only)
-            k = _coarse_kinematics(frame, horizon, pos[sel], vel[sel], err[sel])
+            f, f_rate, el_rate, up, up_rate = _coarse_kinematics(frame, horizon, pos[sel], vel[sel], err[sel])
             m = len(grid)
             sat_ids = np.repeat(sel + i0, m)
             link = np.ones((len(sel), m), dtype=bool)
             link[:, -1] = False
             kept_full = np.zeros((len(sel), m), dtype=bool)
             kept_full[:, :-1] = kept[sel]
-            parts.append(_classify(sat_ids, np.tile(grid, len(sel)), *k, link.ravel(), kept_full.ravel()))
+            parts.append(_classify(sat_ids, np.tile(grid, len(sel)), f, f_rate, el_rate, link.ravel(),
+                                   kept_full.ravel(), up, up_rate))
         fine = np.flatnonzero(~coarse_only)
         if len(fine):
             parts.append(_fine_samples(fine + i0, kept[fine], per_sat[fine], grid, coarse_step_s, evaluator))
         del pos, vel
     if not parts:
-        empty = Intervals(np.empty(0, np.intp), *(np.empty(0) for _ in range(4)))
+        empty = Intervals.empty()
         return Brackets(empty, empty, empty)
     return Brackets(*(Intervals.concat([getattr(p, k) for p in parts])
                       for k in ("crossings", "peaks", "culminations")))
 
 
 def _coarse_kinematics(frame: TopocentricFrame, horizon: HorizonTable, pos: np.ndarray, vel: np.ndarray,
-                       err: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Flattened f, df/dt and d(elevation)/dt (deg, deg/s) at the coarse points of some satellites."""
+                       err: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None,
+                                                 np.ndarray | None]:
+    """Flattened f, df/dt and d(elevation)/dt (deg, deg/s) at the coarse points of some satellites, and
+    under a flat horizon at 0 deg the height above the horizontal plane (km) and its rate (km/s)
+    (None otherwise)."""
     d = pos - frame.origin
-    e, n, u = d @ frame.east, d @ frame.north, d @ frame.up
-    e1, n1, u1 = vel @ frame.east, vel @ frame.north, vel @ frame.up
+    e, n, u = frame.components(d)
+    e1, n1, u1 = frame.components(vel)
     q = e * e + n * n
     rho2 = q + u * u
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -182,7 +229,9 @@ def _coarse_kinematics(frame: TopocentricFrame, horizon: HorizonTable, pos: np.n
     bad = err != 0
     f[bad] = -np.inf
     el_rate[bad] = np.nan
-    return f.ravel(), f_rate.ravel(), el_rate.ravel()
+    if horizon.is_flat and horizon.minimum == 0.0:
+        return f.ravel(), f_rate.ravel(), el_rate.ravel(), u.ravel(), u1.ravel()
+    return f.ravel(), f_rate.ravel(), el_rate.ravel(), None, None
 
 
 def _fine_samples(sats: np.ndarray, kept: np.ndarray, per_sat: np.ndarray, grid: np.ndarray,
@@ -194,7 +243,7 @@ def _fine_samples(sats: np.ndarray, kept: np.ndarray, per_sat: np.ndarray, grid:
     """
     row, interval = np.nonzero(kept)
     if len(row) == 0:
-        empty = Intervals(np.empty(0, np.intp), *(np.empty(0) for _ in range(4)))
+        empty = Intervals.empty()
         return Brackets(empty, empty, empty)
     run_end = np.ones(len(row), dtype=bool)
     run_end[:-1] = (row[1:] != row[:-1]) | (interval[1:] != interval[:-1] + 1)

@@ -9,10 +9,11 @@ The search runs in three stages, each batched over every satellite of the catalo
 
 1. :mod:`~nfwserver.tracking.pass_screen`: a coarse grid proves most of the time invisible and
    brackets every crossing, every possible hidden short pass and every culmination;
-2. :mod:`~nfwserver.tracking.pass_refine`: safeguarded Newton iteration with analytic rates
-   refines all brackets together (crossings to 0.1 ms, maxima to 1 ms);
-3. :mod:`~nfwserver.tracking.pass_assemble`: rises and sets are paired into passes and each
-   pass gets its TCA.
+2. :mod:`~nfwserver.tracking.pass_refine`: safeguarded iteration with analytic derivatives
+   (second-order steps for crossings, Newton steps for maxima) refines the brackets of every
+   satellite together (crossings to 0.1 ms, maxima to 1 ms);
+3. :mod:`~nfwserver.tracking.pass_assemble`: crossings first, then the culminations from the
+   middle of their pass; rises and sets are paired into passes and each pass gets its TCA.
 
 Satellites are searched in groups of similar orbits (low, geosynchronous-like, the rest), each
 with its own grid step and look-back.  Passes already in progress at ``start`` are reported with
@@ -117,16 +118,18 @@ def find_passes(
     short = periods <= _SHORT_PERIOD_S
     slow = ~short & (rev_per_day < _SLOW_REV_PER_DAY) & (ecc < 0.05)
     other = ~short & ~slow
+    look_back = np.where((ecc < 0.05) & short, 0.5, 1.0) * periods  # s
     parts: list[dict[str, np.ndarray]] = []
     # The rest is split by period so that each part looks back and ahead only as far as it needs.
     for group, step in ((short, _LOW_STEP_S), (slow, _SLOW_STEP_S), (other & (periods <= 8 * 3600.0), _OTHER_STEP_S),
                         (other & (periods > 8 * 3600.0) & (periods <= 13 * 3600.0), _OTHER_STEP_S),
                         (other & (periods > 13 * 3600.0), _OTHER_STEP_S)):
         members = np.flatnonzero(group)
+        # Chunks of similar look-back, so that one eccentric orbit does not lengthen its chunk-mates' search.
+        members = members[np.argsort(look_back[members], kind="stable")]
         for c0 in range(0, len(members), _CHUNK):
             idx = members[c0 : c0 + _CHUNK]
-            look = np.where((ecc[idx] < 0.05) & short[idx], 0.5, 1.0) * periods[idx]
-            extension = float(min(np.max(look), SECONDS_PER_DAY))
+            extension = float(min(np.max(look_back[idx]), SECONDS_PER_DAY))
             models = [_model(satellites[i]) for i in idx]
             parts.append(_search(models, catalog_numbers[idx], observer, start, end, horizon, ut1_utc, fine_step_s,
                                  step, extension))

@@ -25,15 +25,14 @@ Report #3" (AIAA 2006-6753), its verification output ``tcppver.out``: TEME posit
 
 from __future__ import annotations
 
-import logging
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import sgp4.api
-import sgp4.model
 
-log = logging.getLogger(__name__)
+# ``sgp4.model`` (the pure-Python model) and ``logging`` are imported only when the compiled
+# extension fails the check: on a working machine the check costs no more imports than sgp4.api.
 
 REFERENCE_LINE1 = "1 00005U 58002B   00179.78495062  .00000023  00000-0  28098-4 0  4753"
 REFERENCE_LINE2 = "2 00005  34.2682 348.7242 1859667 331.7664  19.3264 10.82419157413667"
@@ -71,9 +70,17 @@ def reference_error_km(twoline2rv: Callable[[str, str], object]) -> float:
         return math.inf
 
 
+def _warn(message: str) -> None:
+    import logging
+
+    logging.getLogger(__name__).warning("%s", message)
+
+
 def python_parsed_twoline2rv(cls: type, line1: str, line2: str, whichconst: int = sgp4.api.WGS72):
     """A ``cls`` (compiled ``Satrec``) initialised with ``sgp4init`` from the pure-Python TLE reader."""
-    parsed = sgp4.model.Satrec.twoline2rv(line1, line2, whichconst)
+    from sgp4 import model as python_model
+
+    parsed = python_model.Satrec.twoline2rv(line1, line2, whichconst)
     satrec = cls()
     epoch = (parsed.jdsatepoch - _SGP4INIT_EPOCH_JD) + parsed.jdsatepochF
     satrec.sgp4init(whichconst, "i", parsed.satnum, epoch, parsed.bstar, parsed.ndot, parsed.nddot,
@@ -99,11 +106,13 @@ def ensure_working_sgp4() -> Sgp4Choice:
         choice = Sgp4Choice("compiled-python-parser",
                             f"sgp4's compiled TLE reader is wrong here (error {error:.3g} km): TLEs are read "
                             "by sgp4's pure-Python reader, the compiled propagator is kept")
-        log.warning("%s", choice.detail)
+        _warn(choice.detail)
         return choice
-    sgp4.api.Satrec, sgp4.api.SatrecArray = sgp4.model.Satrec, sgp4.model.SatrecArray
+    from sgp4 import model as python_model
+
+    sgp4.api.Satrec, sgp4.api.SatrecArray = python_model.Satrec, python_model.SatrecArray
     sgp4.api.accelerated = False
     choice = Sgp4Choice("python", f"sgp4's compiled extension is wrong here (error {error:.3g} km, "
                         f"with the Python reader {mixed:.3g} km): using its pure-Python model (slower)")
-    log.warning("%s", choice.detail)
+    _warn(choice.detail)
     return choice
