@@ -121,35 +121,44 @@ class PairEvaluator:
 
         ``grouped``: the pairs of each satellite are already contiguous (no sorting needed).
         """
-        n = len(t)
-        order = None if grouped else np.argsort(sat, kind="stable")
-        s_sorted = sat if order is None else sat[order]
-        fr = self.fr0 + (t if order is None else t[order]) / SECONDS_PER_DAY
-        jd = np.full(n, self.jd0)
+        if grouped:
+            return self._propagate(sat, self.fr0 + t / SECONDS_PER_DAY)
+        order = np.argsort(sat, kind="stable")
+        r, v, e = self._propagate(sat[order], self.fr0 + t[order] / SECONDS_PER_DAY)
+        back = np.empty_like(order)
+        back[order] = np.arange(len(t))
+        return r[back], v[back], e[back]
+
+    def _propagate(self, sat: np.ndarray, fr: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """SGP4 at UTC ``jd0 + fr`` (days) for pairs grouped by satellite: one compiled call per satellite.
+
+        The calls get memoryview slices (the extension reads any buffer of the right length; slicing a
+        memoryview costs less than slicing an array, which counts at a few pairs per call).
+        """
+        n = len(fr)
         e = np.zeros(n, dtype=np.uint8)
         r = np.empty((n, 3))
         v = np.empty((n, 3))
-        bounds = np.flatnonzero(s_sorted[1:] != s_sorted[:-1]) + 1
-        starts = [0, *bounds.tolist()]
-        stops = [*bounds.tolist(), n]
+        edges = np.flatnonzero(sat[1:] != sat[:-1]) + 1
+        starts = np.concatenate(([0], edges))
+        stops = np.concatenate((edges, [n]))
+        jd_m, fr_m, e_m = memoryview(np.full(n, self.jd0)), memoryview(np.ascontiguousarray(fr)), memoryview(e)
+        r_m, v_m = memoryview(r.reshape(-1)), memoryview(v.reshape(-1))
         satrecs = self.satrecs
-        for a, b, i in zip(starts, stops, s_sorted[starts].tolist()):
-            satrecs[i]._sgp4(jd[a:b], fr[a:b], e[a:b], r[a:b], v[a:b])
+        for a, b, a3, b3, i in zip(starts.tolist(), stops.tolist(), (3 * starts).tolist(), (3 * stops).tolist(),
+                                   sat[starts].tolist()):
+            satrecs[i]._sgp4(jd_m[a:b], fr_m[a:b], e_m[a:b], r_m[a3:b3], v_m[a3:b3])
         self.calls += len(starts)
         self.pairs += n
-        if order is None:
-            return r, v, e
-        back = np.empty_like(order)
-        back[order] = np.arange(n)
-        return r[back], v[back], e[back]
+        return r, v, e
 
     def evaluate(self, sat: np.ndarray, t: np.ndarray, grouped: bool = False) -> Kinematics:
         """Angles and derivatives at each pair (``sat`` intp, ``t`` float seconds; see :meth:`teme`)."""
         if not len(sat):
             return Kinematics.empty()
-        r, v, err = self.teme(sat, t, grouped)
-        # TEME to ITRS as in frames.teme_to_itrs (the same arithmetic), kept as separate components.
         fr = self.fr0 + t / SECONDS_PER_DAY
+        r, v, err = self._propagate(sat, fr) if grouped else self.teme(sat, t)
+        # TEME to ITRS as in frames.teme_to_itrs (the same arithmetic), kept as separate components.
         theta, theta_dot = gmst1982(self.jd0, fr + self.ut1_utc / SECONDS_PER_DAY)
         c, s = np.cos(theta), np.sin(theta)
         ms = -s

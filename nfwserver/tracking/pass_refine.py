@@ -153,19 +153,6 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
                               top & (step < _TOP_STEP_S) & (predicted < _SAFETY * tol) & (step < 0.25 * ps)
                               & (k.s_rate_err * step < _TOP_S_TOL * np.cos(np.radians(k.el))))
         done = (ok & (step < tol)) | close | (hi - lo < tol) | (g == 0.0) | ~np.isfinite(g)
-        el, az, f_out, el_rate = k.el, k.az, f, k.el_rate
-        if close.any():  # the values at the accepted root, carried over from ``ca`` by Taylor's formula
-            dt = np.where(close, newton - ca, 0.0)
-            el_cross = k.el + (k.el_rate + 0.5 * k.el_accel * dt) * dt
-            s_top = np.sin(np.radians(k.el)) + (k.s_rate + 0.5 * k.s_accel * dt) * dt
-            el_top = np.degrees(np.arcsin(np.clip(s_top, -1.0, 1.0)))
-            el = np.where(close, np.where(cross, el_cross, np.maximum(el_top, k.el)), k.el)
-            az = np.where(close, (k.az + (k.az_rate + 0.5 * k.az_accel * dt) * dt) % 360.0, k.az)
-            f_out = np.where(close, np.where(cross, 0.0, f + el - k.el), f)
-            el_rate = np.where(close, k.el_rate + k.el_accel * dt, k.el_rate)
-            up = close & (f_out > best_f)
-            np.copyto(best_f, f_out, where=up)
-            np.copyto(best_t, newton, where=up)
         t_out = np.where(ok & done, newton, ca)
         if hid.any():
             with np.errstate(invalid="ignore", divide="ignore"):
@@ -175,8 +162,11 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
             done[:] = True
         if done.any():
             fin = st[_IDX, done].astype(np.intp)
-            out[:, fin] = np.stack((t_out, el, az, f_out, el_rate, best_f, best_t, best_up, best_up_accel,
+            out[:, fin] = np.stack((t_out, k.el, k.az, f, k.el_rate, best_f, best_t, best_up, best_up_accel,
                                     k.f_accel))[:, done]
+        if close.any():
+            _finish_close(out, np.stack((newton, ca, k.el, k.el_rate, k.el_accel, k.s_rate, k.s_accel, k.az,
+                                         k.az_rate, k.az_accel, f, best_f, best_t, kd, st[_IDX]))[:, close])
         np.copyto(ps, step)
         np.copyto(ps, np.inf, where=~ok)
         np.copyto(prev_t, ca)
@@ -184,3 +174,21 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
         np.copyto(ca, np.where(ok, newton, 0.5 * (lo + hi)))
         st = st[:, ~done]
     return Solution(*out, rounds)
+
+
+def _finish_close(out: np.ndarray, v: np.ndarray) -> None:
+    """Write into ``out`` the values at the accepted roots of brackets finished by a final step, carried over
+    from the evaluated time by Taylor's formula.  ``v`` holds, one column per bracket: the root, the time
+    evaluated, the elevation with its two derivatives, s' and s'', the azimuth with its two derivatives,
+    f, the best f and its time so far, the kind and the bracket's index."""
+    newton, ca, el0, el1, el2, s1, s2, az0, az1, az2, f, best_f, best_t, kd, idx = v
+    dt = newton - ca
+    cross = kd == CROSSING
+    el_cross = el0 + (el1 + 0.5 * el2 * dt) * dt
+    s_top = np.sin(np.radians(el0)) + (s1 + 0.5 * s2 * dt) * dt
+    el_top = np.degrees(np.arcsin(np.clip(s_top, -1.0, 1.0)))
+    el = np.where(cross, el_cross, np.maximum(el_top, el0))
+    f_out = np.where(cross, 0.0, f + el - el0)
+    up = f_out > best_f
+    out[1:7, idx.astype(np.intp)] = (el, (az0 + (az1 + 0.5 * az2 * dt) * dt) % 360.0, f_out, el1 + el2 * dt,
+                                     np.where(up, f_out, best_f), np.where(up, newton, best_t))
