@@ -71,13 +71,6 @@ class Solution:
     rounds: int  #: iterations the slowest bracket needed
 
 
-#: Rows of the per-bracket state matrix (one column per unfinished bracket, compacted every round).
-(_IDX, _SAT, _KIND, _HID, _A, _B, _GA, _GB, _C, _TOL, _BEST_F, _BEST_T, _BEST_UP, _BEST_UP_ACCEL, _PREV_STEP,
- _PREV_T, _PREV_ACCEL) = range(17)
-#: Rows of the result matrix, in the order of the fields of :class:`Solution`.
-_RESULTS = 10
-
-
 def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: np.ndarray, gb: np.ndarray,
           kind: np.ndarray, hidden: np.ndarray | None = None, guess: np.ndarray | None = None) -> Solution:
     """Refine brackets ``[a, b]`` of satellites ``sat``; ``ga``/``gb`` hold the sign-carrying values at
@@ -85,58 +78,73 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
     brackets, which may be abandoned early; ``guess`` holds first guesses (NaN: none), else the
     secant of the end values is the first guess."""
     n = len(sat)
-    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-    ga = np.nan_to_num(np.asarray(ga, dtype=float), nan=0.0, neginf=-180.0, posinf=180.0)
-    gb = np.nan_to_num(np.asarray(gb, dtype=float), nan=0.0, neginf=-180.0, posinf=180.0)
+    # Work in satellite order, so every round's batch is already grouped by satellite.
+    perm = np.argsort(sat, kind="stable")
+    undo = np.empty_like(perm)
+    undo[perm] = np.arange(n)
+    sat, kind = sat[perm], kind[perm]
+    a, b, ga, gb = a[perm], b[perm], ga[perm], gb[perm]
+    hidden = None if hidden is None else hidden[perm]
+    guess = None if guess is None else guess[perm]
+    a, b = a.astype(float).copy(), b.astype(float).copy()
+    ga = np.nan_to_num(ga.astype(float), nan=0.0, neginf=-180.0, posinf=180.0)
+    gb = np.nan_to_num(gb.astype(float), nan=0.0, neginf=-180.0, posinf=180.0)
+    hidden = np.zeros(n, dtype=bool) if hidden is None else hidden
+    tol = np.where(kind == CROSSING, CROSSING_TOL_S, TOP_TOL_S)
     with np.errstate(invalid="ignore", divide="ignore"):
         c = np.where(gb != ga, (a * gb - b * ga) / (gb - ga), 0.5 * (a + b))
     if guess is not None:
         c = np.where(np.isfinite(guess), guess, c)
     c = np.where(np.isfinite(c), np.clip(c, np.minimum(a, b), np.maximum(a, b)), 0.5 * (a + b))
-    # The state of every unfinished bracket is one column of ``st`` (indices and flags as exact floats),
-    # so that one gather per round drops the finished ones.  Columns run in satellite order, so every
-    # round's batch is already grouped by satellite.
-    st = np.empty((17, n))
-    st[_IDX] = np.arange(n)
-    st[_SAT], st[_KIND], st[_HID] = sat, kind, False if hidden is None else hidden
-    st[_A], st[_B], st[_GA], st[_GB], st[_C] = a, b, ga, gb, c
-    st[_TOL] = np.where(st[_KIND] == CROSSING, CROSSING_TOL_S, TOP_TOL_S)
-    st[_BEST_F], st[_BEST_T], st[_BEST_UP:_BEST_UP_ACCEL + 1] = -np.inf, c, np.nan
-    st[_PREV_STEP] = np.inf  # the previous round's Newton step (inf after a bisection)
-    st[_PREV_T:_PREV_ACCEL + 1] = np.nan  # the previous round's time and f'' there (crossings)
-    st = st[:, np.argsort(sat, kind="stable")]
-    out = np.full((_RESULTS, n), np.nan)
-    out[3] = out[5] = -np.inf  # f and best_f of brackets never evaluated
+    t_out = c.copy()
+    el_out = np.full(n, np.nan)
+    az_out = np.full(n, np.nan)
+    f_out = np.full(n, -np.inf)
+    el_rate_out = np.full(n, np.nan)
+    f_accel_out = np.full(n, np.nan)
+    best_f = np.full(n, -np.inf)
+    best_t = c.copy()
+    best_up = np.full(n, np.nan)
+    best_up_accel = np.full(n, np.nan)
+    prev_step = np.full(n, np.inf)  # the previous round's Newton step (inf after a bisection)
+    prev_t = np.full(n, np.nan)  # the previous round's time and f'' there (crossings)
+    prev_accel = np.full(n, np.nan)
+    active = np.arange(n)
     rounds = 0
-    while st.shape[1] and rounds < _MAX_ROUNDS:
+    while len(active) and rounds < _MAX_ROUNDS:
         rounds += 1
-        (_, s_, kd, hid, a, b, ga, gb, ca, tol, best_f, best_t, best_up, best_up_accel, ps, prev_t,
-         prev_accel) = st
-        k = ev.evaluate(s_.astype(np.intp), ca, grouped=True)
-        cross, top = kd == CROSSING, kd == TOP
+        ca = c[active]
+        k = ev.evaluate(sat[active], ca, grouped=True)
+        kd = kind[active]
         f = np.fmax(k.f, -180.0)  # NaN and -inf (SGP4 failed) count as -180
-        g = np.where(cross, f, np.where(top, k.s_rate, k.f_rate))
-        g1 = np.where(cross, k.f_rate, np.where(top, k.s_accel, k.f_accel))
-        better = f > best_f
-        np.copyto(best_f, f, where=better)
-        np.copyto(best_t, ca, where=better)
-        np.copyto(best_up, k.up, where=better)
-        np.copyto(best_up_accel, k.up_accel, where=better)
-        same_as_a = (g > 0.0) == (ga > 0.0)
-        new_b = ~same_as_a
-        np.copyto(a, ca, where=same_as_a)
-        np.copyto(b, ca, where=new_b)
-        np.copyto(ga, g, where=same_as_a)
-        np.copyto(gb, g, where=new_b)
-        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        g = np.where(kd == CROSSING, f, np.where(kd == TOP, k.s_rate, k.f_rate))
+        g1 = np.where(kd == CROSSING, k.f_rate, np.where(kd == TOP, k.s_accel, k.f_accel))
+        el_out[active], az_out[active], f_out[active], t_out[active] = k.el, k.az, f, ca
+        el_rate_out[active] = k.el_rate
+        f_accel_out[active] = k.f_accel
+        better = f > best_f[active]
+        best_f[active] = np.where(better, f, best_f[active])
+        best_t[active] = np.where(better, ca, best_t[active])
+        best_up[active] = np.where(better, k.up, best_up[active])
+        best_up_accel[active] = np.where(better, k.up_accel, best_up_accel[active])
+        aa, bb, gaa = a[active], b[active], ga[active]
+        same_as_a = (g > 0.0) == (gaa > 0.0)
+        a[active] = aa = np.where(same_as_a, ca, aa)
+        b[active] = bb = np.where(same_as_a, bb, ca)
+        ga[active] = np.where(same_as_a, g, gaa)
+        gb[active] = np.where(same_as_a, gb[active], g)
+        lo, hi = np.minimum(aa, bb), np.maximum(aa, bb)
         with np.errstate(invalid="ignore", divide="ignore"):
             newton = ca - g / g1
             # Crossings: the root of the second-order Taylor polynomial (Halley-like, cubic convergence).
             disc = g1 * g1 - 2.0 * g * k.f_accel
             quad = ca - 2.0 * g / (g1 + np.copysign(np.sqrt(np.maximum(disc, 0.0)), g1))
-            np.copyto(newton, quad, where=cross & (disc > 0.0) & np.isfinite(quad))
-        ok = np.isfinite(newton) & (newton > lo) & (newton < hi) & (cross | (g1 < 0.0))
+            newton = np.where((kd == CROSSING) & (disc > 0.0) & np.isfinite(quad), quad, newton)
+        ok = np.isfinite(newton) & (newton > lo) & (newton < hi) & ((kd == CROSSING) | (g1 < 0.0))
         step = np.abs(newton - ca)
+        tl = tol[active]
+        ps = prev_step[active]
+        cross = kd == CROSSING
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             # A maximum's Newton step leaves an error ~C step^2, C = step / previous step^2 as observed
             # once two Newton steps were taken.
@@ -145,50 +153,36 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
             # the error of f' (SGP4's velocity), of f'' (the approximate acceleration) and from f'''
             # (the change of f'' since the previous round, with a margin).  Before a second round,
             # Newton's C = |f''/2f'| stands in for the last two.
-            jerk = _JERK_MARGIN * np.abs((k.f_accel - prev_accel) / (ca - prev_t))
+            jerk = _JERK_MARGIN * np.abs((k.f_accel - prev_accel[active]) / (ca - prev_t[active]))
             curve = np.where(np.isfinite(jerk), (0.5 * k.f_accel_err + jerk * step / 6.0) * step,
                              0.5 * np.abs(k.f_accel) * step)
             cross_err = (k.f_rate_err + curve) * step / np.abs(k.f_rate)
-        close = ok & np.where(cross, (step < _QUADRATIC_S) & (cross_err < _CROSSING_SAFETY * tol),
-                              top & (step < _TOP_STEP_S) & (predicted < _SAFETY * tol) & (step < 0.25 * ps)
+        prev_t[active], prev_accel[active] = ca, k.f_accel
+        close = ok & np.where(cross, (step < _QUADRATIC_S) & (cross_err < _CROSSING_SAFETY * tl),
+                              (kd == TOP) & (step < _TOP_STEP_S) & (predicted < _SAFETY * tl) & (step < 0.25 * ps)
                               & (k.s_rate_err * step < _TOP_S_TOL * np.cos(np.radians(k.el))))
-        done = (ok & (step < tol)) | close | (hi - lo < tol) | (g == 0.0) | ~np.isfinite(g)
-        t_out = np.where(ok & done, newton, ca)
+        done = (ok & (step < tl)) | close | (hi - lo < tl) | (g == 0.0) | ~np.isfinite(g)
+        if close.any():  # the values at the accepted root, carried over from ``ca`` by Taylor's formula
+            dt = np.where(close, newton - ca, 0.0)
+            sel = active[close]
+            el_cross = k.el + (k.el_rate + 0.5 * k.el_accel * dt) * dt
+            s_top = np.sin(np.radians(k.el)) + (k.s_rate + 0.5 * k.s_accel * dt) * dt
+            el_top = np.degrees(np.arcsin(np.clip(s_top, -1.0, 1.0)))
+            el_out[sel] = np.where(kd == CROSSING, el_cross, np.maximum(el_top, k.el))[close]
+            az_out[sel] = ((k.az + (k.az_rate + 0.5 * k.az_accel * dt) * dt) % 360.0)[close]
+            f_out[sel] = np.where(kd[close] == CROSSING, 0.0, f[close] + el_out[sel] - k.el[close])
+            el_rate_out[sel] = (k.el_rate + k.el_accel * dt)[close]
+            up = f_out[sel] > best_f[sel]
+            best_f[sel[up]] = f_out[sel[up]]
+            best_t[sel[up]] = newton[close][up]
+        prev_step[active] = np.where(ok, step, np.inf)
+        t_out[active] = np.where(ok & done, newton, ca)
+        hid = hidden[active]
         if hid.any():
             with np.errstate(invalid="ignore", divide="ignore"):
                 model = f + np.where(k.f_accel < 0.0, k.f_rate ** 2 / (-2.0 * k.f_accel), np.inf)
-            done |= (hid != 0.0) & (best_f <= 0.0) & ok & (step < 120.0) & (model < _HOPELESS_DEG)
-        if rounds == _MAX_ROUNDS:
-            done[:] = True
-        if done.any():
-            fin = st[_IDX, done].astype(np.intp)
-            out[:, fin] = np.stack((t_out, k.el, k.az, f, k.el_rate, best_f, best_t, best_up, best_up_accel,
-                                    k.f_accel))[:, done]
-        if close.any():
-            _finish_close(out, np.stack((newton, ca, k.el, k.el_rate, k.el_accel, k.s_rate, k.s_accel, k.az,
-                                         k.az_rate, k.az_accel, f, best_f, best_t, kd, st[_IDX]))[:, close])
-        np.copyto(ps, step)
-        np.copyto(ps, np.inf, where=~ok)
-        np.copyto(prev_t, ca)
-        np.copyto(prev_accel, k.f_accel)
-        np.copyto(ca, np.where(ok, newton, 0.5 * (lo + hi)))
-        st = st[:, ~done]
-    return Solution(*out, rounds)
-
-
-def _finish_close(out: np.ndarray, v: np.ndarray) -> None:
-    """Write into ``out`` the values at the accepted roots of brackets finished by a final step, carried over
-    from the evaluated time by Taylor's formula.  ``v`` holds, one column per bracket: the root, the time
-    evaluated, the elevation with its two derivatives, s' and s'', the azimuth with its two derivatives,
-    f, the best f and its time so far, the kind and the bracket's index."""
-    newton, ca, el0, el1, el2, s1, s2, az0, az1, az2, f, best_f, best_t, kd, idx = v
-    dt = newton - ca
-    cross = kd == CROSSING
-    el_cross = el0 + (el1 + 0.5 * el2 * dt) * dt
-    s_top = np.sin(np.radians(el0)) + (s1 + 0.5 * s2 * dt) * dt
-    el_top = np.degrees(np.arcsin(np.clip(s_top, -1.0, 1.0)))
-    el = np.where(cross, el_cross, np.maximum(el_top, el0))
-    f_out = np.where(cross, 0.0, f + el - el0)
-    up = f_out > best_f
-    out[1:7, idx.astype(np.intp)] = (el, (az0 + (az1 + 0.5 * az2 * dt) * dt) % 360.0, f_out, el1 + el2 * dt,
-                                     np.where(up, f_out, best_f), np.where(up, newton, best_t))
+            done |= hid & (best_f[active] <= 0.0) & ok & (step < 120.0) & (model < _HOPELESS_DEG)
+        c[active] = np.where(ok, newton, 0.5 * (lo + hi))
+        active = active[~done]
+    return Solution(t_out[undo], el_out[undo], az_out[undo], f_out[undo], el_rate_out[undo], best_f[undo],
+                    best_t[undo], best_up[undo], best_up_accel[undo], f_accel_out[undo], rounds)
