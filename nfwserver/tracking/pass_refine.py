@@ -163,17 +163,18 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
                               & (k.s_rate_err * step < _TOP_S_TOL * np.cos(np.radians(k.el))))
         done = (ok & (step < tl)) | close | (hi - lo < tl) | (g == 0.0) | ~np.isfinite(g)
         if close.any():  # the values at the accepted root, carried over from ``ca`` by Taylor's formula
-            dt = np.where(close, newton - ca, 0.0)
             sel = active[close]
-            el_cross = k.el + (k.el_rate + 0.5 * k.el_accel * dt) * dt
-            s_top = np.sin(np.radians(k.el)) + (k.s_rate + 0.5 * k.s_accel * dt) * dt
+            dt = (newton - ca)[close]
+            el0, cross_c = k.el[close], cross[close]
+            el_cross = el0 + (k.el_rate[close] + 0.5 * k.el_accel[close] * dt) * dt
+            s_top = np.sin(np.radians(el0)) + (k.s_rate[close] + 0.5 * k.s_accel[close] * dt) * dt
             el_top = np.degrees(np.arcsin(np.clip(s_top, -1.0, 1.0)))
-            el_out[sel] = np.where(kd == CROSSING, el_cross, np.maximum(el_top, k.el))[close]
-            az_out[sel] = ((k.az + (k.az_rate + 0.5 * k.az_accel * dt) * dt) % 360.0)[close]
-            f_out[sel] = np.where(kd[close] == CROSSING, 0.0, f[close] + el_out[sel] - k.el[close])
-            el_rate_out[sel] = (k.el_rate + k.el_accel * dt)[close]
-            up = f_out[sel] > best_f[sel]
-            best_f[sel[up]] = f_out[sel[up]]
+            el_out[sel] = el_c = np.where(cross_c, el_cross, np.maximum(el_top, el0))
+            az_out[sel] = (k.az[close] + (k.az_rate[close] + 0.5 * k.az_accel[close] * dt) * dt) % 360.0
+            f_out[sel] = f_c = np.where(cross_c, 0.0, f[close] + el_c - el0)
+            el_rate_out[sel] = k.el_rate[close] + k.el_accel[close] * dt
+            up = f_c > best_f[sel]
+            best_f[sel[up]] = f_c[up]
             best_t[sel[up]] = newton[close][up]
         prev_step[active] = np.where(ok, step, np.inf)
         t_out[active] = np.where(ok & done, newton, ca)
