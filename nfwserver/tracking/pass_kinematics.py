@@ -212,9 +212,9 @@ def topocentric_derivatives(frame: TopocentricFrame, horizon: HorizonTable, pos:
         s_rate_err = _VEL_ERR_KM_S * (1.0 + np.abs(s)) / rho
     el = np.degrees(np.arcsin(np.clip(s, -1.0, 1.0)))
     az = np.degrees(np.arctan2(e, n)) % 360.0
-    f = el - horizon.min_elevation_array(az)
-    bad = err != 0
-    bad = bad if bad.any() else None
+    # A flat table's minimum is one number (min_elevation_array would interpolate between copies of it).
+    f = el - horizon.minimum if horizon.is_flat else el - horizon.min_elevation_array(az)
+    bad = (err != 0) if err.any() else None
     plane = (e, n, e1, n1, e2, n2, q, h, bad)
     az_rates = None
     if horizon.is_flat:
