@@ -48,12 +48,13 @@ def teme_to_itrs(r: np.ndarray, v: np.ndarray | None, jd, fr, ut1_utc: float = 0
 class TopocentricFrame:
     """An observer's east-north-up frame as numpy vectors, for many positions at once."""
 
-    __slots__ = ("origin", "east", "north", "up", "_axes")
+    __slots__ = ("origin", "east", "north", "up", "axes")
 
     def __init__(self, observer: Observer) -> None:
         self.origin = np.array(observer.itrs_km())
         self.east, self.north, self.up = (np.array(b) for b in observer.enu_basis())
-        self._axes = tuple(tuple(float(c) for c in b) for b in observer.enu_basis())
+        #: the (east, north, up) unit vectors as tuples of floats (for sums of products)
+        self.axes = tuple(tuple(float(c) for c in b) for b in observer.enu_basis())
 
     def enu(self, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(east, north, up) components (km) of ``pos - origin`` for ITRS positions (..., 3)."""
@@ -66,7 +67,7 @@ class TopocentricFrame:
         BLAS, whose worker threads then keep spinning on the other cores after a few microseconds of work.
         """
         x, y, z = vectors[..., 0], vectors[..., 1], vectors[..., 2]
-        (ex, ey, ez), (nx, ny, nz), (ux, uy, uz) = self._axes
+        (ex, ey, ez), (nx, ny, nz), (ux, uy, uz) = self.axes
         return x * ex + y * ey + z * ez, x * nx + y * ny + z * nz, x * ux + y * uy + z * uz
 
     def look_angles(self, pos: np.ndarray, vel: np.ndarray | None = None

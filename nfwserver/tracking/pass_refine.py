@@ -116,9 +116,10 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
         ca = c[active]
         k = ev.evaluate(sat[active], ca, grouped=True)
         kd = kind[active]
-        f = np.maximum(np.nan_to_num(k.f, nan=-180.0), -180.0)
-        g = np.where(kd == CROSSING, f, np.where(kd == TOP, k.s_rate, k.f_rate))
-        g1 = np.where(kd == CROSSING, k.f_rate, np.where(kd == TOP, k.s_accel, k.f_accel))
+        cross, top = kd == CROSSING, kd == TOP
+        f = np.fmax(k.f, -180.0)  # NaN and -inf (SGP4 failed) count as -180
+        g = np.where(cross, f, np.where(top, k.s_rate, k.f_rate))
+        g1 = np.where(cross, k.f_rate, np.where(top, k.s_accel, k.f_accel))
         el_out[active], az_out[active], f_out[active], t_out[active] = k.el, k.az, f, ca
         el_rate_out[active] = k.el_rate
         f_accel_out[active] = k.f_accel
@@ -139,12 +140,11 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
             # Crossings: the root of the second-order Taylor polynomial (Halley-like, cubic convergence).
             disc = g1 * g1 - 2.0 * g * k.f_accel
             quad = ca - 2.0 * g / (g1 + np.copysign(np.sqrt(np.maximum(disc, 0.0)), g1))
-            newton = np.where((kd == CROSSING) & (disc > 0.0) & np.isfinite(quad), quad, newton)
-        ok = np.isfinite(newton) & (newton > lo) & (newton < hi) & ((kd == CROSSING) | (g1 < 0.0))
+            newton = np.where(cross & (disc > 0.0) & np.isfinite(quad), quad, newton)
+        ok = np.isfinite(newton) & (newton > lo) & (newton < hi) & (cross | (g1 < 0.0))
         step = np.abs(newton - ca)
         tl = tol[active]
         ps = prev_step[active]
-        cross = kd == CROSSING
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             # A maximum's Newton step leaves an error ~C step^2, C = step / previous step^2 as observed
             # once two Newton steps were taken.
@@ -159,21 +159,22 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
             cross_err = (k.f_rate_err + curve) * step / np.abs(k.f_rate)
         prev_t[active], prev_accel[active] = ca, k.f_accel
         close = ok & np.where(cross, (step < _QUADRATIC_S) & (cross_err < _CROSSING_SAFETY * tl),
-                              (kd == TOP) & (step < _TOP_STEP_S) & (predicted < _SAFETY * tl) & (step < 0.25 * ps)
+                              top & (step < _TOP_STEP_S) & (predicted < _SAFETY * tl) & (step < 0.25 * ps)
                               & (k.s_rate_err * step < _TOP_S_TOL * np.cos(np.radians(k.el))))
         done = (ok & (step < tl)) | close | (hi - lo < tl) | (g == 0.0) | ~np.isfinite(g)
         if close.any():  # the values at the accepted root, carried over from ``ca`` by Taylor's formula
-            dt = np.where(close, newton - ca, 0.0)
             sel = active[close]
-            el_cross = k.el + (k.el_rate + 0.5 * k.el_accel * dt) * dt
-            s_top = np.sin(np.radians(k.el)) + (k.s_rate + 0.5 * k.s_accel * dt) * dt
+            dt = (newton - ca)[close]
+            el0, cross_c = k.el[close], cross[close]
+            el_cross = el0 + (k.el_rate[close] + 0.5 * k.el_accel[close] * dt) * dt
+            s_top = np.sin(np.radians(el0)) + (k.s_rate[close] + 0.5 * k.s_accel[close] * dt) * dt
             el_top = np.degrees(np.arcsin(np.clip(s_top, -1.0, 1.0)))
-            el_out[sel] = np.where(kd == CROSSING, el_cross, np.maximum(el_top, k.el))[close]
-            az_out[sel] = ((k.az + (k.az_rate + 0.5 * k.az_accel * dt) * dt) % 360.0)[close]
-            f_out[sel] = np.where(kd[close] == CROSSING, 0.0, f[close] + el_out[sel] - k.el[close])
-            el_rate_out[sel] = (k.el_rate + k.el_accel * dt)[close]
-            up = f_out[sel] > best_f[sel]
-            best_f[sel[up]] = f_out[sel[up]]
+            el_out[sel] = el_c = np.where(cross_c, el_cross, np.maximum(el_top, el0))
+            az_out[sel] = (k.az[close] + (k.az_rate[close] + 0.5 * k.az_accel[close] * dt) * dt) % 360.0
+            f_out[sel] = f_c = np.where(cross_c, 0.0, f[close] + el_c - el0)
+            el_rate_out[sel] = k.el_rate[close] + k.el_accel[close] * dt
+            up = f_c > best_f[sel]
+            best_f[sel[up]] = f_c[up]
             best_t[sel[up]] = newton[close][up]
         prev_step[active] = np.where(ok, step, np.inf)
         t_out[active] = np.where(ok & done, newton, ca)
