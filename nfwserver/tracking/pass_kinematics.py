@@ -67,7 +67,7 @@ class Kinematics:
     def empty(cls) -> Kinematics:
         """No pairs."""
         e = np.empty(0)
-        return cls(*(e for _ in range(14)), _az_rates=(e, e))
+        return cls(e, e, e, e, e, e, e, e, e, e, e, e, e, e, _az_rates=(e, e))
 
     @property
     def az_rate(self) -> np.ndarray:
@@ -142,9 +142,13 @@ class PairEvaluator:
         edges = np.flatnonzero(sat[1:] != sat[:-1]) + 1
         starts = np.concatenate(([0], edges))
         stops = np.concatenate((edges, [n]))
-        jd_m, fr_m, e_m = memoryview(np.full(n, self.jd0)), memoryview(np.ascontiguousarray(fr)), memoryview(e)
-        r_m, v_m = memoryview(r.reshape(-1)), memoryview(v.reshape(-1))
+        jd_m, fr_m, e_m = np.full(n, self.jd0).data, np.ascontiguousarray(fr).data, e.data
+        r_m, v_m = r.reshape(-1).data, v.reshape(-1).data
         satrecs = self.satrecs
+        if not hasattr(satrecs[0], "_sgp4"):  # sgp4's pure-Python model (sgp4_selfcheck's last resort)
+            for a, b, i in zip(starts.tolist(), stops.tolist(), sat[starts].tolist()):
+                e[a:b], r[a:b], v[a:b] = satrecs[i].sgp4_array(np.full(b - a, self.jd0), fr[a:b])
+            return r, v, e
         for a, b, a3, b3, i in zip(starts.tolist(), stops.tolist(), (3 * starts).tolist(), (3 * stops).tolist(),
                                    sat[starts].tolist()):
             satrecs[i]._sgp4(jd_m[a:b], fr_m[a:b], e_m[a:b], r_m[a3:b3], v_m[a3:b3])

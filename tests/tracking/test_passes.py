@@ -175,3 +175,22 @@ def test_element_sets_and_their_models_give_the_same_passes_and_no_model_is_kept
     assert all(s._satrec is None for s in sets)  # a catalog-wide search holds one chunk's models at a time
     from_models = find_passes([s.satrec for s in sets], observer, START, START + timedelta(hours=6))
     assert len(from_sets) > 100 and list(from_sets) == list(from_models)
+
+
+def test_sgp4s_pure_python_model_finds_the_same_passes(monkeypatch) -> None:
+    """The start-up self-check's last resort (sgp4_selfcheck, mode "python") swaps in sgp4's pure-Python
+    Satrec and SatrecArray; the search must run on them and agree with the compiled extension."""
+    import sgp4.model
+
+    from nfwserver.tracking import pass_screen
+
+    monkeypatch.setattr(pass_screen, "SatrecArray", sgp4.model.SatrecArray)
+    sets = VISUAL[:3]
+    pure = find_passes([sgp4.model.Satrec.twoline2rv(s.line1, s.line2) for s in sets], OBSERVERS[0], START,
+                       START + timedelta(hours=8))
+    compiled = find_passes(sets, OBSERVERS[0], START, START + timedelta(hours=8))
+    assert len(pure) == len(compiled) >= 3
+    for a, b in zip(pure, compiled):
+        assert a.catalog_number == b.catalog_number
+        assert abs((a.aos - b.aos).total_seconds()) < 1e-3 and abs((a.los - b.los).total_seconds()) < 1e-3
+        assert abs(a.max_elevation_deg - b.max_elevation_deg) < 1e-6
