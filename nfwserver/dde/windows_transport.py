@@ -23,6 +23,7 @@ from __future__ import annotations
 import ctypes
 import logging
 import queue
+import struct
 import sys
 import threading
 import time
@@ -36,6 +37,7 @@ from nfwserver.dde.transport import DdeServerHandler
 log = logging.getLogger(__name__)
 
 _WAKE = ddeml.WM_APP + 0x4E
+_GMEM_MOVEABLE = 0x0002
 
 
 class _User32Api:  # pragma: no cover - Windows only
@@ -43,6 +45,8 @@ class _User32Api:  # pragma: no cover - Windows only
 
     def __init__(self, user32, inst: int) -> None:
         self.u, self.inst = user32, inst
+        #: when a set: what Wine's DdePostAdvise copies of each handle made look like (_WineAdviseCopies)
+        self.wine_copies: set[bytes] | None = None
 
     def query_string(self, hsz: int) -> str:
         if not hsz:
@@ -62,7 +66,64 @@ class _User32Api:  # pragma: no cover - Windows only
 
     def create_data(self, data: bytes, hsz_item: int, fmt: int) -> int:
         buf = ctypes.create_string_buffer(data, len(data))
+        if self.wine_copies is not None:  # WINE_DDEHEAD: no flags, the format; then the data
+            self.wine_copies.add(struct.pack("<HH", 0, fmt) + data)
         return self.u.DdeCreateDataHandle(self.inst, buf, len(data), 0, hsz_item, fmt, 0) or 0
+
+
+class _WineAdviseCopies:  # pragma: no cover - Windows (Wine) only
+    """Frees the copies of advise data that Wine 8.0's ``DdePostAdvise`` leaves behind.
+
+    For every hot link Wine's ``DdePostAdvise`` copies our data handle into a new moveable global
+    block (``WDML_DataHandle2Global``: a 4-byte ``WINE_DDEHEAD`` with no flags set, then the data)
+    and posts it.  To another process the message carries a copy of the block's bytes, and nobody
+    frees the block; kernelbase has 65,536 moveable handles per process, so after that many posts
+    every ``GlobalAlloc(GMEM_MOVEABLE)`` fails and the links get ``WM_DDE_DATA`` without data
+    (100 links at 10 Hz: about 65 s; docs/PLATFORMS.md).  Windows' DDEML leaves no such block.
+
+    kernelbase hands out free handles last-freed-first.  :meth:`reserve` takes ``count`` handles and
+    frees them in reverse, so they are the next ones given out; after the post, :meth:`release`
+    frees those of them that now hold exactly a copy of data we returned for the post.  Copies
+    posted to a conversation in this process are the very block the client reads: the transport
+    does not call this when such a conversation is linked.
+    """
+
+    def __init__(self, kernel32) -> None:
+        from ctypes import wintypes
+
+        self.k = kernel32
+        self.k.GlobalAlloc.restype, self.k.GlobalAlloc.argtypes = ctypes.c_void_p, [wintypes.UINT, ctypes.c_size_t]
+        self.k.GlobalFree.restype, self.k.GlobalFree.argtypes = ctypes.c_void_p, [ctypes.c_void_p]
+        self.k.GlobalSize.restype, self.k.GlobalSize.argtypes = ctypes.c_size_t, [ctypes.c_void_p]
+        self.k.GlobalLock.restype, self.k.GlobalLock.argtypes = ctypes.c_void_p, [ctypes.c_void_p]
+        self.k.GlobalUnlock.restype, self.k.GlobalUnlock.argtypes = wintypes.BOOL, [ctypes.c_void_p]
+        self.freed = 0  #: copies freed so far
+
+    def reserve(self, count: int) -> list[int]:
+        handles = []
+        for _ in range(count):
+            handle = self.k.GlobalAlloc(_GMEM_MOVEABLE, 1)
+            if not handle:
+                break
+            handles.append(handle)
+        for handle in reversed(handles):
+            self.k.GlobalFree(handle)
+        return handles
+
+    def release(self, handles: list[int], copies: set[bytes]) -> None:
+        sizes = {len(copy) for copy in copies}
+        for handle in handles:
+            size = self.k.GlobalSize(handle)  # 0 for a handle that is free again
+            if size not in sizes:
+                continue
+            ptr = self.k.GlobalLock(handle)
+            if not ptr:
+                continue
+            block = ctypes.string_at(ptr, size)
+            self.k.GlobalUnlock(handle)
+            if block in copies:
+                self.k.GlobalFree(handle)
+                self.freed += 1
 
 
 class WindowsDdeTransport:  # pragma: no cover - Windows only
@@ -82,6 +143,8 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
         #: DdePostAdvise calls on the DDE thread (each runs one XTYP_ADVREQ per advise loop)
         self.post_advise_stats = PostAdviseStats()
         self._wine_atoms = False  #: set on the DDE thread when running under Wine (see post_advise)
+        self._wine_copies: _WineAdviseCopies | None = None  #: under Wine: frees DdePostAdvise's leftovers
+        self._local_convs: set[int] = set()  #: conversations whose client is in this process
         self._thread = threading.Thread(target=self._run, name="nfw-ddeml", daemon=True)
         self._thread.start()
         if not self._ready.wait(start_timeout_s) or self._error is not None:
@@ -97,6 +160,10 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
             self._kernel32.GlobalAddAtomW.argtypes = [wintypes.LPCWSTR]
             self._kernel32.GlobalAddAtomW.restype = wintypes.ATOM
             self._wine_atoms = ddeml.running_under_wine()
+            if self._wine_atoms:
+                self._wine_copies = _WineAdviseCopies(self._kernel32)
+            self.u.GetWindowThreadProcessId.restype = wintypes.DWORD
+            self.u.GetWindowThreadProcessId.argtypes = [wintypes.HWND, ctypes.POINTER(wintypes.DWORD)]
             self._thread_id = ctypes.windll.kernel32.GetCurrentThreadId()
             inst = wintypes.DWORD(0)
             self._dispatcher: DdemlDispatcher | None = None
@@ -131,7 +198,23 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
     def _on_callback(self, utype, fmt, hconv, hsz1, hsz2, hdata, data1, data2):
         if self._dispatcher is None:
             return 0
+        if utype == ddeml.XTYP_CONNECT_CONFIRM and self._client_is_local(hconv or 0):
+            self._local_convs.add(hconv or 0)
+        elif utype == ddeml.XTYP_DISCONNECT:
+            self._local_convs.discard(hconv or 0)
         return self._dispatcher(utype, fmt, hconv or 0, hsz1 or 0, hsz2 or 0, hdata or 0, data1, data2) or None
+
+    def _client_is_local(self, hconv: int) -> bool:
+        """Whether the conversation's client window belongs to this process (True if unknown)."""
+        from ctypes import wintypes
+
+        info = ddeml.ConvInfo()
+        info.cb = ctypes.sizeof(ddeml.ConvInfo)
+        pid = wintypes.DWORD(0)
+        if not self.u.DdeQueryConvInfo(hconv, ddeml.QID_SYNC, ctypes.byref(info)) or not info.hwndPartner:
+            return True
+        self.u.GetWindowThreadProcessId(info.hwndPartner, ctypes.byref(pid))
+        return pid.value in (0, self._kernel32.GetCurrentProcessId())
 
     def _lookup(self, service: str) -> DdeServerHandler | None:
         return self._handlers.get(service.upper())
@@ -230,7 +313,17 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
                 # atom is gone and the others drop their data.  Add the references Windows would.
                 for _ in range(links - 1):
                     self._kernel32.GlobalAddAtomW(item)
-            ok = self.u.DdePostAdvise(self.inst, self._string(topic), self._string(item))
+            copies = self._wine_copies if not self._local_convs else None
+            reserved = copies.reserve(2 * links + 2) if copies is not None else []
+            api = self._dispatcher.api if self._dispatcher is not None else None
+            if copies is not None and isinstance(api, _User32Api):
+                api.wine_copies = set()
+            try:
+                ok = self.u.DdePostAdvise(self.inst, self._string(topic), self._string(item))
+            finally:
+                if copies is not None and isinstance(api, _User32Api) and api.wine_copies is not None:
+                    copies.release(reserved, api.wine_copies)
+                    api.wine_copies = None
             self.post_advise_stats.add(time.perf_counter() - start, links)
             if not ok:
                 err = self.u.DdeGetLastError(self.inst)
@@ -248,3 +341,5 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
         self._call(do, wait=False)
         self._thread.join(5.0)
         log.info("%s", self.post_advise_stats.summary())  # the DDE thread has stopped adding
+        if self._wine_copies is not None:
+            log.info("Wine: freed %d advise data copies DdePostAdvise left behind", self._wine_copies.freed)
