@@ -82,10 +82,11 @@ class _WineAdviseCopies:  # pragma: no cover - Windows (Wine) only
     (100 links at 10 Hz: about 65 s; docs/PLATFORMS.md).  Windows' DDEML leaves no such block.
 
     kernelbase hands out free handles last-freed-first.  :meth:`reserve` takes ``count`` handles and
-    frees them in reverse, so they are the next ones given out; after the post, :meth:`release`
+    frees them in reverse, so they are the next ones given out (our data handle for each link
+    takes the first and gives it back, its copy takes the next); after the post, :meth:`release`
     frees those of them that now hold exactly a copy of data we returned for the post.  Copies
     posted to a conversation in this process are the very block the client reads: the transport
-    does not call this when such a conversation is linked.
+    does not call this while any conversation's client is in its own process.
     """
 
     def __init__(self, kernel32) -> None:
@@ -314,7 +315,7 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
                 for _ in range(links - 1):
                     self._kernel32.GlobalAddAtomW(item)
             copies = self._wine_copies if not self._local_convs else None
-            reserved = copies.reserve(2 * links + 2) if copies is not None else []
+            reserved = copies.reserve(links + 4) if copies is not None else []
             api = self._dispatcher.api if self._dispatcher is not None else None
             if copies is not None and isinstance(api, _User32Api):
                 api.wine_copies = set()
