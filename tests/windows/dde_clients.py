@@ -3,9 +3,9 @@
 ``python dde_clients.py --clients 20 --seconds 60 --out FILE [--wait-disconnect 40] [--start-at EPOCH]``
 
 Each client is a conversation of its own (the server sees N clients): half connect to ``NFW32``,
-half to ``NFW_SERVER`` (retrying while the station starts), poke ``TUNE ON`` and start a hot
-advise loop on ``NFW_SERVER``.  They share one DDEML instance on this program's one thread:
-Wine 8.0's DDEML finds instances by thread, so several instances on one thread misroute their
+half to ``NFW_SERVER`` (``--services`` names others; retrying while the station starts), poke
+``TUNE ON`` and start a hot advise loop on ``NFW_SERVER``.  They share one DDEML instance on this
+program's one thread: Wine 8.0's DDEML finds instances by thread, so several instances on one thread misroute their
 callbacks, and many threads connecting at once lose conversations (docs/PLATFORMS.md).
 The strings delivered during a common window of ``--seconds`` are counted per conversation; the
 window starts once every conversation is up, or with ``--start-at`` at that wall-clock time (Unix
@@ -51,9 +51,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--connect-timeout", type=float, default=60.0)
     parser.add_argument("--wait-disconnect", type=float, default=0.0)
     parser.add_argument("--start-at", type=float, default=0.0, help="window start, Unix seconds")
+    parser.add_argument("--services", default=",".join(SERVICES), help="service names, used in turn")
     parser.add_argument("--out", required=True)
     args = parser.parse_args(argv)
-    records = [{"client": i, "service": SERVICES[i % 2], "error": None} for i in range(args.clients)]
+    services = args.services.split(",")
+    records = [{"client": i, "service": services[i % len(services)], "error": None} for i in range(args.clients)]
     shared = DdemlClient()
     clients: list[DdemlClient] = []
     convs: list[int] = []
