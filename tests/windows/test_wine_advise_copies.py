@@ -26,6 +26,27 @@ pytestmark = [
 CLIENTS = Path(__file__).resolve().parent / "dde_clients.py"
 
 
+def pump_messages(seconds: float) -> None:
+    """Dispatch this thread's window messages for ``seconds``: DdeConnect in the client program sends
+    WM_DDE_INITIATE to every top-level window, windows this thread kept from earlier tests included,
+    and waits for each to answer."""
+    from ctypes import wintypes
+
+    from nfwserver.dde import ddeml
+
+    user32 = ddeml.load_user32()
+    msg = wintypes.MSG()
+    deadline = time.monotonic() + seconds
+    while True:
+        while user32.PeekMessageW(ctypes.byref(msg), None, 0, 0, ddeml.PM_REMOVE):
+            user32.TranslateMessage(ctypes.byref(msg))
+            user32.DispatchMessageW(ctypes.byref(msg))
+        remaining_ms = int((deadline - time.monotonic()) * 1000)
+        if remaining_ms <= 0:
+            return
+        user32.MsgWaitForMultipleObjects(0, None, False, min(remaining_ms, 20), ddeml.QS_ALLINPUT)
+
+
 def free_moveable_handles(limit: int = 70_000) -> int:
     """How many ``GlobalAlloc(GMEM_MOVEABLE)`` calls succeed in this process right now (all freed again)."""
     kernel32 = ctypes.WinDLL("kernel32")
@@ -84,7 +105,7 @@ def test_hot_links_from_another_process_leave_the_stations_moveable_handles(own_
     try:
         while program.poll() is None:
             links_seen = max(links_seen, own_station.client_count()[1])
-            time.sleep(0.1)
+            pump_messages(0.1)
     finally:
         if program.poll() is None:
             program.kill()
