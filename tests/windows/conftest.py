@@ -5,9 +5,10 @@ These run only where DDEML exists (Windows, or the Windows Python under Wine: ``
 
 from __future__ import annotations
 
+import contextlib
 import re
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import TypeVar
 
 import pytest
@@ -84,9 +85,10 @@ def station(tmp_path_factory):
         proc.stop()
 
 
-@pytest.fixture
-def live_server():
-    """A server core on the DDEML transport in this process (for checks of its state)."""
+@contextlib.contextmanager
+def serving_station(services: tuple[str, ...] | None = None) -> Iterator:
+    """A server core on the DDEML transport in this process, publishing at 10 Hz (ISS); yields the
+    Nova DDE service (``services`` its DDE service names, Nova's by default)."""
     from nfwserver.clock import SystemClock
     from nfwserver.core.publisher import Publisher
     from nfwserver.core.station_core import StationCore
@@ -95,12 +97,21 @@ def live_server():
     from tests.dde.conftest import CATALOG, ISS, OBSERVER
 
     core = StationCore(CATALOG, OBSERVER, SystemClock(), satellite=ISS, rate_hz=10)
-    server = NovaDdeService(core)
+    server = NovaDdeService(core) if services is None else NovaDdeService(core, services=services)
     transport = WindowsDdeTransport()
     server.attach(transport)
     publisher = Publisher(core, SystemClock())
     publisher.start()
-    yield core
-    publisher.stop()
-    server.detach()
-    transport.close()
+    try:
+        yield server
+    finally:
+        publisher.stop()
+        server.detach()
+        transport.close()
+
+
+@pytest.fixture
+def live_server():
+    """A server core on the DDEML transport in this process (for checks of its state)."""
+    with serving_station() as server:
+        yield server.core

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.windows.conftest import wine_version
+from tests.windows.conftest import serving_station, wine_version
 
 pytestmark = [
     pytest.mark.windows,
@@ -70,24 +70,9 @@ SERVICES = ("NFW_HANDLES_A", "NFW_HANDLES_B")
 
 @pytest.fixture
 def own_station():
-    """A server core on the DDEML transport in this process, under a service name nobody else serves."""
-    from nfwserver.clock import SystemClock
-    from nfwserver.core.publisher import Publisher
-    from nfwserver.core.station_core import StationCore
-    from nfwserver.dde.nova_service import NovaDdeService
-    from nfwserver.dde.windows_transport import WindowsDdeTransport
-    from tests.dde.conftest import CATALOG, ISS, OBSERVER
-
-    core = StationCore(CATALOG, OBSERVER, SystemClock(), satellite=ISS, rate_hz=10)
-    server = NovaDdeService(core, services=SERVICES)
-    transport = WindowsDdeTransport()
-    server.attach(transport)
-    publisher = Publisher(core, SystemClock())
-    publisher.start()
-    yield server
-    publisher.stop()
-    server.detach()
-    transport.close()
+    """A server core on the DDEML transport in this process, under service names nobody else serves."""
+    with serving_station(SERVICES) as server:
+        yield server
 
 
 def test_hot_links_from_another_process_leave_the_stations_moveable_handles(own_station, tmp_path) -> None:
