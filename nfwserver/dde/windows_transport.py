@@ -314,17 +314,19 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
                 # atom is gone and the others drop their data.  Add the references Windows would.
                 for _ in range(links - 1):
                     self._kernel32.GlobalAddAtomW(item)
-            copies = self._wine_copies if not self._local_convs else None
-            reserved = copies.reserve(links + 4) if copies is not None else []
             api = self._dispatcher.api if self._dispatcher is not None else None
-            if copies is not None and isinstance(api, _User32Api):
-                api.wine_copies = set()
-            try:
+            copies = self._wine_copies if not self._local_convs and isinstance(api, _User32Api) else None
+            if copies is None:
                 ok = self.u.DdePostAdvise(self.inst, self._string(topic), self._string(item))
-            finally:
-                if copies is not None and isinstance(api, _User32Api) and api.wine_copies is not None:
-                    copies.release(reserved, api.wine_copies)
+            else:  # under Wine: free the copies its DdePostAdvise leaves (_WineAdviseCopies)
+                assert isinstance(api, _User32Api)
+                reserved = copies.reserve(links + 4)
+                api.wine_copies = made = set()
+                try:
+                    ok = self.u.DdePostAdvise(self.inst, self._string(topic), self._string(item))
+                finally:
                     api.wine_copies = None
+                    copies.release(reserved, made)
             self.post_advise_stats.add(time.perf_counter() - start, links)
             if not ok:
                 err = self.u.DdeGetLastError(self.inst)
