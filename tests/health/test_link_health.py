@@ -1,0 +1,81 @@
+"""LinkHealth: a fault is visible while it lasts, retried after a bounded backoff, cleared by one success."""
+
+from __future__ import annotations
+
+import logging
+from datetime import datetime, timezone
+
+import pytest
+
+from nfwserver.clock import VirtualClock
+from nfwserver.health import Backoff, HealthBoard, LinkHealth
+
+
+@pytest.fixture
+def clock() -> VirtualClock:
+    return VirtualClock(datetime(2026, 5, 8, tzinfo=timezone.utc))
+
+
+def test_backoff_doubles_up_to_its_bound() -> None:
+    b = Backoff(initial_s=2.0, max_s=30.0)
+    assert [b.delay(n) for n in range(7)] == [0.0, 2.0, 4.0, 8.0, 16.0, 30.0, 30.0]
+    assert b.delay(10_000) == 30.0
+    with pytest.raises(ValueError):
+        Backoff(initial_s=0.0)
+    with pytest.raises(ValueError):
+        Backoff(initial_s=5.0, max_s=1.0)
+
+
+def test_a_failure_waits_its_backoff_and_one_success_clears_it(clock: VirtualClock) -> None:
+    h = LinkHealth("rotor", clock, Backoff(1.0, 8.0))
+    assert h.ok and h.may_try() and h.describe() == "ok"
+    h.failed("RPRT -1")
+    assert not h.ok and not h.may_try()
+    assert h.describe() == "RPRT -1 (1 failure in 0 s, retry in 1 s)"
+    clock.advance(1.0)
+    assert h.may_try()
+    h.failed("RPRT -1")
+    clock.advance(1.5)
+    assert not h.may_try()  # second failure: 2 s
+    clock.advance(0.5)
+    assert h.may_try()
+    h.succeeded()
+    assert h.ok and h.may_try() and h.fault is None and h.recoveries == 1
+
+
+def test_retry_now_skips_the_wait_but_keeps_the_fault_until_a_success(clock: VirtualClock) -> None:
+    h = LinkHealth("radio", clock, Backoff(10.0, 60.0))
+    h.failed("connection refused")
+    assert not h.may_try()
+    h.retry_now()
+    assert h.may_try() and not h.ok
+    assert h.fault is not None and h.fault.failures == 1
+
+
+def test_repeated_failures_write_one_line_then_the_recovery(clock: VirtualClock,
+                                                           caplog: pytest.LogCaptureFixture) -> None:
+    h = LinkHealth("state-file", clock, Backoff(1.0, 4.0), logger=logging.getLogger("test.health"))
+    with caplog.at_level(logging.INFO, logger="test.health"):
+        for _ in range(50):
+            h.failed("Permission denied")
+            clock.advance(0.5)
+        h.succeeded()
+    lines = [r.getMessage() for r in caplog.records]
+    assert lines[0] == "state-file: Permission denied; retrying in 1 s"
+    assert sum("Permission denied;" in line for line in lines) == 1
+    assert lines[-1].startswith("state-file: recovered after 25.0 s (50 failures)")
+
+
+def test_the_board_lists_faults_and_tells_listeners(clock: VirtualClock) -> None:
+    board = HealthBoard(clock)
+    seen: list[tuple[str, bool]] = []
+    board.subscribe(lambda h: seen.append((h.name, h.ok)))
+    rotor, radio = board.link("rotor"), board.link("radio")
+    assert board.link("rotor") is rotor
+    radio.failed("EOF")
+    radio.failed("EOF")
+    assert board.faults() == {"radio": "EOF (2 failures in 0 s, retry in 2 s)"}
+    assert board.states()["rotor"] == "ok"
+    radio.succeeded()
+    assert board.faults() == {}
+    assert seen == [("radio", False), ("radio", True)]
