@@ -28,6 +28,7 @@ from nfwserver.core.sample import TickSample
 from nfwserver.core.state import DEFAULT_RATE_HZ, StateSnapshot, StationState
 from nfwserver.core.status import INTERFACE_VERSION, StatusBit
 from nfwserver.core.tracker import TickListener, Tracker
+from nfwserver.health.board import HealthBoard
 from nfwserver.radio.transponder import Channel
 from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.tracking.catalog import Catalog
@@ -81,6 +82,10 @@ class StationCore:
         self.state = StationState(catalog, observer, horizon=horizon, ut1_utc_s=ut1_utc, rate_hz=rate_hz,
                                   channels=channels)
         self.tracker = Tracker(self.state, clock, self.events)
+        #: Every link's health (rotor, radio, element sources, state file, listeners): what STATUS,
+        #: the console and the web page show while a fault lasts.
+        self.health = HealthBoard(clock)
+        self.health.subscribe(self._health_changed)
         #: Refused commands: one warning per client at once, then a counted summary at most once a minute
         #: (every refusal is still an event).
         self._refusals = RateLimitedLog(log, clock, 60.0)
@@ -103,6 +108,11 @@ class StationCore:
 
     def snapshot(self) -> CoreSnapshot:
         return CoreSnapshot(self.state.snapshot(), self.tracker.last_sample, self.tracker.status_word())
+
+    def _health_changed(self, link: object) -> None:
+        name, fault = getattr(link, "name", "?"), getattr(link, "fault", None)
+        text = f"{name}: recovered" if fault is None else f"{name}: {fault.reason}"
+        self._note(text, "health", accepted=fault is None)
 
     # -- ports -------------------------------------------------------------------------------
     def _note(self, text: str, source: str, accepted: bool | None = None) -> None:

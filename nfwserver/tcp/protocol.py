@@ -136,6 +136,9 @@ class NovaTcpProtocol:
             la = sample.look_angles
             fields.update(az=format_azimuth(la.azimuth_deg), el=format_elevation(la.elevation_deg),
                           rr=format_range_rate(la.range_rate_km_s), ah="Y" if sample.above_horizon else "N")
+        faults = self.core.health.faults()
+        fields["faults"] = ",".join(faults) or "none"
+        fields.update({f"{name}_fault": text for name, text in faults.items()})
         if self.extra is not None:
             try:
                 fields.update(self.extra())

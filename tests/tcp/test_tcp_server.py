@@ -218,3 +218,17 @@ def test_flip_sets_the_rotors_inverted_tracking_mode(tcp_station, client) -> Non
         with_rotor.close()
     finally:
         server.stop()
+
+
+def test_status_names_every_failing_link_while_its_fault_lasts(tcp_station, client) -> None:
+    station, _ = tcp_station
+    fields = dict(pair.split("=", 1) for pair in client.ask("STATUS").split(" "))
+    assert fields["faults"] == "none"
+    link = station.core.health.link("radio")
+    link.failed("rigctld: connection refused")
+    fields = dict(pair.split("=", 1) for pair in client.ask("STATUS").split(" "))
+    assert fields["faults"] == "radio"
+    assert fields["radio_fault"].startswith("rigctld:_connection_refused_(1_failure_in_")
+    link.succeeded()
+    fields = dict(pair.split("=", 1) for pair in client.ask("STATUS").split(" "))
+    assert fields["faults"] == "none" and "radio_fault" not in fields
