@@ -81,11 +81,11 @@ class StationCore:
         self.events = events if events is not None else EventLog()
         self.state = StationState(catalog, observer, horizon=horizon, ut1_utc_s=ut1_utc, rate_hz=rate_hz,
                                   channels=channels)
-        self.tracker = Tracker(self.state, clock, self.events)
-        #: Every link's health (rotor, radio, element sources, state file, listeners): what STATUS,
-        #: the console and the web page show while a fault lasts.
+        #: Every link's health (rotor, radio, element sources, state file, listeners, the tracker's own
+        #: computation): what STATUS, the console and the web page show while a fault lasts.
         self.health = HealthBoard(clock)
         self.health.subscribe(self._health_changed)
+        self.tracker = Tracker(self.state, clock, self.events, self.health.link("tracking", paced=False))
         #: Refused commands: one warning per client at once, then a counted summary at most once a minute
         #: (every refusal is still an event).
         self._refusals = RateLimitedLog(log, clock, 60.0)
@@ -178,8 +178,14 @@ class StationCore:
             elif poke.kind is PokeKind.TRACK:
                 note = self.set_track(bool(poke.value), source) or note
             elif poke.kind is PokeKind.SAT:
-                if not self.select_satellite(int(poke.value), source):
+                sat = self.state.catalog.get(int(poke.value))
+                if sat is None:
                     return f"satellite {poke.value} is not in the catalog; keeping the current one", note
+                why = self.tracker.why_not_computable(sat)
+                if why is not None:
+                    return (f"satellite {poke.value} {sat.dde_name} cannot be computed now ({why}); "
+                            "keeping the current one"), note
+                self.select_satellite(int(poke.value), source)
             elif poke.kind is PokeKind.ANTAZ:
                 self.report_antenna_position(float(poke.value), None, source)
             elif poke.kind is PokeKind.ANTEL:

@@ -11,10 +11,13 @@ Status word (seed: OrbitDRV interrupt interface), as this tracker reads it:
 - 0x0004: tracking disabled (Nova's ``TRACK OFF``); 0x0008: *tuning* disabled in OrbitDRV's sense,
   i.e. the radio gets no Doppler updates.  Nova's ``TUNE`` (DDE output) is reported separately
   (:attr:`TickSample.dde_output`), because OrbitDRV's tuning is the radio's, not the feed's.
-- 0x0010: an arithmetic error.  As the spec says, it *latches*: "No computations will be done until a
-  new Enable call is made".  Enable calls here are ``TRACK ON``, ``TUNE ON`` and switching radio tuning
-  on; selecting another satellite (OrbitDRV's Set Satellite Elements) clears it too, since the error
-  belonged to the old satellite's elements.  While latched the feed is empty.
+- 0x0010: an arithmetic error, with its code.  OrbitDRV's words are "No computations will be done
+  until a new Enable call is made"; a server left unattended must not go silent for good on one bad
+  instant (a clock step, a set past decay), so here the error **belongs to the tick** in which the
+  computation failed: every tick computes again, the bit and its code are set for each tick that
+  fails and clear on the first one that succeeds, and the feed resumes with it.  While it lasts the
+  feed is empty, the ``tracking`` link on the health board says why (STATUS ``faults=tracking``), and
+  the log has one line for the start of the fault (rate-limited repeats) and one for its end.
 - 0x0020: not in view (only while tracking is enabled); 0x0040: not recomputed since the last
   parameter change.
 - 0x4000 / 0x8000: the most recent command had a bad function (not a command we know) / a bad
@@ -40,6 +43,8 @@ from nfwserver.core.nova_protocol import format_nova
 from nfwserver.core.sample import TickSample
 from nfwserver.core.state import StateSnapshot, StationState
 from nfwserver.core.status import ArithmeticErrorCode, StatusBit
+from nfwserver.health.link_health import LinkHealth
+from nfwserver.tracking.catalog import Satellite
 from nfwserver.tracking.look_angles import LookAngleCalculator, LookAngles, PropagationError
 
 log = logging.getLogger(__name__)
@@ -50,8 +55,10 @@ TickListener = Callable[[TickSample], None]
 class Tracker:
     """Computes ticks from ``state``; see the module docstring."""
 
-    def __init__(self, state: StationState, clock: Clock, events: EventLog) -> None:
+    def __init__(self, state: StationState, clock: Clock, events: EventLog,
+                 health: LinkHealth | None = None) -> None:
         self.state = state
+        self.health = health  #: the ``tracking`` link: failing while the selected satellite cannot be computed
         self.clock = clock
         self.events = events
         self._lock = threading.Lock()
@@ -61,7 +68,6 @@ class Tracker:
         self._text = ""
         self._computed_generation = -1
         self._error = ArithmeticErrorCode.NONE
-        self._error_satellite: int | None = None
         self._command_bits = 0
 
     # -- subscribers -------------------------------------------------------------------------
@@ -99,15 +105,27 @@ class Tracker:
 
     # -- what commands tell the tracker --------------------------------------------------------
     def enable_call(self) -> None:
-        """An OrbitDRV enable call (TRACK ON, TUNE ON, radio tuning on): resets a latched arithmetic error."""
-        with self._lock:
-            self._error = ArithmeticErrorCode.NONE
+        """An OrbitDRV enable call (TRACK ON, TUNE ON, radio tuning on).  Nothing is latched, so there is
+        nothing to reset: the next tick computes as every tick does."""
 
     def selection_changed(self) -> None:
-        """A new AutoTracking satellite: never serve the old one's string, forget its error."""
+        """A new AutoTracking satellite: never serve the old one's string."""
         with self._lock:
             self._text = ""
-            self._error = ArithmeticErrorCode.NONE
+
+    def why_not_computable(self, satellite: Satellite, when: datetime | None = None) -> str | None:
+        """Why ``satellite`` cannot be computed at ``when`` (default now) for this station, or None if it can.
+
+        Used before a ``SAT=`` takes effect, so a client never gets a silent OK for a set that will
+        publish nothing (SGP4 error codes, a set past decay)."""
+        calc = self._calculator_for(self.state.snapshot())
+        if calc is None:
+            return None  # no observer: nothing is computed for any satellite, and STATUS says why
+        try:
+            calc.compute(satellite.satrec, self.clock.now() if when is None else when)
+        except (PropagationError, ArithmeticError, ValueError) as exc:
+            return str(exc) or type(exc).__name__
+        return None
 
     def dde_output_off(self) -> None:
         with self._lock:
@@ -160,10 +178,14 @@ class Tracker:
             code, reason = ArithmeticErrorCode.OVERFLOW, exc
         except (ValueError, ArithmeticError) as exc:
             code, reason = ArithmeticErrorCode.DOMAIN, exc
-        log.error("cannot compute %s at %s: %s; no computations until the next enable call",
-                  sat.dde_name, when.isoformat(), reason)
-        self.events.add(when, Direction.INFO, "note", f"arithmetic error {int(code):02X} for {sat.dde_name}: {reason}",
-                        accepted=False)
+        if self.health is not None:
+            self.health.failed(f"cannot compute {sat.dde_name} (arithmetic error {int(code):02X}): {reason}",
+                               logging.ERROR)
+        else:
+            log.error("cannot compute %s at %s: %s", sat.dde_name, when.isoformat(), reason)
+        if self._error != code:
+            self.events.add(when, Direction.INFO, "note",
+                            f"arithmetic error {int(code):02X} for {sat.dde_name}: {reason}", accepted=False)
         return None, code
 
     def tick(self, when: datetime | None = None) -> TickSample:
@@ -171,12 +193,11 @@ class Tracker:
         when = self.clock.now() if when is None else when
         snap = self.state.snapshot()
         sat = snap.satellite
-        angles: LookAngles | None = None
-        if not self._error:
-            angles, error = self._compute(snap, when)
-            if error:
-                with self._lock:
-                    self._error = error
+        angles, error = self._compute(snap, when)
+        with self._lock:
+            self._error = error
+        if not error and self.health is not None and not self.health.ok:
+            self.health.succeeded()
         above = angles is not None and snap.horizon.is_above(angles.azimuth_deg, angles.elevation_deg)
         text = ""
         if angles is not None and sat is not None and snap.dde_output:

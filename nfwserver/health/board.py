@@ -20,12 +20,13 @@ class HealthBoard:
         self._lock = threading.Lock()
         self._listeners: list[Callable[[LinkHealth], None]] = []
 
-    def link(self, name: str, backoff: Backoff | None = None) -> LinkHealth:
-        """The health of link ``name`` (``rotor``, ``radio``, ``elements``, ``state-file`` ...)."""
+    def link(self, name: str, backoff: Backoff | None = None, paced: bool = True) -> LinkHealth:
+        """The health of link ``name`` (``rotor``, ``radio``, ``elements``, ``state-file`` ...); ``backoff``
+        and ``paced`` count when the link is first made."""
         with self._lock:
             health = self._links.get(name)
             if health is None:
-                health = LinkHealth(name, self.clock, backoff, on_change=self._changed)
+                health = LinkHealth(name, self.clock, backoff, on_change=self._changed, paced=paced)
                 self._links[name] = health
             return health
 

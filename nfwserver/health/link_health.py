@@ -13,7 +13,10 @@ Usage, from whatever thread owns the link::
 Delays are seconds on the injected clock (:meth:`Clock.monotonic`): the first retry comes
 ``initial_s`` after the first failure, each further one doubles the delay, up to ``max_s``.  A caller
 may :meth:`LinkHealth.retry_now` (an operator action: a new satellite, ``TRACK ON``, a reload) to
-skip the wait once.  Thread-safe: the state is read by ``STATUS`` and the console from other threads.
+skip the wait once.  A link that is tried on its own schedule anyway (the tracker computes every tick)
+is made with ``paced=False``: it is never held back and its lines name no retry time.
+
+Thread-safe: the state is read by ``STATUS`` and the console from other threads.
 """
 
 from __future__ import annotations
@@ -69,8 +72,10 @@ class LinkHealth:
     """The health of the link called ``name``; see the module docstring."""
 
     def __init__(self, name: str, clock: Clock, backoff: Backoff | None = None,
-                 logger: logging.Logger | None = None, on_change: Callable[[LinkHealth], None] | None = None) -> None:
+                 logger: logging.Logger | None = None, on_change: Callable[[LinkHealth], None] | None = None,
+                 paced: bool = True) -> None:
         self.name = name
+        self.paced = paced
         self.clock = clock
         self.backoff = backoff or Backoff()
         self.logger = logger or log
@@ -92,12 +97,18 @@ class LinkHealth:
     def describe(self) -> str:
         """``ok`` or the fault, for STATUS and the console."""
         fault = self._fault
-        return "ok" if fault is None else fault.describe(self.clock.monotonic())
+        if fault is None:
+            return "ok"
+        if not self.paced:
+            now = self.clock.monotonic()
+            times = "failure" if fault.failures == 1 else "failures"
+            return f"{fault.reason} ({fault.failures} {times} in {now - fault.since:.0f} s)"
+        return fault.describe(self.clock.monotonic())
 
     def may_try(self) -> bool:
         """True when the link is ok or its retry time has come."""
         fault = self._fault
-        return fault is None or self.clock.monotonic() >= fault.retry_at
+        return fault is None or not self.paced or self.clock.monotonic() >= fault.retry_at
 
     # -- writing ---------------------------------------------------------------------------
     def failed(self, reason: str, level: int = logging.WARNING) -> Fault:
@@ -107,11 +118,15 @@ class LinkHealth:
         with self._lock:
             old = self._fault
             failures = 1 if old is None else old.failures + 1
-            fault = Fault(reason, now if old is None else old.since, failures, now + self.backoff.delay(failures))
+            delay = self.backoff.delay(failures) if self.paced else 0.0
+            fault = Fault(reason, now if old is None else old.since, failures, now + delay)
             self._fault = fault
         if old is None:
             self._lines.clear(self.name)
-        self._lines.log(level, self.name, "%s: %s; retrying in %.0f s", self.name, reason, fault.retry_at - now)
+        if self.paced:
+            self._lines.log(level, self.name, "%s: %s; retrying in %.0f s", self.name, reason, fault.retry_at - now)
+        else:
+            self._lines.log(level, self.name, "%s: %s", self.name, reason)
         if old is None:
             self._changed()
         return fault

@@ -8,7 +8,10 @@ from __future__ import annotations
 
 from datetime import timedelta
 
+import pytest
+
 from nfwserver.core.status import INTERFACE_VERSION, StatusBit
+from nfwserver.fake_dde.errors import DMLERR_NOTPROCESSED, DdeError
 from nfwserver.tracking.catalog import Catalog
 from tests.dde.conftest import CATALOG, ISS, ISS_PASS, make_station
 
@@ -83,19 +86,42 @@ def test_not_recomputed_after_a_parameter_change() -> None:
     assert not core.tracker.status_word() & StatusBit.NOT_RECOMPUTED
 
 
-def test_arithmetic_error_latches_until_an_enable_call() -> None:
-    # "0010 An arithmetic error has occurred. No computations will be done until a new Enable call is made."
-    # Function FE: "Enabling tracking resets any existing arithmetic error conditions."
+def test_arithmetic_error_belongs_to_the_tick_it_happened_in() -> None:
+    # "0010 An arithmetic error has occurred."  OrbitDRV then computed nothing until an enable call; an
+    # unattended server must not go silent for good on one bad instant (issue: unattended station), so
+    # the bit describes the tick that failed and the feed resumes on the first good one, no command needed.
     core = make_station().core
     core.command("TUNE ON")
-    far = core.tick(ISS_PASS.tca + timedelta(days=3650))  # ten years on: SGP4 gives up
-    assert far.status & StatusBit.ARITHMETIC_ERROR and far.text == "" and far.error
-    again = core.tick(ISS_PASS.tca)  # a good instant, but no computation until an enable call
-    assert again.status & StatusBit.ARITHMETIC_ERROR and again.look_angles is None and again.text == ""
-    assert core.current_text() == ""
-    core.command("TRACK ON")
     good = core.tick(ISS_PASS.tca)
-    assert not good.status & StatusBit.ARITHMETIC_ERROR and good.look_angles is not None and good.text
+    far = core.tick(ISS_PASS.tca + timedelta(days=3650))  # a clock step ten years on: SGP4 gives up
+    assert far.status & StatusBit.ARITHMETIC_ERROR and far.text == "" and far.error
+    assert core.current_text() == ""
+    assert list(core.health.faults()) == ["tracking"]
+    assert "cannot compute ISS" in core.health.faults()["tracking"]
+    again = core.tick(ISS_PASS.tca)  # the clock is back: the very next tick publishes
+    assert not again.status & StatusBit.ARITHMETIC_ERROR and not again.error
+    assert again.text == good.text and core.current_text() == good.text
+    assert core.health.faults() == {}
+
+
+def test_sat_of_a_set_that_cannot_be_computed_now_is_refused_and_the_feed_stays() -> None:
+    # Never a silent OK followed by nothing: the poke is refused (DDE_FNOTPROCESSED, a bad subfunction)
+    # with the reason, and the satellite being published stays selected.
+    station = _station_with_dead_satellite()
+    core = station.core
+    core.command("TUNE ON")
+    before = core.tick()
+    assert before.text.startswith("ISS ")
+    result = core.command(f"SAT={DEAD}")
+    assert not result.accepted and result.status & StatusBit.BAD_SUBFUNCTION
+    assert result.note is not None and "cannot be computed now" in result.note and "decayed" in result.note
+    assert core.state.snapshot().catalog_number == ISS
+    assert core.tick().text.startswith("ISS ")
+    conv = station.system.connect("NFW32", "NFW_DATA")
+    with pytest.raises(DdeError) as refused:  # DDE_FNOTPROCESSED on the wire too
+        conv.poke("NFW_SERVER", f"SAT={DEAD}")
+    assert refused.value.code == DMLERR_NOTPROCESSED
+    assert conv.request_text("NFW_SERVER").startswith("ISS ")
 
 
 def test_no_string_of_the_previous_satellite_after_sat_change() -> None:
@@ -104,7 +130,7 @@ def test_no_string_of_the_previous_satellite_after_sat_change() -> None:
     core = station.core
     core.command("TUNE ON")
     assert core.tick(ISS_PASS.tca).text.startswith("ISS ")
-    assert core.command(f"SAT={DEAD}").ok
+    assert core.select_satellite(DEAD, source="console")  # the console's picker selects without computing
     assert core.current_text() == ""  # at once, before any tick
     sample = core.tick(ISS_PASS.tca)
     assert sample.status & StatusBit.ARITHMETIC_ERROR and sample.text == "" and core.current_text() == ""
