@@ -6,6 +6,12 @@
 (:mod:`nfwserver.easycomm.line_format`) for the newest sample, with pyserial.  Nova never reads the
 port, and neither do we.
 
+Only the current tick is written: a sample older than one and a half periods (the longer of the
+publisher's and this output's) is skipped, not written.  After the process was stopped and continued
+(SIGSTOP/SIGCONT, a suspended VM) the worker may wake before the publisher has ticked again; the
+newest sample then describes an instant seconds or minutes ago, and the antenna must not be sent
+there.  The next period writes the fresh tick.
+
 When lines are written: while autotracking is on (Nova's ``TRACK ON``) and the selected satellite
 is above the horizon table (``AH:Y``).  When that stops -- ``TRACK OFF``, LOS, another satellite
 below the horizon, no position -- one ``SA SE`` line stops the antenna; ``SA SE`` is written again at
@@ -63,6 +69,7 @@ class EasyCommOutput(ServiceThread):
         self.open_port = open_port
         self.last_line = ""  #: the last line written, without its terminator
         self.lines_written = 0
+        self.stale_skipped = 0  #: periods skipped because the newest sample was not the current tick
         self._port: serial.Serial | None = None
         self._pending: TickSample | None = None
         self._active = False  # the last step wrote a position: a stop is owed when it ends
@@ -90,12 +97,20 @@ class EasyCommOutput(ServiceThread):
             return doppler_line(la.azimuth_deg, la.elevation_deg, la.range_rate_km_s, channel)
         return range_rate_line(la.azimuth_deg, la.elevation_deg, la.range_rate_km_s)
 
+    def max_sample_age_s(self) -> float:
+        """How old (seconds, on the clock) the newest sample may be and still be the current tick."""
+        return 1.5 * max(1.0 / self.state.rate_hz, 1.0 / self.config.rate_hz)
+
     def step(self) -> None:
         """One period's work: a position line, or the one stop line owed (worker thread).  A closed port is
         reopened (within the back-off) even with nothing to write, so a missing device shows at once."""
         if self._port is None:
             self._open()
-        line = self.line_for(self._pending)
+        sample = self._pending
+        if sample is not None and (self.clock.now() - sample.time).total_seconds() > self.max_sample_age_s():
+            self.stale_skipped += 1
+            return  # computed for another tick: wait for the current one
+        line = self.line_for(sample)
         if line is not None:
             if self._write(line):
                 self._active = True

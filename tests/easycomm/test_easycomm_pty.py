@@ -81,6 +81,12 @@ def _step(station, output: EasyCommOutput) -> None:
     assert output.lines_written == written + 1
 
 
+def ticked(station) -> bool:
+    """Tick the core, as the publisher would at this instant; always True (for use inside predicates)."""
+    station.core.tick()
+    return True
+
+
 def test_lines_during_a_pass_match_the_spec_and_skyfield(tmp_path) -> None:
     start = ISS_PASS.tca - timedelta(seconds=60)
     dut1 = float(skyfield_look_angles(CATALOG.get(ISS).elements, OBSERVER, [start])[4][0])
@@ -119,6 +125,7 @@ def test_lines_come_at_the_configured_rate_on_the_clock(tmp_path) -> None:
         first = output.lines_written
         for _ in range(100):  # 10 s of virtual time in small steps the worker can follow
             station.clock.advance(0.1)
+            station.core.tick()  # as the publisher does
             time.sleep(0.01)
         assert output.lines_written - first in (19, 20, 21)  # 2 Hz
     finally:
@@ -173,6 +180,7 @@ def test_doppler_mode_carries_the_channel_frequencies_and_modes(tmp_path) -> Non
 
 
 def test_the_device_vanishing_and_returning_is_survived_with_capped_back_off(tmp_path, caplog) -> None:
+    # The publisher ticks at every step of the clock, as it does in a running station.
     station = make_station(start=ISS_PASS.tca - timedelta(seconds=120))
     pty = Pty(tmp_path / "ttyUSB0")
     attempts: list[float] = []
@@ -186,19 +194,49 @@ def test_the_device_vanishing_and_returning_is_survived_with_capped_back_off(tmp
     station.core.tick()
     output.start()
     try:
-        assert advance_until(station.clock, lambda: output.lines_written >= 2, step_s=0.25)
+        assert advance_until(station.clock, lambda: ticked(station) and output.lines_written >= 2, step_s=0.25)
         assert pty.lines()[0].startswith("AZ") and output.connected
         pty.vanish()  # unplugged
         gone = station.clock.monotonic()
-        assert advance_until(station.clock, lambda: len(attempts) >= 7, step_s=0.25, limit_s=60)
+        assert advance_until(station.clock, lambda: ticked(station) and len(attempts) >= 7, step_s=0.25, limit_s=60)
         assert not output.connected
         gaps = [b - a for a, b in zip(attempts[1:], attempts[2:])]
         assert gaps[:2] == pytest.approx([2.0, 4.0], abs=0.51) and max(gaps) <= 4.0 + 0.51
         assert len([r for r in caplog.records if r.levelname == "WARNING" and "EasyComm" in r.getMessage()]) == 1
         written = output.lines_written
         back = Pty(pty.path)  # plugged in again (a new tty behind the same name)
-        assert advance_until(station.clock, lambda: output.lines_written > written + 1, step_s=0.25, limit_s=10)
+        assert advance_until(station.clock, lambda: ticked(station) and output.lines_written > written + 1,
+                             step_s=0.25, limit_s=10)
         assert station.clock.monotonic() - gone < 60
         assert back.lines()[0].startswith("AZ") and output.connected
     finally:
         output.stop()
+
+
+def test_after_the_process_was_stopped_no_line_for_an_old_tick_is_written(tmp_path) -> None:
+    # SIGSTOP, then SIGCONT 60 s later: the output's worker may wake before the publisher ticks again, with
+    # the newest sample a minute old (ISS moved tens of degrees).  It must write nothing for that sample
+    # and write the fresh position as soon as the publisher has ticked.
+    station = make_station(start=ISS_PASS.tca - timedelta(seconds=90))
+    pty = Pty(tmp_path / "ttyUSB0")
+    output = _output(station, pty.path)
+    station.core.set_track(True)
+    for _ in range(3):
+        station.core.tick()
+        output.step()
+        station.clock.advance(0.5)
+    before = pty.lines()
+    assert len(before) == 3 and all(NOVA_LINE.match(line) for line in before)
+    station.clock.advance(60.0)  # stopped for a minute: no tick, then the worker wakes first
+    written = output.lines_written
+    output.step()
+    assert output.lines_written == written and output.stale_skipped == 1
+    assert pty.lines(wait_s=0.05) == []
+    fresh = station.core.tick()
+    output.step()
+    (line,) = pty.lines()
+    la = fresh.look_angles
+    m = NOVA_LINE.match(line)
+    assert m and abs(float(m.group(1)) - la.azimuth_deg) <= 0.05 + 1e-9
+    assert abs(float(m.group(2)) - la.elevation_deg) <= 0.05 + 1e-9
+    output._close()
