@@ -23,7 +23,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs" / "BENCHMARKS.md"
 OPT_IN = ("wine_dde",)  #: run only when named
-STANDALONE = ("reliability",)  #: run alone, named first, with their own options; they write no section
+STANDALONE = ("reliability", "faults")  #: run alone, named first, with their own options; they write no section
 HEADER = ("# Benchmarks\n\nRegenerate with `python -m bench` (a subset: `python -m bench NAME ...`; the Wine "
           "section: `NFW_WINE_HOME=... python -m bench wine-dde`).\n")
 

@@ -1,0 +1,175 @@
+"""A real station for the fault campaign, stepped one tick at a time on a virtual clock.
+
+:class:`FaultRig` builds ``nfwserver.app.station.Station`` from a configuration file (watched, so a
+live reload can be faulted) with: the in-process DDE transport and a hot advise client, Nova's TCP
+server on an ephemeral loopback port, a rotor on a real ``rotctld`` and a radio on a real ``rigctld``,
+each behind a :class:`~bench.fault_campaign.fault_proxy.FaultProxy`, EasyComm on a pseudo-terminal,
+the session state file in a work directory.  The clock starts shortly before a high ISS pass.
+
+:meth:`FaultRig.tick` advances the clock by one publish period, waits (real time, bounded) until the
+publisher has ticked and the workers have had a moment, and returns a :class:`TickRecord`: what the
+DDE client received for that tick, the STATUS line's fields as Nova's TCP protocol builds them, and
+how many log records with a traceback were written since the previous tick.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import tempfile
+import time
+from dataclasses import dataclass, field
+from datetime import datetime, timedelta, timezone
+from pathlib import Path
+
+from bench.fault_campaign.fault_proxy import FaultProxy
+from nfwserver.app.station import Station
+from nfwserver.clock import VirtualClock
+from nfwserver.config import parse_config
+from nfwserver.fake_dde import FakeDdeSystem
+from nfwserver.tracking.catalog import Catalog
+from nfwserver.tracking.elements import load_element_file
+from nfwserver.tracking.observer import Observer
+from nfwserver.tracking.passes import find_passes
+from tests.hamlib_daemons import HamlibDaemon
+
+ROOT = Path(__file__).resolve().parents[2]
+ELEMENTS = ROOT / "tests" / "data" / "visual.txt"
+OBSERVER = Observer(52.2053, 0.1218, 20.0)
+ISS = 25544
+RATE_HZ = 5.0
+
+
+def iss_pass_start() -> datetime:
+    """Ten seconds before the highest ISS pass over the observer on 2026-05-08 (from our own search;
+    the campaign only needs *a* pass, not an accurate one): the rotor faults come first, while it is up."""
+    catalog = Catalog(s for s in load_element_file(ELEMENTS).sets)
+    day = datetime(2026, 5, 8, tzinfo=timezone.utc)
+    best = max(find_passes([catalog.get(ISS)], OBSERVER, day, day + timedelta(days=1)),
+               key=lambda p: p.max_elevation_deg)
+    return best.aos - timedelta(seconds=10)
+
+
+class TracebackCounter(logging.Handler):
+    """Counts log records that carry exception information (a traceback in the log)."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.DEBUG)
+        self.count = 0
+        self.last = ""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        if record.exc_info:
+            self.count += 1
+            self.last = record.getMessage()
+
+
+@dataclass
+class TickRecord:
+    """What one tick looked like from outside."""
+
+    index: int
+    time: datetime
+    published: bool  #: the DDE advise client received a string for this tick
+    text: str  #: the tick's Nova string ("" when none)
+    status: dict[str, str]  #: STATUS fields
+    tracebacks: int  #: log records with a traceback since the previous tick
+
+    @property
+    def faults(self) -> list[str]:
+        value = self.status.get("faults", "none")
+        return [] if value == "none" else value.split(",")
+
+
+@dataclass
+class FaultRig:
+    """See the module docstring.  Use as a context manager."""
+
+    work: Path = field(default_factory=lambda: Path(tempfile.mkdtemp(prefix="nfw-faults-")))
+
+    def __post_init__(self) -> None:
+        self.clock = VirtualClock(iss_pass_start())
+        self.rotctld = HamlibDaemon("rotctld", extra=["--set-conf=min_az=0,max_az=450,min_el=0,max_el=90"]).start()
+        self.rigctld = HamlibDaemon("rigctld").start()
+        self.rotor_proxy = FaultProxy((self.rotctld.host, self.rotctld.port))
+        self.radio_proxy = FaultProxy((self.rigctld.host, self.rigctld.port))
+        self.master, slave = os.openpty()
+        self.tty = os.ttyname(slave)
+        self._slave = slave
+        (self.work / "state").mkdir()
+        self.state_path = self.work / "state" / "state.json"
+        self.config_path = self.work / "nfwserver.toml"
+        self.config_text = self._config_text()
+        self.config_path.write_text(self.config_text)
+        self.system = FakeDdeSystem()
+        self.station = Station(parse_config(self.config_text), self.clock, transport=self.system.server_transport())
+        self.tracebacks = TracebackCounter()
+        logging.getLogger().addHandler(self.tracebacks)
+        self._seen_tracebacks = 0
+        self.received: list[tuple[int, str]] = []  # (tick index, text) of every DDE delivery
+        self.index = 0
+
+    def _config_text(self) -> str:
+        return (
+            f'[observer]\nlocation = "{OBSERVER.latitude_deg},{OBSERVER.longitude_deg},{OBSERVER.altitude_m}"\n'
+            f'[elements]\nfiles = ["{ELEMENTS}"]\nuse_bundled = false\nstore = "none"\n'
+            f'[server]\nstate_file = "{self.state_path}"\nsatellite = {ISS}\ntune = true\ntrack = true\n'
+            f'rate_hz = {RATE_HZ:g}\n'
+            '[tcp]\nenabled = true\nport = 0\n'
+            f'[rotor]\nbackend = "rotctld"\nport = {self.rotor_proxy.port}\ngeometry = "overlap-450"\n'
+            f'[radio]\nenabled = true\nbackend = "rigctld"\nport = {self.radio_proxy.port}\n'
+            f'[easycomm]\nenabled = true\ndevice = "{self.tty}"\n')
+
+    # -- life cycle ------------------------------------------------------------------------------------
+    def __enter__(self) -> FaultRig:
+        self.station.start()
+        self.station.watch_config(str(self.config_path), interval_s=1.0)
+        conv = self.system.connect("NFW32", "NFW_DATA", client_name="campaign")
+        conv.on_receive = lambda r: self.received.append((self.index, r.text or ""))
+        conv.start_advise("NFW_SERVER", hot=True)
+        self.conv = conv
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.station.stop()
+        logging.getLogger().removeHandler(self.tracebacks)
+        for proxy in (self.rotor_proxy, self.radio_proxy):
+            proxy.close()
+        for daemon in (self.rotctld, self.rigctld):
+            daemon.kill()
+        os.close(self.master)
+        os.close(self._slave)
+
+    # -- stepping --------------------------------------------------------------------------------------
+    def drain_tty(self) -> bytes:
+        """Whatever EasyComm wrote since the last call (non-blocking)."""
+        os.set_blocking(self.master, False)
+        data = b""
+        try:
+            while chunk := os.read(self.master, 65536):
+                data += chunk
+        except (BlockingIOError, OSError):
+            pass
+        return data
+
+    def tick(self) -> TickRecord:
+        """One publish period of virtual time; see the module docstring."""
+        publisher = self.station.publisher
+        before = publisher.stats.ticks
+        self.index += 1
+        self.clock.advance(1.0 / RATE_HZ)
+        deadline = time.monotonic() + 2.0
+        while publisher.stats.ticks == before and time.monotonic() < deadline:
+            time.sleep(0.0005)
+        time.sleep(0.003)  # let the device workers take the sample
+        sample = self.station.core.tracker.last_sample
+        text = sample.text if sample is not None else ""
+        got = any(i == self.index and t for i, t in self.received[-3:])
+        assert self.station.tcp is not None
+        status = dict(pair.split("=", 1) for pair in self.station.tcp.protocol.status_line().split(" "))
+        traces, self._seen_tracebacks = self.tracebacks.count - self._seen_tracebacks, self.tracebacks.count
+        self.drain_tty()
+        return TickRecord(self.index, self.clock.now(), got, text, status, traces)
+
+    def run(self, seconds: float) -> list[TickRecord]:
+        return [self.tick() for _ in range(round(seconds * RATE_HZ))]

@@ -1,0 +1,160 @@
+"""The faults of the campaign: how each is caused, how its cause ends, and what "working" means.
+
+Each :class:`Fault` names the health link that must show it in STATUS while it lasts (``link``; None
+for a fault that must not disturb anything an operator sees), injects its cause into a running
+:class:`~bench.fault_campaign.rig.FaultRig`, ends it, and says per tick whether the output it hits
+works again (:attr:`Fault.works`).
+"""
+
+from __future__ import annotations
+
+import math
+import socket
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from bench.fault_campaign.rig import ISS, FaultRig, TickRecord
+from nfwserver.tracking.elements import load_elements
+from nfwserver.tracking.tle import tle_checksum
+
+
+@dataclass(frozen=True)
+class Fault:
+    name: str  #: what an operator would call it
+    link: str | None  #: the health link STATUS names while it lasts
+    inject: Callable[[FaultRig], None]
+    remove: Callable[[FaultRig], None]
+    works: Callable[[FaultRig, TickRecord], bool]
+    duration_s: float = 20.0  #: how long the cause lasts (virtual seconds)
+    feed_may_stop: bool = False  #: the Nova feed itself is what fails (silent ticks are the fault)
+
+
+# -- what "works" means -----------------------------------------------------------------------------------
+def _ask(port: int, command: bytes) -> list[str]:
+    with socket.create_connection(("127.0.0.1", port), timeout=2.0) as s:
+        s.sendall(command)
+        data = b""
+        while data.count(b"\n") < (2 if command == b"p\n" else 1):
+            chunk = s.recv(4096)
+            if not chunk:
+                break
+            data += chunk
+    return data.decode().split()
+
+
+def feed_works(rig: FaultRig, record: TickRecord) -> bool:
+    return record.published
+
+
+def rotor_works(rig: FaultRig, record: TickRecord) -> bool:
+    """The rotor follows: no rotor fault, and the real daemon's position is where the driver sent it
+    (within 2 degrees a step at 6 deg/s covers) or moving toward it."""
+    rotor = rig.station.rotor
+    if rotor is None or "rotor" in record.faults:
+        return False
+    _, _, target_el, target_az = rotor.driver.positions()
+    if target_az is None or target_el is None:
+        return False
+    az, el = (float(v) for v in _ask(rig.rotctld.port, b"p\n")[:2])
+    return math.hypot(az - target_az, el - target_el) < 15.0
+
+
+def radio_works(rig: FaultRig, record: TickRecord) -> bool:
+    """The radio is tuned: no radio fault, and the real rigctld holds the frequency last sent."""
+    radio = rig.station.radio
+    if radio is None or "radio" in record.faults or radio.last_result is None:
+        return False
+    return abs(int(_ask(rig.rigctld.port, b"f\n")[0]) - radio.last_result.rx_hz) <= 100
+
+
+def state_saved(rig: FaultRig, record: TickRecord) -> bool:
+    return "state-file" not in record.faults and rig.state_path.is_file() and \
+        f'"satellite": {rig.station.core.state.catalog_number}' in rig.state_path.read_text()
+
+
+def config_kept(rig: FaultRig, record: TickRecord) -> bool:
+    observer = rig.station.core.state.observer
+    return "config" not in record.faults and observer is not None and abs(observer.latitude_deg - 52.2053) < 1e-6
+
+
+# -- causes ---------------------------------------------------------------------------------------------
+DECAYED = 99999  #: the catalog number the decay fault uses
+
+
+def _decayed_set(rig: FaultRig, years_old: int) -> None:
+    """ISS's elements as satellite 99999, with an epoch ``years_old`` years before ISS's: ten years old,
+    SGP4 reports it decayed at every tick; a fresh set (0) computes again, as a refreshed set does."""
+    iss = rig.station.core.state.catalog.get(ISS).elements
+    year = int(iss.line1[18:20]) - years_old
+    l1 = iss.line1[:2] + f"{DECAYED:05d}" + iss.line1[7:18] + f"{year:02d}" + iss.line1[20:68]
+    l2 = iss.line2[:2] + f"{DECAYED:05d}" + iss.line2[7:68]
+    sets = load_elements(f"DECAYED\n{l1}{tle_checksum(l1)}\n{l2}{tle_checksum(l2)}\n").sets
+    core = rig.station.core
+    core.state.catalog.update(sets)
+    core.state.catalog_changed()
+    if years_old:
+        core.select_satellite(DECAYED, source="campaign")  # selected before it went bad (SAT= now refuses it)
+
+
+def _state_dir_blocked(rig: FaultRig, blocked: bool) -> None:
+    folder, away = rig.state_path.parent, rig.state_path.parent.with_name("state.away")
+    if blocked:
+        folder.rename(away)
+        folder.write_text("a file where the state folder was\n")  # writes now fail with ENOTDIR
+        rig.station.core.select_satellite(694, source="campaign")  # a change that must be saved
+    else:
+        folder.unlink()
+        away.rename(folder)
+
+
+def _stop_process(rig: FaultRig) -> None:
+    """SIGSTOP for a minute, then SIGCONT: the clock jumps with nobody ticking."""
+    rig.clock.advance(60.0)
+
+
+def _tcp_junk(rig: FaultRig) -> None:
+    assert rig.station.tcp is not None
+    with socket.create_connection(rig.station.tcp.address, timeout=2.0) as s:
+        s.sendall(b"\x0b\r\n\x0c\r\n\x1c\x1d\x1e\x1f\r\n" * 50 + b"SUMMARY\r\n")
+        data = b""
+        while data.count(b"\r\n") < 2:
+            chunk = s.recv(65536)
+            if not chunk:
+                break
+            data += chunk
+
+
+def _nothing(rig: FaultRig) -> None:
+    return None
+
+
+FAULTS = (
+    Fault("rotctld refuses every move (RPRT -1)", "rotor",
+          lambda rig: rig.rotor_proxy.set_mode("refuse"), lambda rig: rig.rotor_proxy.set_mode("pass"), rotor_works),
+    Fault("rotor jammed: moves accepted, nothing turns", "rotor",
+          lambda rig: rig.rotor_proxy.set_mode("jam"), lambda rig: rig.rotor_proxy.set_mode("pass"), rotor_works,
+          duration_s=40.0),
+    Fault("rotctld killed, restarted", "rotor",
+          lambda rig: rig.rotctld.kill(), lambda rig: rig.rotctld.restart(), rotor_works),
+    Fault("rigctld killed, restarted", "radio",
+          lambda rig: rig.rigctld.kill(), lambda rig: rig.rigctld.restart(), radio_works),
+    Fault("rigctld answers one byte at a time", "radio",
+          lambda rig: rig.radio_proxy.set_mode("trickle"), lambda rig: rig.radio_proxy.set_mode("pass"), radio_works),
+    Fault("selected set past decay (SGP4 error 6), then a fresh set", "tracking",
+          lambda rig: _decayed_set(rig, 10), lambda rig: _decayed_set(rig, 0), feed_works, feed_may_stop=True),
+    Fault("state folder unwritable, then writable", "state-file",
+          lambda rig: _state_dir_blocked(rig, True), lambda rig: _state_dir_blocked(rig, False), state_saved),
+    Fault("configuration file emptied by an editor mid-save, then written whole", "config",
+          lambda rig: rig.config_path.write_text(""), lambda rig: rig.config_path.write_text(rig.config_text),
+          config_kept),
+    Fault("process stopped for 60 s (SIGSTOP/SIGCONT)", None, _stop_process, _nothing, feed_works, duration_s=0.2),
+    Fault("TCP lines of VT, FF and 0x1C-0x1F", None, _tcp_junk, _nothing, feed_works, duration_s=0.2),
+)
+
+
+def restore_baseline(rig: FaultRig) -> None:
+    """Between faults: ISS selected again (a fault may have changed it)."""
+    if rig.station.core.state.catalog_number != ISS:
+        rig.station.core.select_satellite(ISS, source="campaign")
+
+
