@@ -124,10 +124,14 @@ def test_fuzzed_configuration_is_accepted_or_refused_with_reasons(entries) -> No
 
 @given(st.text(max_size=500))
 def test_random_text_configuration(text) -> None:
+    # Accepted, or refused with at least one reason, each one printable line naming TOML or a section.
     try:
         parse_config(text)
-    except ConfigError:
-        pass
+    except ConfigError as exc:
+        assert exc.problems
+        for problem in exc.problems:
+            assert problem.strip() and "\n" not in problem
+            assert problem.startswith(("not valid TOML", "[")), problem
 
 
 def test_pokes_cannot_forge_log_lines(caplog) -> None:

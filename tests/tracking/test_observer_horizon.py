@@ -47,11 +47,16 @@ def test_locator_round_trip_stays_in_its_box(lat: float, lon: float, precision: 
     assert latlon_to_locator(clat, clon, precision) == loc
 
 
-@pytest.mark.parametrize("text", ["", "abc", "91,0", "10,400", "1,2,3,4", "nan,0", "10X,5E", "ZZ99", "10,10,xx"])
-def test_bad_observers_say_why(text: str) -> None:
+@pytest.mark.parametrize(("text", "says"), [
+    ("", "neither LAT,LON"), ("abc", "'abc' is neither LAT,LON"), ("91,0", "latitude 91.0 is outside -90..90"),
+    ("10,400", "longitude 400.0 is outside"), ("1,2,3,4", "'1,2,3,4' is neither"), ("nan,0", "'nan' is not a finite"),
+    ("10X,5E", "latitude '10X' is not a number"), ("ZZ99", "'ZZ99' is neither"), ("10,10,xx", "altitude 'xx'"),
+])
+def test_bad_observers_say_why(text: str, says: str) -> None:
+    # The reason names the value the user typed and what is wrong with it.
     with pytest.raises(ValueError) as info:
         parse_observer(text)
-    assert str(info.value)
+    assert says in str(info.value)
 
 
 def test_itrs_position_of_a_known_place() -> None:
