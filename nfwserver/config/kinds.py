@@ -13,19 +13,17 @@ import ipaddress
 import math
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from nfwserver.config.files import check_regular_file
+from nfwserver.config.setting import Setting
 from nfwserver.radio.defaults import DEFAULT_CHANNELS
 from nfwserver.radio.transponder import Channel
 from nfwserver.tracking.dde_names import validate_dde_name
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import parse_observer
 
-if TYPE_CHECKING:
-    from nfwserver.config.table import Setting
-
-Converter = Callable[["Setting", Any, "Path | None"], Any]
+Converter = Callable[[Setting, Any, "Path | None"], Any]
 
 
 class ManyProblems(ValueError):

@@ -13,41 +13,15 @@ Units are in the key names (``_hz``, ``_deg``, ``_s``, ``_m``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 from nfwserver.config.kinds import convert
+from nfwserver.config.setting import Section, Setting
 
 #: Hamlib's standard serial rates (baud).
 STANDARD_BAUD_RATES = (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200)
 ROTOR_GEOMETRIES = tuple(f"{base}{flip}" for base in ("north-stop", "south-stop", "overlap-450")
                          for flip in ("", "+flip"))
-
-
-@dataclass(frozen=True)
-class Setting:
-    """One key of one section."""
-
-    section: str
-    key: str
-    kind: str  #: a converter name in :data:`nfwserver.config.kinds.CONVERTERS`
-    default: Any  #: TOML value used when the key is absent; None = not set
-    help: str
-    where: str  #: dotted path of the effective value on Config
-    lo: float | None = None  #: numbers: inclusive range; texts: ``hi`` is the maximum length
-    hi: float | None = None
-    choices: tuple = ()
-    example: Any = None  #: shown commented out in the template instead of the default
-
-    @property
-    def name(self) -> str:
-        return f"[{self.section}] {self.key}"
-
-
-@dataclass(frozen=True)
-class Section:
-    name: str
-    help: str
 
 
 SECTIONS: tuple[Section, ...] = (

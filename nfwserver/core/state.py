@@ -145,15 +145,6 @@ class StationState:
             self._channels = MappingProxyType(dict(channels))
             self.generation += 1
 
-    def set_rate(self, rate_hz: float) -> bool:
-        return self._set("_rate_hz", check_rate(rate_hz))
-
-    def set_observer(self, observer: Observer | None) -> bool:
-        return self._set("_observer", observer)
-
-    def set_horizon(self, horizon: HorizonTable) -> bool:
-        return self._set("_horizon", horizon)
-
     def select(self, catalog_number: int | None) -> bool:
         return self._set("_catalog_number", catalog_number)
 

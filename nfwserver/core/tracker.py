@@ -93,10 +93,6 @@ class Tracker:
         after a change of satellite until the next tick, and while the computation fails."""
         return self._text  # replaced whole under the lock; reading one attribute needs none
 
-    @property
-    def arithmetic_error(self) -> ArithmeticErrorCode:
-        return self._error
-
     def status_word(self) -> int:
         """The status word now (OrbitDRV's Get Status Only)."""
         snap = self.state.snapshot()

@@ -9,15 +9,12 @@ the machine's locale.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import datetime, tzinfo
 
 from nfwserver.core.sample import TickSample
 from nfwserver.radio.transponder import Channel
-from nfwserver.tracking.derived import geodetic_from_itrs
-from nfwserver.tracking.timescale import SECONDS_PER_DAY, gmst1982, julian_date
 
 
 @dataclass(frozen=True)
@@ -39,22 +36,6 @@ class DialectView:
     time: datetime | None = None  #: the instant the values are for, aware UTC
     local_time: datetime | None = None  #: the same instant in the station's local time zone
     subpoint: tuple[float, float, float] | None = None  #: (latitude, east longitude, altitude km)
-
-
-def sub_satellite_point(satrec: object, when: datetime, ut1_utc: float = 0.0) -> tuple[float, float, float] | None:
-    """(geodetic latitude deg, east longitude deg -180..180, altitude km) under the satellite, or None.
-
-    SGP4's TEME position rotated by Greenwich mean sidereal time (IAU 1982, as SGP4 itself assumes),
-    polar motion neglected (metres).
-    """
-    jd, fr = julian_date(when)
-    err, r, _ = satrec.sgp4(jd, fr)  # type: ignore[attr-defined]
-    if err:
-        return None
-    theta, _ = gmst1982(jd, fr + ut1_utc / SECONDS_PER_DAY)
-    c, s = math.cos(theta), math.sin(theta)
-    lat, lon, alt = geodetic_from_itrs(c * r[0] + s * r[1], -s * r[0] + c * r[1], r[2])
-    return lat, (lon + 180.0) % 360.0 - 180.0, alt
 
 
 def view_from_sample(sample: TickSample, element_name: str, channel: Channel | None,

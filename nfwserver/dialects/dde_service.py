@@ -17,8 +17,8 @@ from nfwserver.core.sample import TickSample
 from nfwserver.core.station_core import StationCore
 from nfwserver.dde.clipboard import TEXT_FORMATS, encode_text
 from nfwserver.dde.transport import ConversationId, DdeServerTransport, PokeResult
-from nfwserver.dialects.base import Dialect, sub_satellite_point, view_from_sample
-from nfwserver.tracking.derived import revolution_and_phase
+from nfwserver.dialects.base import Dialect, view_from_sample
+from nfwserver.tracking.derived import revolution_and_phase, sub_satellite_point
 
 
 class DialectServer:

@@ -61,9 +61,6 @@ class RotorGeometry:
             return options[0]
         return min(options, key=lambda a: abs(a - current))
 
-    def clamp_elevation(self, el: float) -> float:
-        return min(max(el, self.el_min), self.el_max)
-
 
 def unwrap(azimuths: Sequence[float]) -> list[float]:
     """Continuous azimuths (steps below 180 degrees) starting from the first value."""

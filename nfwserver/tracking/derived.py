@@ -31,7 +31,7 @@ from nfwserver.tracking.constants import (
 )
 from nfwserver.tracking.doppler import doppler_shift_hz
 from nfwserver.tracking.elements import ElementSet
-from nfwserver.tracking.frames import ScalarLookAngles
+from nfwserver.tracking.frames import ScalarLookAngles, teme_to_itrs
 from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError
 from nfwserver.tracking.maidenhead import latlon_to_locator
 from nfwserver.tracking.observer import Observer
@@ -66,6 +66,19 @@ def geodetic_from_itrs(x: float, y: float, z: float) -> tuple[float, float, floa
             break
         lat = new
     return math.degrees(lat), math.degrees(lon), height
+
+
+def sub_satellite_point(satrec: object, when: datetime, ut1_utc: float = 0.0) -> tuple[float, float, float] | None:
+    """(geodetic latitude deg, east longitude deg -180..180, altitude km) under the satellite, or None when
+    SGP4 fails.  SGP4's TEME position taken to the ITRS by the one rotation of :mod:`~nfwserver.tracking.frames`
+    (GMST 1982 at UT1), polar motion neglected (metres)."""
+    jd, fr = julian_date(when)
+    err, r, _ = satrec.sgp4(jd, fr)  # type: ignore[attr-defined]
+    if err:
+        return None
+    pos, _ = teme_to_itrs(np.asarray(r, dtype=float), None, jd, fr, ut1_utc)
+    lat, lon, alt = geodetic_from_itrs(float(pos[0]), float(pos[1]), float(pos[2]))
+    return lat, (lon + 180.0) % 360.0 - 180.0, alt
 
 
 def revolution_and_phase(elements: ElementSet, when: datetime) -> tuple[int, int]:

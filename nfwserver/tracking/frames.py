@@ -56,10 +56,6 @@ class TopocentricFrame:
         #: the (east, north, up) unit vectors as tuples of floats (for sums of products)
         self.axes = tuple(tuple(float(c) for c in b) for b in observer.enu_basis())
 
-    def enu(self, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(east, north, up) components (km) of ``pos - origin`` for ITRS positions (..., 3)."""
-        return self.components(pos - self.origin)
-
     def components(self, vectors: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(east, north, up) components of ITRS vectors (..., 3), in their unit (km, km/s, ...).
 

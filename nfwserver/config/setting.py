@@ -1,0 +1,38 @@
+"""The record types of the configuration table: one :class:`Setting` per key, one :class:`Section` each.
+
+Kept apart from the table (:mod:`nfwserver.config.table`) so that the value converters
+(:mod:`nfwserver.config.kinds`) can name a setting without importing the table that uses them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+__all__ = ["Section", "Setting"]
+
+
+@dataclass(frozen=True)
+class Setting:
+    """One key of one section."""
+
+    section: str
+    key: str
+    kind: str  #: a converter name in :data:`nfwserver.config.kinds.CONVERTERS`
+    default: Any  #: TOML value used when the key is absent; None = not set
+    help: str
+    where: str  #: dotted path of the effective value on Config
+    lo: float | None = None  #: numbers: inclusive range; texts: ``hi`` is the maximum length
+    hi: float | None = None
+    choices: tuple[Any, ...] = ()
+    example: Any = None  #: shown commented out in the template instead of the default
+
+    @property
+    def name(self) -> str:
+        return f"[{self.section}] {self.key}"
+
+
+@dataclass(frozen=True)
+class Section:
+    name: str
+    help: str
