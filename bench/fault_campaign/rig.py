@@ -74,6 +74,7 @@ class TickRecord:
     text: str  #: the tick's Nova string ("" when none)
     status: dict[str, str]  #: STATUS fields
     tracebacks: int  #: log records with a traceback since the previous tick
+    easycomm: list[str]  #: EasyComm lines written during this tick
 
     @property
     def faults(self) -> list[str]:
@@ -108,6 +109,7 @@ class FaultRig:
         self._seen_tracebacks = 0
         self.received: list[tuple[int, str]] = []  # (tick index, text) of every DDE delivery
         self.index = 0
+        self.stale_easycomm = 0  #: EasyComm lines more than 5 deg from the tick that was current when read
 
     def _config_text(self) -> str:
         return (
@@ -157,7 +159,8 @@ class FaultRig:
         publisher = self.station.publisher
         before = publisher.stats.ticks
         self.index += 1
-        self.clock.advance(1.0 / RATE_HZ)
+        # A microsecond past the slot: the publisher's t0 + k / rate may round one ulp above k steps of 1 / rate.
+        self.clock.advance(1.0 / RATE_HZ + 1e-6)
         deadline = time.monotonic() + 2.0
         while publisher.stats.ticks == before and time.monotonic() < deadline:
             time.sleep(0.0005)
@@ -168,8 +171,15 @@ class FaultRig:
         assert self.station.tcp is not None
         status = dict(pair.split("=", 1) for pair in self.station.tcp.protocol.status_line().split(" "))
         traces, self._seen_tracebacks = self.tracebacks.count - self._seen_tracebacks, self.tracebacks.count
-        self.drain_tty()
-        return TickRecord(self.index, self.clock.now(), got, text, status, traces)
+        lines = [line for line in self.drain_tty().decode("ascii", "replace").split("\r\n") if line]
+        la = sample.look_angles if sample is not None else None
+        for line in lines:
+            if line.startswith("AZ") and la is not None:
+                az, el = float(line[2:].split()[0]), float(line.split()[1][2:])
+                daz = abs((az - la.azimuth_deg + 180.0) % 360.0 - 180.0)
+                if daz > 5.0 or abs(el - la.elevation_deg) > 5.0:
+                    self.stale_easycomm += 1
+        return TickRecord(self.index, self.clock.now(), got, text, status, traces, lines)
 
     def run(self, seconds: float) -> list[TickRecord]:
         return [self.tick() for _ in range(round(seconds * RATE_HZ))]

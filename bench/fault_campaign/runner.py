@@ -4,7 +4,8 @@ Per fault, in virtual time at the station's publish rate:
 
 1. healthy: ticks until the affected output works and STATUS names no fault (at most 60 s);
 2. the cause, for the fault's duration;
-3. the cause ended: ticks until the output works again and its link has left STATUS (at most 300 s).
+3. the cause ended: ticks until the output works again and its link has left STATUS (at most 300 s,
+   ``recovery_limit_s``).
 
 Measured: ``detected_s`` (cause to the first tick whose STATUS names the link), ``recovered_ticks`` and
 ``recovered_s`` (cause ended to the first tick that works with the link gone from STATUS), ``silent``
@@ -54,7 +55,7 @@ def _ok(fault: Fault, rig: FaultRig, record: TickRecord) -> bool:
     return works and (fault.link is None or fault.link not in record.faults)
 
 
-def run_fault(rig: FaultRig, fault: Fault) -> FaultResult:
+def run_fault(rig: FaultRig, fault: Fault, recovery_limit_s: float = RECOVERY_LIMIT_S) -> FaultResult:
     restore_baseline(rig)
     healthy = False
     for _ in range(round(HEALTHY_LIMIT_S * RATE_HZ)):
@@ -69,7 +70,7 @@ def run_fault(rig: FaultRig, fault: Fault) -> FaultResult:
     fault.remove(rig)
     ended = rig.index
     recovered: int | None = None
-    for _ in range(round(RECOVERY_LIMIT_S * RATE_HZ)):
+    for _ in range(round(recovery_limit_s * RATE_HZ)):
         record = rig.tick()
         records.append(record)
         if _ok(fault, rig, record):

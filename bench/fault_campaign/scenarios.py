@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import socket
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -44,6 +45,11 @@ def _ask(port: int, command: bytes) -> list[str]:
 
 def feed_works(rig: FaultRig, record: TickRecord) -> bool:
     return record.published
+
+
+def feed_and_easycomm_current(rig: FaultRig, record: TickRecord) -> bool:
+    """The feed publishes and EasyComm never wrote a line for a tick other than the current one."""
+    return record.published and rig.stale_easycomm == 0
 
 
 def rotor_works(rig: FaultRig, record: TickRecord) -> bool:
@@ -108,8 +114,22 @@ def _state_dir_blocked(rig: FaultRig, blocked: bool) -> None:
 
 
 def _stop_process(rig: FaultRig) -> None:
-    """SIGSTOP for a minute, then SIGCONT: the clock jumps with nobody ticking."""
-    rig.clock.advance(60.0)
+    """SIGSTOP for two minutes, then SIGCONT: the clock jumps with nobody ticking, every thread waiting on
+    it wakes at once, and the scheduler may run the device workers before the publisher (forced here:
+    the publisher is held until EasyComm's worker has had its period).  The satellite moved tens of
+    degrees meanwhile."""
+    easycomm = rig.station.easycomm
+    assert easycomm is not None
+    rig.station.publisher.stop()
+    periods = easycomm.lines_written + getattr(easycomm, "stale_skipped", 0)
+    rig.clock.advance(120.0)
+    deadline = time.monotonic() + 2.0
+    while easycomm.lines_written + getattr(easycomm, "stale_skipped", 0) == periods and time.monotonic() < deadline:
+        time.sleep(0.001)
+    ticks = rig.station.publisher.stats.ticks
+    rig.station.publisher.start()  # its schedule starts again from now, with a tick at once
+    while rig.station.publisher.stats.ticks == ticks and time.monotonic() < deadline + 2.0:
+        time.sleep(0.001)
 
 
 def _tcp_junk(rig: FaultRig) -> None:
@@ -147,7 +167,8 @@ FAULTS = (
     Fault("configuration file emptied by an editor mid-save, then written whole", "config",
           lambda rig: rig.config_path.write_text(""), lambda rig: rig.config_path.write_text(rig.config_text),
           config_kept),
-    Fault("process stopped for 60 s (SIGSTOP/SIGCONT)", None, _stop_process, _nothing, feed_works, duration_s=0.2),
+    Fault("process stopped for 120 s (SIGSTOP/SIGCONT)", None, _stop_process, _nothing, feed_and_easycomm_current,
+          duration_s=0.2),
     Fault("TCP lines of VT, FF and 0x1C-0x1F", None, _tcp_junk, _nothing, feed_works, duration_s=0.2),
 )
 
