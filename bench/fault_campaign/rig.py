@@ -93,7 +93,7 @@ class FaultRig:
         self.rotctld = HamlibDaemon("rotctld", extra=["--set-conf=min_az=0,max_az=450,min_el=0,max_el=90"]).start()
         self.rigctld = HamlibDaemon("rigctld").start()
         self.rotor_proxy = FaultProxy((self.rotctld.host, self.rotctld.port))
-        self.radio_proxy = FaultProxy((self.rigctld.host, self.rigctld.port))
+        self.radio_proxy = FaultProxy((self.rigctld.host, self.rigctld.port), trickle_s=0.3)
         self.master, slave = os.openpty()
         self.tty = os.ttyname(slave)
         self._slave = slave

@@ -63,30 +63,33 @@ def run_fault(rig: FaultRig, fault: Fault, recovery_limit_s: float = RECOVERY_LI
         if _ok(fault, rig, record) and not record.faults:
             healthy = True
             break
-    records: list[TickRecord] = []
+    records: list[tuple[TickRecord, bool]] = []  # each tick with whether the output worked then
+
+    def step() -> tuple[TickRecord, bool]:
+        record = rig.tick()
+        records.append((record, _ok(fault, rig, record)))
+        return records[-1]
+
     fault.inject(rig)
     start = rig.index
-    records += rig.run(fault.duration_s)
+    for _ in range(round(fault.duration_s * RATE_HZ)):
+        step()
     fault.remove(rig)
     ended = rig.index
     recovered: int | None = None
     for _ in range(round(recovery_limit_s * RATE_HZ)):
-        record = rig.tick()
-        records.append(record)
-        if _ok(fault, rig, record):
+        record, ok = step()
+        if ok:
             recovered = record.index - ended
             break
     after = rig.run(AFTER_S)
-    detected = next((r.index for r in records if fault.link is not None and fault.link in r.faults), None)
-    silent = sum(not r.published for r in records)
+    detected = next((r.index for r, _ in records if fault.link is not None and fault.link in r.faults), None)
+    silent = sum(not r.published for r, _ in records)
     unexplained = 0
-    for r in records:
+    for r, ok in records:
         if detected is not None and r.index < detected:
             continue  # detection takes its time; counted in detected_s
-        if recovered is not None and r.index >= ended + recovered:
-            continue
-        bad = not r.published if fault.feed_may_stop or fault.link is None else not _ok(fault, rig, r)
-        if (bad or not r.published) and not r.faults:
+        if (not ok or not r.published) and not r.faults:
             unexplained += 1
     return FaultResult(
         fault.name, fault.link, healthy,
@@ -94,4 +97,4 @@ def run_fault(rig: FaultRig, fault: Fault, recovery_limit_s: float = RECOVERY_LI
         recovered, None if recovered is None else recovered / RATE_HZ,
         len(records), silent, unexplained,
         sum(fault.link is not None and fault.link in r.faults for r in after),
-        sum(r.tracebacks for r in records + after))
+        sum(r.tracebacks for r, _ in records) + sum(r.tracebacks for r in after))

@@ -66,11 +66,14 @@ def rotor_works(rig: FaultRig, record: TickRecord) -> bool:
 
 
 def radio_works(rig: FaultRig, record: TickRecord) -> bool:
-    """The radio is tuned: no radio fault, and the real rigctld holds the frequency last sent."""
-    radio = rig.station.radio
-    if radio is None or "radio" in record.faults or radio.last_result is None:
+    """The radio follows Doppler: no radio fault, and the real rigctld is within 500 Hz (a few seconds of
+    Doppler drift) of this tick's downlink frequency for the satellite's channel."""
+    sample = rig.station.core.tracker.last_sample
+    channel = rig.station.core.state.channels.get(ISS)
+    if "radio" in record.faults or sample is None or sample.look_angles is None or channel is None:
         return False
-    return abs(int(_ask(rig.rigctld.port, b"f\n")[0]) - radio.last_result.rx_hz) <= 100
+    rx, _ = channel.ground_frequencies(sample.look_angles.range_rate_km_s)
+    return abs(int(_ask(rig.rigctld.port, b"f\n")[0]) - rx) <= 500
 
 
 def state_saved(rig: FaultRig, record: TickRecord) -> bool:
