@@ -17,7 +17,6 @@ threads.  :meth:`start` and :meth:`stop` are idempotent.
 from __future__ import annotations
 
 import logging
-from dataclasses import replace
 
 from nfwserver.app.config_watcher import ConfigWatcher
 from nfwserver.app.devices import make_radio, make_rotor
@@ -27,6 +26,7 @@ from nfwserver.app.session_state import SessionSaver, SessionState, StateFile
 from nfwserver.app.station_catalog import configured_store, load_station_catalog
 from nfwserver.app.status_fields import device_status
 from nfwserver.clock import Clock
+from nfwserver.config.live_reload import keep_running, restart_needed
 from nfwserver.config.schema import Config
 from nfwserver.core.events import Direction
 from nfwserver.core.publisher import Publisher
@@ -114,25 +114,8 @@ class Station:
         self.core.state.catalog_changed()
         if new.radio.enabled != self.config.radio.enabled:
             self.core.set_radio_tuning(new.radio.enabled, source="configuration")
-        running, restart = self.config, []
-        for label, old, now in (
-                ("[elements]", running.elements, new.elements), ("[rotor]", running.rotor, new.rotor),
-                ("[radio] backend", (running.radio.backend, running.radio.host, running.radio.port),
-                 (new.radio.backend, new.radio.host, new.radio.port)),
-                ("[server] services/topic/items", (running.server.services, running.server.topic,
-                                                    running.server.items),
-                 (new.server.services, new.server.topic, new.server.items)),
-                ("[dialects]", running.dialects, new.dialects), ("[tcp]", running.tcp, new.tcp),
-                ("[easycomm]", running.easycomm, new.easycomm)):
-            if old != now:
-                restart.append(label)
-        # What needs a restart keeps running as it was: remember it, so the next comparison is true.
-        self.config = replace(new, elements=running.elements, rotor=running.rotor,
-                              radio=replace(new.radio, backend=running.radio.backend, host=running.radio.host,
-                                            port=running.radio.port),
-                              server=replace(new.server, services=running.server.services,
-                                             topic=running.server.topic, items=running.server.items),
-                              dialects=running.dialects, tcp=running.tcp, easycomm=running.easycomm)
+        restart = restart_needed(self.config, new)
+        self.config = keep_running(self.config, new)  # what needs a restart keeps running as it was
         return restart
 
     def _config_changed(self, new: Config) -> None:
