@@ -58,7 +58,7 @@ def link_value(text: str) -> Link:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = subparsers.add_parser(
         "simulate", help="show what a DDE client receives, on virtual time",
         description="Run the server on the in-process DDE transport under a virtual clock with one client "

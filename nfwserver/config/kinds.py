@@ -21,7 +21,7 @@ from nfwserver.radio.defaults import DEFAULT_CHANNELS
 from nfwserver.radio.transponder import Channel
 from nfwserver.tracking.dde_names import validate_dde_name
 from nfwserver.tracking.horizon import HorizonTable
-from nfwserver.tracking.observer import parse_observer
+from nfwserver.tracking.observer import Observer, parse_observer
 
 Converter = Callable[[Setting, Any, "Path | None"], Any]
 
@@ -54,7 +54,7 @@ def _int(setting: Setting, value: Any, base: Path | None) -> int:
     if not _is_int(value):
         raise ValueError("must be a whole number")
     _range(setting, value)
-    return value
+    return int(value)
 
 
 def _number(setting: Setting, value: Any, base: Path | None) -> float:
@@ -77,7 +77,7 @@ def _text(setting: Setting, value: Any, base: Path | None) -> str:
     return value
 
 
-def _list(value: Any, what: str) -> list:
+def _list(value: Any, what: str) -> list[Any]:
     if not isinstance(value, list):
         raise ValueError(f"must be a list of {what}")
     return value
@@ -87,14 +87,14 @@ def _texts(setting: Setting, value: Any, base: Path | None) -> tuple[str, ...]:
     return tuple(_text(setting, v, base) for v in _list(value, "strings"))
 
 
-def _choices(setting: Setting, value: Any, base: Path | None) -> tuple:
+def _choices(setting: Setting, value: Any, base: Path | None) -> tuple[Any, ...]:
     return tuple(_choice(setting, v, base) for v in _list(value, "names"))
 
 
 def _catnr(setting: Setting, value: Any, base: Path | None) -> int:
     if not _is_int(value) or not 0 < value < 1_000_000_000:
         raise ValueError(f"{_show(value)} is not a catalog number")
-    return value
+    return int(value)
 
 
 def _catnrs(setting: Setting, value: Any, base: Path | None) -> tuple[int, ...]:
@@ -156,7 +156,7 @@ def _store(setting: Setting, value: Any, base: Path | None) -> str | None:
         raise ValueError("must be a file name, \"default\" or \"none\"") from None
 
 
-def _location(setting: Setting, value: Any, base: Path | None):
+def _location(setting: Setting, value: Any, base: Path | None) -> Observer:
     if not isinstance(value, str):
         raise ValueError("must be a string such as \"JO02ae\" or \"52.2,0.12,20\"")
     return parse_observer(value)
@@ -222,7 +222,7 @@ CHANNEL_KEYS: tuple[tuple[str, Any, str], ...] = (
 _CHANNEL_TYPES = {"name": str, "downlink_mode": str, "uplink_mode": str, "hold": str, "inverting": bool}
 
 
-def _channel(entry: dict) -> tuple[int, Channel]:
+def _channel(entry: dict[str, Any]) -> tuple[int, Channel]:
     """One channel entry; ValueError naming the first problem."""
     unknown = sorted(set(entry) - {k for k, _, _ in CHANNEL_KEYS})
     if unknown:

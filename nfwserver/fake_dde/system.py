@@ -197,9 +197,9 @@ class FakeDdeSystem:
             data = self._call(conv, "request", lambda: conv.handler.on_request(conv_id, conv.topic, item, fmt))
             if data is None:
                 raise DdeError(DMLERR_NOTPROCESSED, f"the server refused the request for {item!r}")
-            data = bytes(data)  # type: ignore[call-overload]
-            conv.client._deliver(Received(next(self._seq), "reply", item, fmt, data))
-            return data
+            reply: bytes = bytes(data)  # type: ignore[call-overload]
+            conv.client._deliver(Received(next(self._seq), "reply", item, fmt, reply))
+            return reply
 
     def _poke(self, conv_id: ConversationId, item: str, fmt: int, data: bytes) -> None:
         _check_name(item, "item")

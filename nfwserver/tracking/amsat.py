@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from datetime import datetime
 
 from nfwserver.tracking.tle import TleError, TleFields, check_ranges, epoch_from_tle
 
@@ -80,7 +81,7 @@ def _field_of(label: str) -> str | None:
     return None
 
 
-def _epoch(text: str):
+def _epoch(text: str) -> datetime:
     parts = text.split()
     if len(parts) >= 2 and parts[0].isdigit() and _NUMBER.fullmatch(parts[1]):
         year, day = int(parts[0]), float(parts[1])

@@ -33,7 +33,8 @@ class BodyView:
     right_ascension_deg: float  #: 0..360
 
 
-def body_view(position_km, observer: Observer, when: datetime, ut1_utc: float = 0.0) -> BodyView:
+def body_view(position_km: np.ndarray | tuple[float, float, float], observer: Observer, when: datetime,
+              ut1_utc: float = 0.0) -> BodyView:
     """View of a body at geocentric ``position_km`` (mean equator of date) at ``when`` (UTC)."""
     jd, fr = julian_date(when)
     x, y, z = (float(v) for v in position_km)

@@ -14,6 +14,8 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from datetime import datetime
 
+from sgp4.api import Satrec
+
 from nfwserver.tracking.constants import SECONDS_PER_DAY, WGS72_A_KM, WGS72_MU_KM3_S2
 from nfwserver.tracking.dde_names import assign_dde_names, validate_dde_name
 from nfwserver.tracking.elements import ElementSet
@@ -35,7 +37,7 @@ class Satellite:
         return self.elements.name
 
     @property
-    def satrec(self):
+    def satrec(self) -> Satrec:
         return self.elements.satrec
 
     def age_days(self, at: datetime) -> float:
@@ -47,7 +49,7 @@ class Satellite:
         """Perigee height above the equatorial radius (km), from the mean motion (WGS72)."""
         n = self.elements.mean_motion_rev_per_day * 2.0 * math.pi / SECONDS_PER_DAY
         a = (WGS72_MU_KM3_S2 / (n * n)) ** (1.0 / 3.0)
-        return a * (1.0 - self.elements.eccentricity) - WGS72_A_KM
+        return float(a * (1.0 - self.elements.eccentricity) - WGS72_A_KM)
 
     @property
     def is_decayed(self) -> bool:

@@ -15,6 +15,7 @@ tick).  Positions are km, velocities km/s, times split UTC Julian dates ``jd + f
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -25,7 +26,8 @@ from nfwserver.tracking.timescale import gmst1982
 _DEG = 180.0 / math.pi
 
 
-def teme_to_itrs(r: np.ndarray, v: np.ndarray | None, jd, fr, ut1_utc: float = 0.0
+def teme_to_itrs(r: np.ndarray, v: np.ndarray | None, jd: float | np.ndarray, fr: float | np.ndarray,
+                 ut1_utc: float = 0.0
                  ) -> tuple[np.ndarray, np.ndarray | None]:
     """Rotate TEME states (..., 3) into the ITRS at the UTC instants ``jd + fr``.
 
@@ -99,7 +101,8 @@ class ScalarLookAngles:
         self._ox, self._oy, self._oz = observer.itrs_km()
         self._e, self._n, self._u = observer.enu_basis()
 
-    def itrs(self, r, v, jd: float, fr: float) -> tuple[float, float, float, float, float, float]:
+    def itrs(self, r: Sequence[float], v: Sequence[float], jd: float, fr: float
+             ) -> tuple[float, float, float, float, float, float]:
         """ITRS position (km) and velocity (km/s) of the TEME state ``r``, ``v`` at ``jd + fr`` (UTC)."""
         theta, theta_dot = gmst1982(jd, fr + self._ut1_days)
         c, s = math.cos(theta), math.sin(theta)
@@ -108,7 +111,7 @@ class ScalarLookAngles:
         w = theta_dot / SECONDS_PER_DAY
         return x, y, r[2], c * v[0] + s * v[1] + w * y, -s * v[0] + c * v[1] - w * x, v[2]
 
-    def look(self, r, v, jd: float, fr: float) -> tuple[float, float, float, float]:
+    def look(self, r: Sequence[float], v: Sequence[float], jd: float, fr: float) -> tuple[float, float, float, float]:
         """(azimuth deg, elevation deg, range km, range rate km/s) of a TEME state."""
         x, y, z, vx, vy, vz = self.itrs(r, v, jd, fr)
         dx, dy, dz = x - self._ox, y - self._oy, z - self._oz

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from datetime import datetime
 
 import numpy as np
-from sgp4.api import SGP4_ERRORS, SatrecArray
+from sgp4.api import SGP4_ERRORS, Satrec, SatrecArray
 
 from nfwserver.tracking.frames import ScalarLookAngles, itrs_to_topocentric, teme_to_itrs
 from nfwserver.tracking.observer import Observer
@@ -61,7 +61,7 @@ class LookAngleCalculator:
         self.ut1_utc = ut1_utc
         self._scalar = ScalarLookAngles(observer, ut1_utc)
 
-    def compute(self, satrec, when: datetime) -> LookAngles:
+    def compute(self, satrec: Satrec, when: datetime) -> LookAngles:
         """Look angles of ``satrec`` (an ``sgp4.api.Satrec``) at ``when`` (aware UTC).
 
         Raises :class:`PropagationError` when SGP4 fails.
@@ -69,7 +69,7 @@ class LookAngleCalculator:
         jd, fr = julian_date(when)
         return self.compute_jd(satrec, jd, fr)
 
-    def compute_jd(self, satrec, jd: float, fr: float) -> LookAngles:
+    def compute_jd(self, satrec: Satrec, jd: float, fr: float) -> LookAngles:
         """Like :meth:`compute` for a split UTC Julian date ``jd + fr``."""
         err, r, v = satrec.sgp4(jd, fr)
         if err:
@@ -104,7 +104,7 @@ def earth_fixed_states(
 
 
 def look_angles_array(
-    satrecs: SatrecArray | list, observer: Observer, jd: np.ndarray, fr: np.ndarray, ut1_utc: float = 0.0
+    satrecs: SatrecArray | list[Satrec], observer: Observer, jd: np.ndarray, fr: np.ndarray, ut1_utc: float = 0.0
 ) -> LookAngleArrays:
     """Look angles of every satellite at every time (split UTC Julian dates ``jd + fr``)."""
     if not isinstance(satrecs, SatrecArray):

@@ -15,6 +15,7 @@ from datetime import datetime, timedelta
 
 import numpy as np
 
+from nfwserver.tracking.catalog import Satellite
 from nfwserver.tracking.look_angles import look_angles_array
 from nfwserver.tracking.observer import Observer
 from nfwserver.tracking.timescale import julian_date
@@ -29,11 +30,11 @@ STALE_AFTER_DAYS = 30.0
 class Screened:
     """Satellites split by whether their positions at the screening instant are usable."""
 
-    usable: list = field(default_factory=list)
-    unusable: list = field(default_factory=list)
+    usable: list[Satellite] = field(default_factory=list)
+    unusable: list[Satellite] = field(default_factory=list)
 
 
-def screen_satellites(satellites: list, observer: Observer, at: datetime, ut1_utc: float = 0.0,
+def screen_satellites(satellites: list[Satellite], observer: Observer, at: datetime, ut1_utc: float = 0.0,
                       max_range_km: float = MAX_PLAUSIBLE_RANGE_KM) -> Screened:
     """Split ``satellites`` (objects with ``.satrec``) into usable and unusable at ``at``."""
     result = Screened()
@@ -49,7 +50,8 @@ def screen_satellites(satellites: list, observer: Observer, at: datetime, ut1_ut
     return result
 
 
-def stale_satellites(satellites: list, at: datetime, max_age_days: float = STALE_AFTER_DAYS) -> list:
+def stale_satellites(satellites: list[Satellite], at: datetime,
+                     max_age_days: float = STALE_AFTER_DAYS) -> list[Satellite]:
     """The satellites whose element epoch is more than ``max_age_days`` before ``at``."""
     oldest = at - timedelta(days=max_age_days)
     return [s for s in satellites if s.elements.epoch < oldest]

@@ -78,7 +78,7 @@ def _exp_field(text: str, what: str) -> float:
     sign = -1.0 if m.group(1) == "-" else 1.0
     mantissa = int(m.group(2)) / 10 ** len(m.group(2))
     exponent = int(m.group(4)) * (-1 if m.group(3) == "-" else 1)
-    return sign * mantissa * 10.0**exponent
+    return float(sign * mantissa * 10.0**exponent)
 
 
 def _format_exp(value: float) -> str:

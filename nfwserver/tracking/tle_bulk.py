@@ -105,7 +105,8 @@ def _exponent(rows: np.ndarray, lo: int, mantissa: np.ndarray) -> np.ndarray:
     """Value of the assumed-decimal exponent field ``±NNNNN±E`` at column ``lo`` (mantissa already read)."""
     exp = rows[:, lo + 7].astype(np.int64) - 48
     e = np.where(rows[:, lo + 6] == 45, -exp, exp)
-    return np.where(rows[:, lo] == 45, -1.0, 1.0) * (mantissa / 100000.0) * _POW10[np.clip(e, -9, 9) + 9]
+    values: np.ndarray = np.where(rows[:, lo] == 45, -1.0, 1.0) * (mantissa / 100000.0) * _POW10[np.clip(e, -9, 9) + 9]
+    return values
 
 
 def _read_block(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, dict[str, np.ndarray]]:
