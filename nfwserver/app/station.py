@@ -40,6 +40,7 @@ from nfwserver.dialects.predict_udp import PredictContext, PredictUdpServer
 from nfwserver.dialects.satpc32 import SATPC32
 from nfwserver.dialects.wxtrack import WXTRACK
 from nfwserver.easycomm.output import EasyCommOutput
+from nfwserver.health import Backoff
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.rotor.coupling import RotorCoupling
 from nfwserver.tcp.server import NovaTcpServer
@@ -79,8 +80,10 @@ class Station:
         self.rotor: RotorCoupling | None = make_rotor(config.rotor, self.core, clock)
         self.radio: RadioCoupling | None = make_radio(config.radio, self.core, clock)
         self.saver = SessionSaver(self.state_file, config.server.satellite) if self.state_file else None
-        self.easycomm: EasyCommOutput | None = (EasyCommOutput(config.easycomm, self.core.state, clock)
-                                                if config.easycomm.enabled else None)
+        self.easycomm: EasyCommOutput | None = (
+            EasyCommOutput(config.easycomm, self.core.state, clock,
+                           health=self.core.health.link("easycomm", Backoff(1.0, 16.0)))
+            if config.easycomm.enabled else None)
         self.tcp: NovaTcpServer | None = (
             NovaTcpServer(self.core, config.tcp, device_status(self.rotor, self.radio, self.easycomm),
                           set_flip=self.rotor.set_flip_mode if self.rotor is not None else None)

@@ -18,9 +18,10 @@ below the horizon, no position -- one ``SA SE`` line stops the antenna; ``SA SE`
 shutdown (:meth:`stop`) whenever the port can be written.
 
 The device may vanish and return (a USB adapter unplugged): a failed open or write closes the port
-and the worker tries again after 1 s, 2 s, 4 s ... at most ``max_backoff_s``, measured on the clock;
-the first failure is logged as a warning, the return as info.  Writes time out after
-:data:`WRITE_TIMEOUT_S` real seconds (a port nobody drains), so the worker never hangs; the
+and the worker tries again after 1 s, 2 s, 4 s ... at most ``max_backoff_s``, measured on the clock,
+through the station's ``easycomm`` link (:class:`~nfwserver.health.LinkHealth`): the fault is in
+STATUS while it lasts, its first failure is logged as a warning, and the first successful write clears it.
+Writes time out after :data:`WRITE_TIMEOUT_S` real seconds (a port nobody drains), so the worker never hangs; the
 publisher is never involved.
 
 Threading: the worker thread owns the port; :meth:`stop` joins it before the final ``SA SE``.
@@ -41,6 +42,7 @@ from nfwserver.core.sample import TickSample
 from nfwserver.core.service_thread import ServiceThread
 from nfwserver.core.state import StationState
 from nfwserver.easycomm.line_format import LINE_END, STOP_LINE, doppler_line, range_rate_line
+from nfwserver.health import Backoff, LinkHealth
 
 log = logging.getLogger(__name__)
 
@@ -59,22 +61,23 @@ class EasyCommOutput(ServiceThread):
     thread_name = "nfw-easycomm"
 
     def __init__(self, config: EasyCommConfig, state: StationState, clock: Clock, *, max_backoff_s: float = 16.0,
-                 open_port: PortOpener = open_serial) -> None:
+                 open_port: PortOpener = open_serial, health: LinkHealth | None = None) -> None:
         if not config.device:
             raise ValueError("[easycomm] device is required")
         self.config = config
         self.state = state
         self.clock = clock
-        self.max_backoff_s = max_backoff_s
         self.open_port = open_port
+        #: the port's health: failing while it cannot be opened or written (its own when none is given)
+        self.health = health if health is not None else LinkHealth("easycomm", clock, Backoff(1.0, max_backoff_s),
+                                                                   logger=log)
         self.last_line = ""  #: the last line written, without its terminator
         self.lines_written = 0
         self.stale_skipped = 0  #: periods skipped because the newest sample was not the current tick
         self._port: serial.Serial | None = None
         self._pending: TickSample | None = None
         self._active = False  # the last step wrote a position: a stop is owed when it ends
-        self._failures = 0
-        self._retry_at = float("-inf")
+        self._opened_once = False
         super().__init__()
 
     @property
@@ -121,30 +124,18 @@ class EasyCommOutput(ServiceThread):
     def _open(self) -> bool:
         if self._port is not None:
             return True
-        now = self.clock.monotonic()
-        if now < self._retry_at:
+        if not self.health.may_try():
             return False
         device = str(self.config.device)
         try:
             self._port = self.open_port(device, self.config.baud)
         except (serial.SerialException, OSError, ValueError) as exc:
-            self._failed(f"cannot open {device}: {exc}")
+            self.health.failed(f"cannot open {device}: {exc}")
             return False
-        if self._failures:
-            log.info("EasyComm: %s is back; writing again", device)
-        else:
+        if not self._opened_once:
             log.info("EasyComm I output on %s at %d baud", device, self.config.baud)
-        self._failures = 0
+        self._opened_once = True
         return True
-
-    def _failed(self, why: str) -> None:
-        self._failures += 1
-        delay = min(self.max_backoff_s, 2.0 ** (self._failures - 1))
-        self._retry_at = self.clock.monotonic() + delay
-        if self._failures == 1:
-            log.warning("EasyComm: %s; retrying every %g s at most", why, self.max_backoff_s)
-        else:
-            log.debug("EasyComm: %s; next try in %g s", why, delay)
 
     def _close(self) -> None:
         port, self._port = self._port, None
@@ -162,8 +153,9 @@ class EasyCommOutput(ServiceThread):
             self._port.write((line + LINE_END).encode("ascii"))
         except (serial.SerialException, OSError) as exc:
             self._close()
-            self._failed(f"writing to {self.config.device} failed: {exc}")
+            self.health.failed(f"writing to {self.config.device} failed: {exc}")
             return False
+        self.health.succeeded()
         self.last_line = line
         self.lines_written += 1
         return True
@@ -191,7 +183,7 @@ class EasyCommOutput(ServiceThread):
             return
         self._thread.join(5.0)
         self._thread = None
-        self._retry_at = float("-inf")
+        self.health.retry_now()  # one last try for the stop line, whatever the back-off
         self._write(STOP_LINE)
         self._active = False
         self._close()

@@ -202,13 +202,16 @@ def test_the_device_vanishing_and_returning_is_survived_with_capped_back_off(tmp
         assert not output.connected
         gaps = [b - a for a, b in zip(attempts[1:], attempts[2:])]
         assert gaps[:2] == pytest.approx([2.0, 4.0], abs=0.51) and max(gaps) <= 4.0 + 0.51
-        assert len([r for r in caplog.records if r.levelname == "WARNING" and "EasyComm" in r.getMessage()]) == 1
+        warned = [r.getMessage() for r in caplog.records if r.levelname == "WARNING" and "easycomm" in r.getMessage()]
+        assert len(warned) == 1 and warned[0].startswith("easycomm: writing to "), warned  # one line, not one a try
+        assert not output.health.ok and output.health.fault is not None and output.health.fault.failures >= 6
         written = output.lines_written
         back = Pty(pty.path)  # plugged in again (a new tty behind the same name)
         assert advance_until(station.clock, lambda: ticked(station) and output.lines_written > written + 1,
                              step_s=0.25, limit_s=10)
         assert station.clock.monotonic() - gone < 60
         assert back.lines()[0].startswith("AZ") and output.connected
+        assert output.health.ok  # the first line written cleared the fault
     finally:
         output.stop()
 
