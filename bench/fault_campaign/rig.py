@@ -94,9 +94,8 @@ class FaultRig:
         self.rigctld = HamlibDaemon("rigctld").start()
         self.rotor_proxy = FaultProxy((self.rotctld.host, self.rotctld.port))
         self.radio_proxy = FaultProxy((self.rigctld.host, self.rigctld.port), trickle_s=0.3)
-        self.master, slave = os.openpty()
-        self.tty = os.ttyname(slave)
-        self._slave = slave
+        self.tty = self.work / "ttyUSB0"  # a link to the pty, as udev makes for a USB adapter
+        self.plug_tty()
         (self.work / "state").mkdir()
         self.state_path = self.work / "state" / "state.json"
         self.config_path = self.work / "nfwserver.toml"
@@ -139,12 +138,29 @@ class FaultRig:
             proxy.close()
         for daemon in (self.rotctld, self.rigctld):
             daemon.kill()
-        os.close(self.master)
-        os.close(self._slave)
+        if self.master >= 0:
+            os.close(self.master)
+            os.close(self._slave)
+
+    def plug_tty(self) -> None:
+        """A new pseudo-terminal behind the adapter's name (plugged in)."""
+        self.master, self._slave = os.openpty()
+        self.tty.unlink(missing_ok=True)
+        self.tty.symlink_to(os.ttyname(self._slave))
+
+    def unplug_tty(self) -> None:
+        """The adapter pulled out: the terminal and its name are gone."""
+        if self.master >= 0:
+            os.close(self.master)
+            os.close(self._slave)
+        self.master = self._slave = -1
+        self.tty.unlink()
 
     # -- stepping --------------------------------------------------------------------------------------
     def drain_tty(self) -> bytes:
         """Whatever EasyComm wrote since the last call (non-blocking)."""
+        if self.master < 0:
+            return b""
         os.set_blocking(self.master, False)
         data = b""
         try:

@@ -52,6 +52,14 @@ def feed_and_easycomm_current(rig: FaultRig, record: TickRecord) -> bool:
     return record.published and rig.stale_easycomm == 0
 
 
+def easycomm_works(rig: FaultRig, record: TickRecord) -> bool:
+    """EasyComm writes while the satellite is up (it never reads its port, so a missing adapter shows
+    only when a line is owed)."""
+    sample = rig.station.core.tracker.last_sample
+    up = sample is not None and sample.above_horizon
+    return "easycomm" not in record.faults and (bool(record.easycomm) or not up or rig.index % 3 != 0)
+
+
 def rotor_works(rig: FaultRig, record: TickRecord) -> bool:
     """The rotor follows: no rotor fault, and the real daemon's position is where the driver sent it
     (within 2 degrees a step at 6 deg/s covers) or moving toward it."""
@@ -163,6 +171,8 @@ FAULTS = (
           lambda rig: rig.rigctld.kill(), lambda rig: rig.rigctld.restart(), radio_works),
     Fault("rigctld answers one byte at a time", "radio",
           lambda rig: rig.radio_proxy.set_mode("trickle"), lambda rig: rig.radio_proxy.set_mode("pass"), radio_works),
+    Fault("EasyComm adapter unplugged, then plugged in again", "easycomm",
+          lambda rig: rig.unplug_tty(), lambda rig: rig.plug_tty(), easycomm_works),
     Fault("selected set past decay (SGP4 error 6), then a fresh set", "tracking",
           lambda rig: _decayed_set(rig, 10), lambda rig: _decayed_set(rig, 0), feed_works, feed_may_stop=True),
     Fault("state folder unwritable, then writable", "state-file",

@@ -82,7 +82,7 @@ class Station:
         self.saver = SessionSaver(self.state_file, config.server.satellite) if self.state_file else None
         self.easycomm: EasyCommOutput | None = (
             EasyCommOutput(config.easycomm, self.core.state, clock,
-                           health=self.core.health.link("easycomm", Backoff(1.0, 16.0)))
+                           health=self.core.health.link("easycomm", Backoff(0.5, 2.0)))
             if config.easycomm.enabled else None)
         self.tcp: NovaTcpServer | None = (
             NovaTcpServer(self.core, config.tcp, device_status(self.rotor, self.radio, self.easycomm),
