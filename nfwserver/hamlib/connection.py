@@ -10,7 +10,13 @@ When the daemon dies (EOF, broken pipe, refused connection) the connection is dr
 :class:`HamlibUnavailable` is raised at once; reconnection is attempted on a later call, no sooner
 than the back-off delay (doubling from ``backoff_initial_s`` to ``backoff_max_s``, 1.5 s by default so a
 returning daemon is found again within 2 s; measured on the
-injected clock), so a dead daemon never stalls the caller.
+injected clock), so a dead daemon never stalls the caller.  The connection's state is one
+:class:`~nfwserver.health.LinkHealth` (the station puts it on its board as ``rotctld``/``rigctld``):
+failing while the daemon cannot be reached or answers nonsense, cleared by the first whole reply.
+
+Every reply must arrive whole within ``reply_deadline_s`` real seconds (a daemon that trickles one
+byte at a time, each within the per-read timeout, would otherwise hold the caller for hours); past
+it the connection is dropped as for a dead daemon.
 
 A reply that makes no sense (a line over :data:`MAX_LINE_BYTES`, a value where ``RPRT`` was due, no
 value where one was due, or a value the backend finds non-finite or out of range and reports with
@@ -24,16 +30,20 @@ from __future__ import annotations
 
 import logging
 import socket
+import time
 
 from nfwserver.clock import Clock
 from nfwserver.hamlib.commands import HamlibCommand
 from nfwserver.hamlib.errors import describe_rprt
+from nfwserver.health import Backoff, LinkHealth
 from nfwserver.ratelimited_log import RateLimitedLog
 
 log = logging.getLogger(__name__)
 
 #: Longest reply line accepted (bytes); Hamlib's replies are a few dozen.
 MAX_LINE_BYTES = 65536
+#: A whole reply must arrive within this many real seconds (rigctld behind a slow serial radio: ~0.3 s).
+REPLY_DEADLINE_S = 2.0
 
 
 class HamlibError(Exception):
@@ -52,15 +62,16 @@ class HamlibConnection:
     """One TCP connection to a Hamlib daemon, reopened on demand."""
 
     def __init__(self, host: str, port: int, clock: Clock, name: str = "hamlib", timeout_s: float = 1.0,
-                 backoff_initial_s: float = 0.25, backoff_max_s: float = 1.5, warn_interval_s: float = 60.0) -> None:
+                 backoff_initial_s: float = 0.25, backoff_max_s: float = 1.5, warn_interval_s: float = 60.0,
+                 reply_deadline_s: float = REPLY_DEADLINE_S, health: LinkHealth | None = None) -> None:
         self.host, self.port, self.clock, self.name = host, port, clock, name
         self.timeout_s = timeout_s
-        self.backoff_initial_s, self.backoff_max_s = backoff_initial_s, backoff_max_s
+        self.reply_deadline_s = reply_deadline_s
+        #: reachability of the daemon: failing while it is down, silent or answering nonsense
+        self.health = health if health is not None else LinkHealth(
+            name, clock, Backoff(backoff_initial_s, backoff_max_s), logger=log)
         self._sock: socket.socket | None = None
         self._buffer = b""
-        self._backoff = 0.0
-        self._retry_at: float | None = None
-        self.failures = 0  #: consecutive failures
         self.reconnects = 0
         self.faults = 0  #: replies rejected as nonsense (device faults), in total
         self.warnings = RateLimitedLog(log, clock, warn_interval_s)
@@ -72,10 +83,10 @@ class HamlibConnection:
     def _connect(self) -> socket.socket:
         if self._sock is not None:
             return self._sock
-        now = self.clock.monotonic()
-        if self._retry_at is not None and now < self._retry_at:
-            raise HamlibUnavailable(f"{self.name} at {self.host}:{self.port} is down; retrying in "
-                                    f"{self._retry_at - now:.1f} s")
+        if not self.health.may_try():
+            fault = self.health.fault
+            wait = fault.retry_at - self.clock.monotonic() if fault is not None else 0.0
+            raise HamlibUnavailable(f"{self.name} at {self.host}:{self.port} is down; retrying in {wait:.1f} s")
         try:
             sock = socket.create_connection((self.host, self.port), timeout=self.timeout_s)
         except OSError as exc:
@@ -84,10 +95,8 @@ class HamlibConnection:
         sock.settimeout(self.timeout_s)
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)  # one short line per command
         self._sock, self._buffer = sock, b""
-        if self.failures:
+        if not self.health.ok:
             self.reconnects += 1
-            self.warnings.log(logging.INFO, "back", "%s at %s:%d is back", self.name, self.host, self.port)
-        self.failures, self._backoff, self._retry_at = 0, 0.0, None
         return sock
 
     def _drop(self) -> None:
@@ -101,24 +110,29 @@ class HamlibConnection:
 
     def _fail(self, why: str) -> None:
         self._drop()
-        self.failures += 1
-        self._backoff = min(self.backoff_max_s, max(self.backoff_initial_s, self._backoff * 2.0))
-        self._retry_at = self.clock.monotonic() + self._backoff
-        if self.failures == 1:
-            self.warnings.warning("lost", "%s at %s:%d lost (%s); retrying with back-off", self.name, self.host,
-                                  self.port, why)
+        self.health.failed(f"{self.name} at {self.host}:{self.port}: {why}")
 
     def fault(self, why: str) -> HamlibError:
-        """Count a nonsense reply, drop the connection (it may be out of step) and return the error to raise."""
+        """Count a nonsense reply, drop the connection (it may be out of step) and return the error to raise.
+        The link is failing until a whole reply makes sense again; the next call reconnects at once."""
         self.faults += 1
         self._drop()
-        self.warnings.warning("fault", "%s at %s:%d sent a reply that makes no sense (%s); reconnecting",
-                              self.name, self.host, self.port, why)
+        self.health.failed(f"{self.name} at {self.host}:{self.port} sent a reply that makes no sense ({why})")
+        self.health.retry_now()
         return HamlibError(f"{self.name}: {why}")
 
-    def _read_line(self, sock: socket.socket) -> str:
+    def _read_line(self, sock: socket.socket, deadline: float) -> str:
         while b"\n" not in self._buffer:
-            chunk = sock.recv(4096)
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                raise TimeoutError(f"no whole reply within {self.reply_deadline_s:g} s")
+            sock.settimeout(min(self.timeout_s, remaining))
+            try:
+                chunk = sock.recv(4096)
+            except TimeoutError:
+                if time.monotonic() >= deadline:
+                    raise TimeoutError(f"no whole reply within {self.reply_deadline_s:g} s") from None
+                raise
             if not chunk:
                 raise ConnectionResetError("the daemon closed the connection")
             self._buffer += chunk
@@ -136,9 +150,10 @@ class HamlibConnection:
         if "\n" in command or "\r" in command:
             raise ValueError("a Hamlib command is one line")
         sock = self._connect()
+        deadline = time.monotonic() + self.reply_deadline_s
         try:
             sock.sendall(command.encode("ascii") + b"\n")
-            first = self._read_line(sock)
+            first = self._read_line(sock, deadline)
             if first.startswith("RPRT"):
                 parts = first.split()
                 try:
@@ -146,13 +161,16 @@ class HamlibConnection:
                 except ValueError:
                     raise self.fault(f"{first[:40]!r} is not an RPRT line") from None
                 if code < 0:
+                    self.health.succeeded()  # the daemon answered: reachable, whatever the device says
                     raise HamlibError(f"{self.name}: '{command}' failed: {describe_rprt(code)} (RPRT {code})", code)
                 if reply_lines:
                     raise self.fault(f"{first!r} instead of a value to '{command}'")
+                self.health.succeeded()
                 return []
             if reply_lines == 0:
                 raise self.fault(f"unexpected reply {first[:40]!r} to '{command}'")
-            lines = [first] + [self._read_line(sock) for _ in range(reply_lines - 1)]
+            lines = [first] + [self._read_line(sock, deadline) for _ in range(reply_lines - 1)]
+            self.health.succeeded()
             return lines
         except HamlibError:
             raise

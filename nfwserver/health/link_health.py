@@ -84,6 +84,7 @@ class LinkHealth:
         self._lock = threading.Lock()
         self._fault: Fault | None = None
         self.recoveries = 0  #: faults healed so far (for benchmarks and tests)
+        self._announced = False  # the current fault's first failure was written to the log
 
     # -- reading ---------------------------------------------------------------------------
     @property
@@ -121,26 +122,28 @@ class LinkHealth:
             delay = self.backoff.delay(failures) if self.paced else 0.0
             fault = Fault(reason, now if old is None else old.since, failures, now + delay)
             self._fault = fault
-        if old is None:
-            self._lines.clear(self.name)
         if self.paced:
-            self._lines.log(level, self.name, "%s: %s; retrying in %.0f s", self.name, reason, fault.retry_at - now)
+            written = self._lines.log(level, self.name, "%s: %s; retrying in %.0f s", self.name, reason,
+                                      fault.retry_at - now)
         else:
-            self._lines.log(level, self.name, "%s: %s", self.name, reason)
+            written = self._lines.log(level, self.name, "%s: %s", self.name, reason)
+        if old is None:
+            self._announced = written  # a link that flaps every tick writes a line a minute, not two a tick
         if old is None:
             self._changed()
         return fault
 
     def succeeded(self) -> None:
-        """Record a success: a fault clears at once, with one line saying how long it lasted."""
+        """Record a success: a fault clears at once, with one line saying how long it lasted (when its
+        first failure was written: a link flapping faster than the rate limit is summarised, not echoed)."""
         with self._lock:
             old, self._fault = self._fault, None
         if old is None:
             return
         self.recoveries += 1
-        self._lines.clear(self.name)
-        self.logger.warning("%s: recovered after %.1f s (%d failures)", self.name,
-                            self.clock.monotonic() - old.since, old.failures)
+        if self._announced:
+            self.logger.warning("%s: recovered after %.1f s (%d failures)", self.name,
+                                self.clock.monotonic() - old.since, old.failures)
         self._changed()
 
     def retry_now(self) -> None:

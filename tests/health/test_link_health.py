@@ -79,3 +79,19 @@ def test_the_board_lists_faults_and_tells_listeners(clock: VirtualClock) -> None
     radio.succeeded()
     assert board.faults() == {}
     assert seen == [("radio", False), ("radio", True)]
+
+
+def test_a_link_flapping_every_tick_writes_a_line_a_minute_not_two_a_tick(clock: VirtualClock,
+                                                                        caplog: pytest.LogCaptureFixture) -> None:
+    h = LinkHealth("rotctld", clock, Backoff(0.25, 1.5), logger=logging.getLogger("test.flap"))
+    with caplog.at_level(logging.INFO, logger="test.flap"):
+        for _ in range(50 * 150):  # 150 s of 50 Hz: a fault and a success every tick
+            h.failed("garbage position")
+            h.succeeded()
+            clock.advance(0.02)
+    lines = [r.getMessage() for r in caplog.records]
+    assert 2 <= len(lines) <= 6, lines  # the first fault and its recovery, then a counted line a minute
+    assert lines[0] == "rotctld: garbage position; retrying in 0 s"
+    assert lines[1].startswith("rotctld: recovered after 0.0 s (1 failures)")
+    assert any("more like this" in line for line in lines[2:])
+    assert h.ok and h.recoveries == 50 * 150
