@@ -3,7 +3,7 @@
 :class:`FaultRig` builds ``nfwserver.app.station.Station`` from a configuration file (watched, so a
 live reload can be faulted) with: the in-process DDE transport and a hot advise client, Nova's TCP
 server on an ephemeral loopback port, a rotor on a real ``rotctld`` and a radio on a real ``rigctld``,
-each behind a :class:`~bench.fault_campaign.fault_proxy.FaultProxy`, EasyComm on a pseudo-terminal,
+each behind a :class:`~tests.hamlib_fault_proxy.FaultProxy`, EasyComm on a pseudo-terminal,
 the session state file in a work directory.  The clock starts shortly before a high ISS pass.
 
 :meth:`FaultRig.tick` advances the clock by one publish period, waits (real time, bounded) until the
@@ -22,7 +22,6 @@ from dataclasses import dataclass, field
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
-from bench.fault_campaign.fault_proxy import FaultProxy
 from nfwserver.app.station import Station
 from nfwserver.clock import VirtualClock
 from nfwserver.config import parse_config
@@ -32,6 +31,7 @@ from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.observer import Observer
 from nfwserver.tracking.passes import find_passes
 from tests.hamlib_daemons import HamlibDaemon
+from tests.hamlib_fault_proxy import FaultProxy
 
 ROOT = Path(__file__).resolve().parents[2]
 ELEMENTS = ROOT / "tests" / "data" / "visual.txt"

@@ -64,7 +64,7 @@ def rotor_works(rig: FaultRig, record: TickRecord) -> bool:
     """The rotor follows: no rotor fault, and the real daemon's position is where the driver sent it
     (within 2 degrees a step at 6 deg/s covers) or moving toward it."""
     rotor = rig.station.rotor
-    if rotor is None or "rotor" in record.faults:
+    if rotor is None or "rotor" in record.faults or "rotctld" in record.faults:
         return False
     _, _, target_el, target_az = rotor.driver.positions()
     if target_az is None or target_el is None:
@@ -78,7 +78,7 @@ def radio_works(rig: FaultRig, record: TickRecord) -> bool:
     Doppler drift) of this tick's downlink frequency for the satellite's channel."""
     sample = rig.station.core.tracker.last_sample
     channel = rig.station.core.state.channels.get(ISS)
-    if "radio" in record.faults or sample is None or sample.look_angles is None or channel is None:
+    if "rigctld" in record.faults or sample is None or sample.look_angles is None or channel is None:
         return False
     rx, _ = channel.ground_frequencies(sample.look_angles.range_rate_km_s)
     return abs(int(_ask(rig.rigctld.port, b"f\n")[0]) - rx) <= 500
@@ -165,11 +165,11 @@ FAULTS = (
     Fault("rotor jammed: moves accepted, nothing turns", "rotor",
           lambda rig: rig.rotor_proxy.set_mode("jam"), lambda rig: rig.rotor_proxy.set_mode("pass"), rotor_works,
           duration_s=40.0),
-    Fault("rotctld killed, restarted", "rotor",
+    Fault("rotctld killed, restarted", "rotctld",
           lambda rig: rig.rotctld.kill(), lambda rig: rig.rotctld.restart(), rotor_works),
-    Fault("rigctld killed, restarted", "radio",
+    Fault("rigctld killed, restarted", "rigctld",
           lambda rig: rig.rigctld.kill(), lambda rig: rig.rigctld.restart(), radio_works),
-    Fault("rigctld answers one byte at a time", "radio",
+    Fault("rigctld answers one byte at a time", "rigctld",
           lambda rig: rig.radio_proxy.set_mode("trickle"), lambda rig: rig.radio_proxy.set_mode("pass"), radio_works),
     Fault("EasyComm adapter unplugged, then plugged in again", "easycomm",
           lambda rig: rig.unplug_tty(), lambda rig: rig.plug_tty(), easycomm_works),

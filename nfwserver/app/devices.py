@@ -9,6 +9,7 @@ from nfwserver.clock import Clock
 from nfwserver.config.schema import RadioConfig, RotorConfig
 from nfwserver.core.events import Direction
 from nfwserver.core.station_core import StationCore
+from nfwserver.health import Backoff, LinkHealth
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.radio.rigctld_backend import RigctldBackend
 from nfwserver.radio.tuning import DopplerTuner
@@ -16,6 +17,7 @@ from nfwserver.rotor.backend import RotorBackend
 from nfwserver.rotor.coupling import RotorCoupling
 from nfwserver.rotor.geometry import RotorGeometry
 from nfwserver.rotor.kct_driver import KctDriver
+from nfwserver.rotor.kct_rotor_link import STALL_BACKOFF
 from nfwserver.rotor.rotctld_backend import RotctldBackend
 from nfwserver.rotor.sim_backend import SimulatedRotor
 from nfwserver.rotor.tracks import SatelliteTracks
@@ -30,8 +32,8 @@ def make_rotor(rc: RotorConfig, core: StationCore, clock: Clock) -> RotorCouplin
     if rc.backend == "sim":
         backend = SimulatedRotor(clock, geometry, rc.speed_deg_s, rc.speed_deg_s)
     else:
-        backend = RotctldBackend(clock, geometry, rc.host, rc.port)
-    driver = KctDriver(clock, backend, geometry)
+        backend = RotctldBackend(clock, geometry, rc.host, rc.port, health=_daemon_link(core, "rotctld"))
+    driver = KctDriver(clock, backend, geometry, health=core.health.link("rotor", STALL_BACKOFF))
     driver.set_parking(rc.park_delay_minutes, rc.park_azimuth_deg, rc.park_elevation_deg)
     tracks = SatelliteTracks(core.state)
     return RotorCoupling(
@@ -40,6 +42,12 @@ def make_rotor(rc: RotorConfig, core: StationCore, clock: Clock) -> RotorCouplin
         on_position=lambda az, el: core.report_antenna_position(az, el, "rotor"),
         on_event=lambda text: _note(core, text),
     )
+
+
+def _daemon_link(core: StationCore, name: str) -> LinkHealth:
+    """The station's link for a Hamlib daemon: retried after 0.25 s doubling to 1.5 s (a connect to a daemon
+    is cheap, so one that returns is found again within 2 s)."""
+    return core.health.link(name, Backoff(0.25, 1.5))
 
 
 def _note(core: StationCore, text: str) -> None:
@@ -54,6 +62,6 @@ def make_radio(rc: RadioConfig, core: StationCore, clock: Clock) -> RadioCouplin
     first = next(iter(core.state.channels.values()), None)
     if first is None:
         return None
-    backend = RigctldBackend(clock, rc.host, rc.port)
+    backend = RigctldBackend(clock, rc.host, rc.port, health=_daemon_link(core, "rigctld"))
     tuner = DopplerTuner(first, backend, rc.step_hz, rc.knob_tolerance_hz, clock=clock)
     return RadioCoupling(tuner, core.state, clock)

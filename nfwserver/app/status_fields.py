@@ -23,7 +23,10 @@ def device_status(rotor: RotorCoupling | None, radio: RadioCoupling | None,
         if rotor is not None:
             _, _, target_el, target_az = rotor.driver.positions()
             position = rotor.driver.rotor_position()
-            out["rotor"] = "unreachable" if position is None else "ok"
+            if position is None or not rotor.driver.backend_reachable:
+                out["rotor"] = "unreachable"
+            else:
+                out["rotor"] = "stalled" if rotor.driver.stalled else ("ok" if rotor.driver.health.ok else "retrying")
             if position is not None:
                 out["rotor_az"], out["rotor_el"] = f"{position[0]:.1f}", f"{position[1]:.1f}"
             if target_az is not None and target_el is not None:

@@ -22,6 +22,7 @@ from nfwserver.hamlib.commands import (
     HamlibCommand,
 )
 from nfwserver.hamlib.connection import HamlibConnection, HamlibError, HamlibUnavailable
+from nfwserver.health import LinkHealth
 from nfwserver.radio.backend import RadioError, RadioUnavailable
 from nfwserver.radio.modes import HAMLIB_MODES
 from nfwserver.radio.transponder import MAX_FREQUENCY_HZ, MIN_FREQUENCY_HZ
@@ -37,8 +38,9 @@ def _check_hz(hz: int) -> int:
 class RigctldBackend:
     """A transceiver behind ``rigctld`` at ``host:port`` (127.0.0.1 unless configured otherwise)."""
 
-    def __init__(self, clock: Clock, host: str = "127.0.0.1", port: int = 4532, timeout_s: float = 1.0) -> None:
-        self.connection = HamlibConnection(host, port, clock, name="rigctld", timeout_s=timeout_s)
+    def __init__(self, clock: Clock, host: str = "127.0.0.1", port: int = 4532, timeout_s: float = 1.0,
+                 health: LinkHealth | None = None) -> None:
+        self.connection = HamlibConnection(host, port, clock, name="rigctld", timeout_s=timeout_s, health=health)
 
     def _do(self, command: HamlibCommand, *args: object) -> list[str]:
         try:

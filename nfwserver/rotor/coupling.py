@@ -99,6 +99,8 @@ class RotorCoupling(TickWorker):
         self._track_on_seen = False
         self._replan = False
         self._unreachable_reported = False
+        self._catalog_number: int | None = None  # the satellite the plan belongs to
+        self._seen_satellite = False
         driver.table_load_listeners.append(self._table_loaded)
         driver.annunciator.listeners.append(self._announced)
 
@@ -126,7 +128,9 @@ class RotorCoupling(TickWorker):
             self._event(f"autotracking disabled: {TABLE_LOAD_REASON}; TRACK ON enables it again", logging.WARNING)
 
     def resume(self) -> None:
-        """Enable autotracking again after a table load (the console's / TCP ``TRACK ON`` may call this)."""
+        """Enable autotracking again after a table load (the console's / TCP ``TRACK ON`` may call this);
+        a stalled rotor is tried again at once."""
+        self.driver.retry_now()
         if self.suspended is not None:
             self.suspended = None
             self._replan = True
@@ -138,6 +142,7 @@ class RotorCoupling(TickWorker):
             raise ValueError(f"flip mode must be one of {FLIP_MODES}, not {mode!r}")
         self.flip_mode = mode
         self._replan = True
+        self.driver.retry_now()  # an operator's action: a stalled rotor is tried again at once
         if mode != "auto":
             self.flip_state = mode == "on"
         note = ""
@@ -202,6 +207,8 @@ class RotorCoupling(TickWorker):
         if sample.tracking and not self._track_on_seen:
             self.resume()  # a new TRACK ON enables autotracking again
         self._track_on_seen = sample.tracking
+        if sample.catalog_number != self._catalog_number:
+            self._satellite_changed(sample.catalog_number)
         self._tracking = sample.tracking and self.suspended is None
         la = sample.look_angles
         if self._tracking and la is not None:
@@ -220,6 +227,21 @@ class RotorCoupling(TickWorker):
         pos = self.driver.rotor_position()
         if pos is not None and self.on_position is not None:
             self.on_position(*sky_from_rotor(*pos))
+
+    def _satellite_changed(self, catalog_number: int | None) -> None:
+        """Another satellite: nothing planned for the old one survives (pass plan, flip decision, azimuth
+        branch, last target), and a stalled rotor is tried again at once for the new one."""
+        first = self._catalog_number is None and not self._seen_satellite
+        self._catalog_number = catalog_number
+        self._seen_satellite = True
+        if first:
+            return
+        self.plan = None
+        self._sent = None
+        self._unreachable_reported = False
+        if self.flip_mode == "auto":
+            self.flip_state = False
+        self.driver.retry_now()
 
     def _send(self, az: float, el: float) -> None:
         az_k, el_k = flip(az, el) if self.plan and self.plan.flipped else (az % 360.0, el)

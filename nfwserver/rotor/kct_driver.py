@@ -16,9 +16,8 @@ rate-limited warning says why.  (Clamped, (el 150, az 280) on a 0..90 elevation 
 (:mod:`~nfwserver.rotor.kct_table_store`), the parking timer, AOS/LOS announcements
 (:mod:`~nfwserver.rotor.kct_annunciator`) -- sends the target mapped into the rotor's azimuth range
 continuously from its last position (a 359 -> 1 step never becomes a 358-degree swing), slew
-added, and reads the rotor back, watching for a stall (:mod:`~nfwserver.rotor.stall`): a stalled
-axis sets status bit 10h (azimuth) or 20h (elevation), is stopped and held ("stalled & has been
-disabled") until the Enable call (function 9, AL=1) re-arms it.  Loading the table (function 7) is
+added, and reads the rotor back, watching for a stall; that side, and how a stall heals, is
+:mod:`~nfwserver.rotor.kct_rotor_link`.  Loading the table (function 7) is
 told to ``table_load_listeners``: autotracking (:mod:`~nfwserver.rotor.coupling`) then lets go.
 """
 
@@ -29,15 +28,15 @@ from collections.abc import Callable
 from datetime import datetime, timedelta, timezone
 
 from nfwserver.clock import Clock
-from nfwserver.ratelimited_log import RateLimitedLog
-from nfwserver.rotor.backend import RotorBackend, RotorError, RotorUnavailable
+from nfwserver.health import LinkHealth
+from nfwserver.rotor.backend import RotorBackend
 from nfwserver.rotor.geometry import RotorGeometry
-from nfwserver.rotor.kct_annunciator import Announcement, Annunciator
+from nfwserver.rotor.kct_annunciator import Announcement
 from nfwserver.rotor.kct_parking import Parking, ParkingParameters
+from nfwserver.rotor.kct_rotor_link import KctRotorLink
 from nfwserver.rotor.kct_status import DriverStatus, KctStatusBit
 from nfwserver.rotor.kct_table import NormalEntry, RepetitiveEntry
 from nfwserver.rotor.kct_table_store import ADD_FULL, ADD_INVALID, ADD_OK, TableMode, TableRead, TimeTargetTable
-from nfwserver.rotor.stall import AXES, StallReporting, StallWatch
 
 __all__ = ["ADD_FULL", "ADD_INVALID", "ADD_OK", "Announcement", "KctDriver", "ParkingParameters", "TableMode"]
 
@@ -53,45 +52,28 @@ def _valid_target(el: float, az: float) -> bool:
     return -90.0 <= el <= 269.0 and 0.0 <= az < 360.0
 
 
-class KctDriver:
+class KctDriver(KctRotorLink):
     """The driver model; see the module docstring."""
 
     def __init__(self, clock: Clock, backend: RotorBackend, geometry: RotorGeometry | None = None,
                  elevation_installed: bool = True, utc_offset_hours: int = 0, table_capacity: int = 1000,
                  on_announcement: Callable[[Announcement], None] | None = None,
-                 stall_timeout_s: float | None = 15.0) -> None:
-        self.clock = clock
-        self.backend = backend
-        self.geometry = geometry or RotorGeometry()
-        self.elevation_installed = elevation_installed
+                 stall_timeout_s: float | None = 15.0, health: LinkHealth | None = None) -> None:
+        super().__init__(clock, backend, geometry, elevation_installed, stall_timeout_s, health)
         self.utc_offset_hours = utc_offset_hours
         self.table = TimeTargetTable(table_capacity)
-        self.annunciator = Annunciator(clock.now)
         if on_announcement is not None:
             self.annunciator.listeners.append(on_announcement)
-        self.stall = StallWatch(timeout_s=stall_timeout_s)
         self.table_load_listeners: list[Callable[[], None]] = []
-        self._diagnostics = RateLimitedLog(log, clock)
-        self._slew = (0, 0)  # (el, az)
-        self._target: tuple[float, float] | None = None  # (el, az) KCT frame
-        self._enabled = True
         self._satellite_id = ""
         self._processing = True
         self.parking = Parking()
-        self._rotor_az: float | None = None  # last commanded rotor-frame azimuth (continuity reference)
-        self._sent: tuple[float, float] | None = None
-        self._card_absent = False
-        self._position: tuple[float, float] | None = None  # rotor frame, last read back
         self._popups = 0
 
     @property
     def announcements(self) -> list[Announcement]:
         """What the annunciator sent, oldest first (bounded)."""
         return self.annunciator.history
-
-    @property
-    def _axes(self) -> int:
-        return 2 if self.elevation_installed else 1
 
     # -- function 0 ----------------------------------------------------------------------
     def status(self) -> DriverStatus:
@@ -283,7 +265,10 @@ class KctDriver:
 
     # -- the clock interrupt ---------------------------------------------------------------
     def service(self) -> None:
-        """Run what the clock interrupt ran, then read the rotor position back."""
+        """Run what the clock interrupt ran, try a stalled rotor again when its back-off is over, then
+        read the rotor position back."""
+        if any(self.stall.stalled) and self._enabled and self.health.may_try():
+            self._probe("its back-off is over")
         now = self.clock.now()
         if self._processing and self.table.entries:
             if self.table.mode is TableMode.NORMAL:
@@ -316,83 +301,3 @@ class KctDriver:
         if due is not None:
             self.set_target(due.elevation_deg, due.azimuth_deg)
 
-    def read_position(self) -> tuple[float, float] | None:
-        """Read the rotor back (rotor frame); None when it cannot be reached."""
-        try:
-            self._position = self.backend.get_position()
-            self._card_absent = False
-        except RotorUnavailable:
-            self._card_absent = True
-            return None
-        except RotorError as exc:
-            self._diagnostics.warning("read", "rotor position read failed: %s", exc)
-            self._stalled(self.stall.backend_error(self._axes), f"the rotor refused {self.stall.errors} calls in a row")
-            return None
-        self.stall.backend_ok()
-        if isinstance(self.backend, StallReporting):
-            self._stalled(self.stall.reported(self.backend.stalled_axes()), "the rotor reports it")
-        moving = self.stall.observe(self.clock.monotonic(), self._sent, self._position, self._axes)
-        self._stalled(moving, f"no movement toward the target for {self.stall.timeout_s} s")
-        if self._sent is None and self._target is not None:
-            self._push(force=True)  # the rotor came back: send the target again
-        return self._position
-
-    def rotor_position(self) -> tuple[float, float] | None:
-        """Last read-back position, rotor frame."""
-        return self._position
-
-    def _stalled(self, axes: list[int], why: str) -> None:
-        if not axes:
-            return
-        names = " and ".join(AXES[i] for i in axes)
-        self.annunciator.emit("alarm", f"{names} rotor stalled ({why}); disabled until the driver is enabled again")
-        self._stop_rotor()
-
-    def _stop_rotor(self) -> None:
-        try:
-            self.backend.stop()
-        except RotorError as exc:
-            log.warning("rotor stop failed: %s", exc)
-
-    def _command_for(self, el: float, az: float) -> tuple[float, float] | None:
-        """Rotor-frame (az, el) for a KCT target with the slew added, or None if the rotor cannot reach it."""
-        g = self.geometry
-        rotor_el = el + self._slew[0]
-        sky_az = (az + self._slew[1]) % 360.0
-        if not g.el_min - 1e-9 <= rotor_el <= g.el_max + 1e-9 or not g.rotor_azimuths(sky_az):
-            return None
-        reference = self._rotor_az if self._rotor_az is not None else (self._position[0] if self._position else None)
-        return g.nearest_rotor_azimuth(sky_az, reference), rotor_el
-
-    def _push(self, force: bool = False) -> None:
-        if self._target is None or not self._enabled:
-            return
-        command = self._command_for(*self._target)
-        if command is None:  # the slew offsets moved it out of reach
-            self._diagnostics.warning("slewed", "target with slew el %+d az %+d is out of this rotor's reach; "
-                                      "not sent", *self._slew)
-            return
-        stalled, pos = self.stall.stalled, self._position
-        if all(stalled[: self._axes]) or (any(stalled) and pos is None):
-            return
-        rotor_az = pos[0] if stalled[0] and pos is not None else command[0]
-        rotor_el = pos[1] if stalled[1] and pos is not None else command[1]
-        command = (rotor_az, rotor_el)
-        if command == self._sent and not force:
-            return
-        try:
-            self.backend.set_position(rotor_az, rotor_el)
-        except RotorUnavailable as exc:
-            if not self._card_absent:
-                log.warning("rotor unavailable: %s", exc)
-            self._card_absent = True
-            self._sent = None
-            return
-        except RotorError as exc:
-            self._diagnostics.warning("refused", "rotor refused (%.1f, %.1f): %s", rotor_az, rotor_el, exc)
-            self._stalled(self.stall.backend_error(self._axes), f"the rotor refused {self.stall.errors} calls in a row")
-            return
-        self.stall.backend_ok()
-        self._card_absent = False
-        self._sent = command
-        self._rotor_az = rotor_az

@@ -13,6 +13,7 @@ import math
 from nfwserver.clock import Clock
 from nfwserver.hamlib.commands import GET_POSITION, SET_POSITION, STOP_ROTOR, HamlibCommand
 from nfwserver.hamlib.connection import HamlibConnection, HamlibError, HamlibUnavailable
+from nfwserver.health import LinkHealth
 from nfwserver.rotor.backend import RotorError, RotorUnavailable
 from nfwserver.rotor.geometry import RotorGeometry
 
@@ -22,9 +23,9 @@ POSITION_SLACK_DEG = 5.0
 
 class RotctldBackend:
     def __init__(self, clock: Clock, geometry: RotorGeometry, host: str = "127.0.0.1", port: int = 4533,
-                 timeout_s: float = 1.0) -> None:
+                 timeout_s: float = 1.0, health: LinkHealth | None = None) -> None:
         self.geometry = geometry
-        self.connection = HamlibConnection(host, port, clock, name="rotctld", timeout_s=timeout_s)
+        self.connection = HamlibConnection(host, port, clock, name="rotctld", timeout_s=timeout_s, health=health)
 
     def _do(self, command: HamlibCommand, *args: object) -> list[str]:
         try:

@@ -9,7 +9,10 @@ An axis is declared stalled when
 - the backend refused ``error_limit`` calls in a row (``RPRT -n`` from rotctld): then both axes,
   as the daemon does not say which one failed.
 
-A stalled axis stays stalled until :meth:`StallWatch.reset` (the driver's Enable call).
+A stalled axis stays stalled until :meth:`StallWatch.reset` (the driver's Enable call) or
+:meth:`StallWatch.probe` (the driver trying again after its back-off, or at an operator's action).  A
+probe is on probation: one refusal declares the stall again at once (not three), and the watch notes
+whether the rotor then made progress (:attr:`StallWatch.progressed`), which is what clears the fault.
 Times are ``clock.monotonic()`` seconds; angles are the rotor frame, degrees.
 """
 
@@ -44,12 +47,21 @@ class StallWatch:
     error_limit: int = 3
     stalled: list[bool] = field(default_factory=lambda: [False, False])  #: [azimuth, elevation]
     errors: int = 0  #: backend refusals in a row
+    progressed: bool = False  #: since the last reset or probe, every axis moved toward its target or arrived
+    _moved: list[bool] = field(default_factory=lambda: [False, False])
     _progress: list[_Progress] = field(default_factory=lambda: [_Progress(), _Progress()])
 
     def reset(self) -> None:
         self.stalled = [False, False]
         self.errors = 0
+        self.progressed = False
+        self._moved = [False, False]
         self._progress = [_Progress(), _Progress()]
+
+    def probe(self) -> None:
+        """Re-arm the stalled axes on probation: the next refusal declares them stalled again."""
+        self.reset()
+        self.errors = self.error_limit - 1
 
     def backend_ok(self) -> None:
         self.errors = 0
@@ -77,14 +89,20 @@ class StallWatch:
         newly = []
         for i in range(axes):
             p = self._progress[i]
-            if abs(sent[i] - position[i]) <= self.deadband_deg or p.reference is None or p.since is None:
+            if abs(sent[i] - position[i]) <= self.deadband_deg:
+                self._progress[i] = _Progress(position[i], now)
+                self._moved[i] = True
+                continue
+            if p.reference is None or p.since is None:
                 self._progress[i] = _Progress(position[i], now)
                 continue
             moved = position[i] - p.reference
             if abs(moved) >= self.tolerance_deg and (moved > 0) == (sent[i] > p.reference):
                 self._progress[i] = _Progress(position[i], now)
+                self._moved[i] = True
             elif now - p.since >= self.timeout_s:
                 newly.append(i)
+        self.progressed = all(self._moved[:axes])
         return self._declare(newly)
 
     def _declare(self, axes) -> list[int]:

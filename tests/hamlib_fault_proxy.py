@@ -32,6 +32,7 @@ class FaultProxy:
         self.upstream = upstream
         self.trickle_s = trickle_s
         self.mode = "pass"
+        self.set_commands_relayed = 0  #: set commands that reached the daemon
         self.listener = socket.create_server(("127.0.0.1", 0))
         self.port = self.listener.getsockname()[1]
         self._stop = threading.Event()
@@ -92,6 +93,8 @@ class FaultProxy:
                     if self.mode in ("refuse", "jam") and word in SET_COMMANDS:
                         client.sendall(b"RPRT -1\n" if self.mode == "refuse" else b"RPRT 0\n")
                         continue
+                    if word in SET_COMMANDS:
+                        self.set_commands_relayed += 1
                     upstream.sendall(line + b"\n")
 
     def _answers(self, upstream: socket.socket, client: socket.socket) -> None:

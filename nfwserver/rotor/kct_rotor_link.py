@@ -1,0 +1,171 @@
+"""The side of the KCT driver that faces the rotor: sending targets, reading back, stalls and their healing.
+
+:class:`KctRotorLink` is the base of :class:`~nfwserver.rotor.kct_driver.KctDriver`; it owns the backend,
+the geometry, the current target (KCT frame: elevation -90..269, azimuth 0..359), the slew offsets and
+the stall watch (:mod:`~nfwserver.rotor.stall`).  A target is mapped into the rotor's azimuth range
+continuously from its last position (a 359 -> 1 step never becomes a 358-degree swing), slew added, and
+sent only when it changed.  A stalled axis is stopped and held; nothing latches: :meth:`retry_now` (an
+operator's action) re-arms it at once, and the driver's service call re-arms it by itself after the
+``rotor`` link's back-off (:data:`STALL_BACKOFF`: 5 s doubling to a minute, so a jammed motor is driven
+for at most one stall timeout a minute).  The stall is that link's fault from the moment it is declared
+until the re-armed rotor accepts a command and moves toward its target (or is found already there).
+
+Angles are degrees; rotor-frame positions are what the backend takes and reports.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from nfwserver.clock import Clock
+from nfwserver.health import Backoff, LinkHealth
+from nfwserver.ratelimited_log import RateLimitedLog
+from nfwserver.rotor.backend import RotorBackend, RotorError, RotorUnavailable
+from nfwserver.rotor.geometry import RotorGeometry
+from nfwserver.rotor.kct_annunciator import Annunciator
+from nfwserver.rotor.stall import AXES, StallReporting, StallWatch
+
+__all__ = ["STALL_BACKOFF", "KctRotorLink"]
+
+log = logging.getLogger("nfwserver.rotor.kct_driver")
+
+#: When a stalled rotor is tried again by itself: after 5 s, doubling up to once a minute.
+STALL_BACKOFF = Backoff(5.0, 60.0)
+
+
+class KctRotorLink:
+    """The rotor-facing state and calls of the driver; see the module docstring."""
+
+    def __init__(self, clock: Clock, backend: RotorBackend, geometry: RotorGeometry | None,
+                 elevation_installed: bool, stall_timeout_s: float | None, health: LinkHealth | None) -> None:
+        self.clock = clock
+        self.backend = backend
+        self.geometry = geometry or RotorGeometry()
+        self.elevation_installed = elevation_installed
+        #: the ``rotor`` link: failing from a declared stall until the re-armed rotor moves again
+        self.health = health if health is not None else LinkHealth("rotor", clock, STALL_BACKOFF, logger=log)
+        self.annunciator = Annunciator(clock.now)
+        self.stall = StallWatch(timeout_s=stall_timeout_s)
+        self._diagnostics = RateLimitedLog(log, clock)
+        self._slew = (0, 0)  # (el, az)
+        self._target: tuple[float, float] | None = None  # (el, az) KCT frame
+        self._enabled = True
+        self._rotor_az: float | None = None  # last commanded rotor-frame azimuth (continuity reference)
+        self._sent: tuple[float, float] | None = None
+        self._card_absent = False
+        self._position: tuple[float, float] | None = None  # rotor frame, last read back
+
+    @property
+    def _axes(self) -> int:
+        return 2 if self.elevation_installed else 1
+
+    # -- reading back ---------------------------------------------------------------------
+    def read_position(self) -> tuple[float, float] | None:
+        """Read the rotor back (rotor frame); None when it cannot be reached."""
+        try:
+            self._position = self.backend.get_position()
+            self._card_absent = False
+        except RotorUnavailable:
+            self._card_absent = True
+            return None
+        except RotorError as exc:
+            self._diagnostics.warning("read", "rotor position read failed: %s", exc)
+            self._stalled(self.stall.backend_error(self._axes), f"the rotor refused {self.stall.errors} calls in a row")
+            return None
+        if isinstance(self.backend, StallReporting):
+            self._stalled(self.stall.reported(self.backend.stalled_axes()), "the rotor reports it")
+        moving = self.stall.observe(self.clock.monotonic(), self._sent, self._position, self._axes)
+        self._stalled(moving, f"no movement toward the target for {self.stall.timeout_s} s")
+        if not self.health.ok and not any(self.stall.stalled) and self.stall.progressed:
+            self.health.succeeded()  # re-armed, accepted, and moving (or already there): the stall is over
+        if self._sent is None and self._target is not None:
+            self._push(force=True)  # the rotor came back: send the target again
+        return self._position
+
+    def rotor_position(self) -> tuple[float, float] | None:
+        """Last read-back position, rotor frame."""
+        return self._position
+
+    # -- stalls -----------------------------------------------------------------------------
+    def _stalled(self, axes: list[int], why: str) -> None:
+        if not axes:
+            return
+        names = " and ".join(AXES[i] for i in axes)
+        beginning = self.health.ok
+        fault = self.health.failed(f"{names} rotor stalled ({why})")
+        if beginning:  # the alarm marks the start of a fault, not every try that finds it still there
+            self.annunciator.emit("alarm", f"{names} rotor stalled ({why}); held, trying again in "
+                                           f"{fault.retry_at - self.clock.monotonic():.0f} s")
+        self._stop_rotor()
+
+    def _probe(self, why: str) -> None:
+        """Re-arm the stalled axes on probation and send the target again."""
+        self._diagnostics.log(logging.INFO, "probe", "rotor: trying the stalled rotor again (%s)", why)
+        self.stall.probe()
+        self._push(force=True)
+
+    def retry_now(self) -> None:
+        """An operator's action (a new satellite, ``TRACK ON``, a flip change): a stalled rotor is re-armed
+        and tried at once, whatever its back-off."""
+        if any(self.stall.stalled) and self._enabled:
+            self.health.retry_now()
+            self._probe("an operator's action")
+
+    @property
+    def backend_reachable(self) -> bool:
+        """False while the backend cannot be reached (KCT status bit 80h, "card absent")."""
+        return not self._card_absent
+
+    @property
+    def stalled(self) -> bool:
+        """Any axis is stalled and held now (status bits 10h/20h)."""
+        return any(self.stall.stalled)
+
+    def _stop_rotor(self) -> None:
+        try:
+            self.backend.stop()
+        except RotorError as exc:
+            log.warning("rotor stop failed: %s", exc)
+
+    def _command_for(self, el: float, az: float) -> tuple[float, float] | None:
+        """Rotor-frame (az, el) for a KCT target with the slew added, or None if the rotor cannot reach it."""
+        g = self.geometry
+        rotor_el = el + self._slew[0]
+        sky_az = (az + self._slew[1]) % 360.0
+        if not g.el_min - 1e-9 <= rotor_el <= g.el_max + 1e-9 or not g.rotor_azimuths(sky_az):
+            return None
+        reference = self._rotor_az if self._rotor_az is not None else (self._position[0] if self._position else None)
+        return g.nearest_rotor_azimuth(sky_az, reference), rotor_el
+
+    def _push(self, force: bool = False) -> None:
+        if self._target is None or not self._enabled:
+            return
+        command = self._command_for(*self._target)
+        if command is None:  # the slew offsets moved it out of reach
+            self._diagnostics.warning("slewed", "target with slew el %+d az %+d is out of this rotor's reach; "
+                                      "not sent", *self._slew)
+            return
+        stalled, pos = self.stall.stalled, self._position
+        if all(stalled[: self._axes]) or (any(stalled) and pos is None):
+            return
+        rotor_az = pos[0] if stalled[0] and pos is not None else command[0]
+        rotor_el = pos[1] if stalled[1] and pos is not None else command[1]
+        command = (rotor_az, rotor_el)
+        if command == self._sent and not force:
+            return
+        try:
+            self.backend.set_position(rotor_az, rotor_el)
+        except RotorUnavailable as exc:
+            if not self._card_absent:
+                log.warning("rotor unavailable: %s", exc)
+            self._card_absent = True
+            self._sent = None
+            return
+        except RotorError as exc:
+            self._diagnostics.warning("refused", "rotor refused (%.1f, %.1f): %s", rotor_az, rotor_el, exc)
+            self._stalled(self.stall.backend_error(self._axes), f"the rotor refused {self.stall.errors} calls in a row")
+            return
+        self.stall.backend_ok()
+        self._card_absent = False
+        self._sent = command
+        self._rotor_az = rotor_az
