@@ -4,7 +4,7 @@
 live reload can be faulted) with: the in-process DDE transport and a hot advise client, Nova's TCP
 server on an ephemeral loopback port, a rotor on a real ``rotctld`` and a radio on a real ``rigctld``,
 each behind a :class:`~tests.hamlib_fault_proxy.FaultProxy`, EasyComm on a pseudo-terminal,
-the session state file in a work directory.  The clock starts shortly before a high ISS pass.
+the session state file in a work directory (removed at the end).  The clock starts during a high ISS pass.
 
 :meth:`FaultRig.tick` advances the clock by one publish period, waits (real time, bounded) until the
 publisher has ticked and the workers have had a moment, and returns a :class:`TickRecord`: what the
@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import logging
 import os
+import shutil
 import tempfile
 import time
 from dataclasses import dataclass, field
@@ -41,13 +42,14 @@ RATE_HZ = 5.0
 
 
 def iss_pass_start() -> datetime:
-    """Ten seconds before the highest ISS pass over the observer on 2026-05-08 (from our own search;
-    the campaign only needs *a* pass, not an accurate one): the rotor faults come first, while it is up."""
+    """150 s before the culmination of the highest ISS pass over the observer on 2026-05-08 (from our own
+    search; the campaign only needs *a* pass, not an accurate one): the faults that need the satellite up
+    and moving (rotor, radio, EasyComm) come first."""
     catalog = Catalog(s for s in load_element_file(ELEMENTS).sets)
     day = datetime(2026, 5, 8, tzinfo=timezone.utc)
     best = max(find_passes([catalog.get(ISS)], OBSERVER, day, day + timedelta(days=1)),
                key=lambda p: p.max_elevation_deg)
-    return best.aos - timedelta(seconds=10)
+    return best.tca - timedelta(seconds=150)
 
 
 class TracebackCounter(logging.Handler):
@@ -109,6 +111,10 @@ class FaultRig:
         self.received: list[tuple[int, str]] = []  # (tick index, text) of every DDE delivery
         self.index = 0
         self.stale_easycomm = 0  #: EasyComm lines more than 5 deg from the tick that was current when read
+        #: pace ticks at real time (the real rotctld turns its dummy rotor in real time: rotor faults need it)
+        self.real_time = False
+        self.rotor_distance = float("inf")  #: last seen distance (deg) of the real rotor from its target
+        self._last_tick = time.monotonic()
 
     def _config_text(self) -> str:
         return (
@@ -133,6 +139,7 @@ class FaultRig:
 
     def __exit__(self, *exc: object) -> None:
         self.station.stop()
+        shutil.rmtree(self.work, ignore_errors=True)
         logging.getLogger().removeHandler(self.tracebacks)
         for proxy in (self.rotor_proxy, self.radio_proxy):
             proxy.close()
@@ -172,6 +179,9 @@ class FaultRig:
 
     def tick(self) -> TickRecord:
         """One publish period of virtual time; see the module docstring."""
+        if self.real_time:
+            time.sleep(max(0.0, self._last_tick + 1.0 / RATE_HZ - time.monotonic()))
+        self._last_tick = time.monotonic()
         publisher = self.station.publisher
         before = publisher.stats.ticks
         self.index += 1

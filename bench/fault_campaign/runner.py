@@ -57,6 +57,7 @@ def _ok(fault: Fault, rig: FaultRig, record: TickRecord) -> bool:
 
 def run_fault(rig: FaultRig, fault: Fault, recovery_limit_s: float = RECOVERY_LIMIT_S) -> FaultResult:
     restore_baseline(rig)
+    rig.real_time = fault.real_time
     healthy = False
     for _ in range(round(HEALTHY_LIMIT_S * RATE_HZ)):
         record = rig.tick()
@@ -83,6 +84,7 @@ def run_fault(rig: FaultRig, fault: Fault, recovery_limit_s: float = RECOVERY_LI
             recovered = record.index - ended
             break
     after = rig.run(AFTER_S)
+    rig.real_time = False
     detected = next((r.index for r, _ in records if fault.link is not None and fault.link in r.faults), None)
     silent = sum(not r.published for r, _ in records)
     unexplained = 0

@@ -28,6 +28,7 @@ class Fault:
     works: Callable[[FaultRig, TickRecord], bool]
     duration_s: float = 20.0  #: how long the cause lasts (virtual seconds)
     feed_may_stop: bool = False  #: the Nova feed itself is what fails (silent ticks are the fault)
+    real_time: bool = False  #: ticks paced at real time (a real rotor turns in real time)
 
 
 # -- what "works" means -----------------------------------------------------------------------------------
@@ -61,16 +62,19 @@ def easycomm_works(rig: FaultRig, record: TickRecord) -> bool:
 
 
 def rotor_works(rig: FaultRig, record: TickRecord) -> bool:
-    """The rotor follows: no rotor fault, and the real daemon's position is where the driver sent it
-    (within 2 degrees a step at 6 deg/s covers) or moving toward it."""
+    """The rotor follows: no rotor fault, and the real daemon's rotor is within 15 degrees of where the
+    driver sent it or closing on it (a restarted dummy rotctld starts at 0 degrees and slews back)."""
     rotor = rig.station.rotor
     if rotor is None or "rotor" in record.faults or "rotctld" in record.faults:
         return False
-    _, _, target_el, target_az = rotor.driver.positions()
-    if target_az is None or target_el is None:
+    commanded = rotor.driver.commanded_position
+    if commanded is None:
         return False
     az, el = (float(v) for v in _ask(rig.rotctld.port, b"p\n")[:2])
-    return math.hypot(az - target_az, el - target_el) < 15.0
+    distance = math.hypot(az - commanded[0], el - commanded[1])
+    closing = distance < rig.rotor_distance - 0.5
+    rig.rotor_distance = distance
+    return distance < 15.0 or closing
 
 
 def radio_works(rig: FaultRig, record: TickRecord) -> bool:
@@ -161,12 +165,13 @@ def _nothing(rig: FaultRig) -> None:
 
 FAULTS = (
     Fault("rotctld refuses every move (RPRT -1)", "rotor",
-          lambda rig: rig.rotor_proxy.set_mode("refuse"), lambda rig: rig.rotor_proxy.set_mode("pass"), rotor_works),
+          lambda rig: rig.rotor_proxy.set_mode("refuse"), lambda rig: rig.rotor_proxy.set_mode("pass"), rotor_works,
+          real_time=True),
     Fault("rotor jammed: moves accepted, nothing turns", "rotor",
           lambda rig: rig.rotor_proxy.set_mode("jam"), lambda rig: rig.rotor_proxy.set_mode("pass"), rotor_works,
-          duration_s=40.0),
+          duration_s=40.0, real_time=True),
     Fault("rotctld killed, restarted", "rotctld",
-          lambda rig: rig.rotctld.kill(), lambda rig: rig.rotctld.restart(), rotor_works),
+          lambda rig: rig.rotctld.kill(), lambda rig: rig.rotctld.restart(), rotor_works, real_time=True),
     Fault("rigctld killed, restarted", "rigctld",
           lambda rig: rig.rigctld.kill(), lambda rig: rig.rigctld.restart(), radio_works),
     Fault("rigctld answers one byte at a time", "rigctld",

@@ -63,6 +63,8 @@ class Fault:
 
     def describe(self, now: float) -> str:
         """``reason (N failures in S s, retry in R s)``: what STATUS and the console show."""
+        if self.failures == 0:
+            return f"{self.reason} (for {now - self.since:.0f} s)"
         wait = max(0.0, self.retry_at - now)
         times = "failure" if self.failures == 1 else "failures"
         return f"{self.reason} ({self.failures} {times} in {now - self.since:.0f} s, retry in {wait:.0f} s)"
@@ -112,15 +114,23 @@ class LinkHealth:
         return fault is None or not self.paced or self.clock.monotonic() >= fault.retry_at
 
     # -- writing ---------------------------------------------------------------------------
-    def failed(self, reason: str, level: int = logging.WARNING) -> Fault:
-        """Record a failure: the first of a run is logged at once, repeats are counted (rate-limited)."""
+    def failed(self, reason: str, level: int = logging.WARNING, *, attempt: bool = True) -> Fault:
+        """Record a failure: the first of a run is logged at once, repeats are counted (rate-limited).
+
+        ``attempt=False`` records a symptom seen between attempts (a refused command before the link is
+        declared down): the fault shows with its reason, but the back-off does not grow."""
         reason = " ".join(str(reason).split()) or "failed"
         now = self.clock.monotonic()
         with self._lock:
             old = self._fault
-            failures = 1 if old is None else old.failures + 1
-            delay = self.backoff.delay(failures) if self.paced else 0.0
-            fault = Fault(reason, now if old is None else old.since, failures, now + delay)
+            before = 0 if old is None else old.failures
+            failures = before + 1 if attempt else before
+            if attempt or old is None:
+                delay = self.backoff.delay(failures) if self.paced else 0.0
+                retry_at = now + delay
+            else:
+                retry_at = old.retry_at
+            fault = Fault(reason, now if old is None else old.since, failures, retry_at)
             self._fault = fault
         if self.paced:
             written = self._lines.log(level, self.name, "%s: %s; retrying in %.0f s", self.name, reason,

@@ -8,7 +8,8 @@ sent only when it changed.  A stalled axis is stopped and held; nothing latches:
 operator's action) re-arms it at once, and the driver's service call re-arms it by itself after the
 ``rotor`` link's back-off (:data:`STALL_BACKOFF`: 5 s doubling to a minute, so a jammed motor is driven
 for at most one stall timeout a minute).  The stall is that link's fault from the moment it is declared
-until the re-armed rotor accepts a command and moves toward its target (or is found already there).
+until the re-armed rotor accepts a command and moves toward its target (or is found already there).  A single refused
+move is the link's fault at once (not yet a stall: three in a row are), cleared the same way.
 
 Angles are degrees; rotor-frame positions are what the backend takes and reports.
 """
@@ -54,6 +55,7 @@ class KctRotorLink:
         self._sent: tuple[float, float] | None = None
         self._card_absent = False
         self._position: tuple[float, float] | None = None  # rotor frame, last read back
+        self._alarmed = False  # the current stall was announced
 
     @property
     def _axes(self) -> int:
@@ -76,8 +78,9 @@ class KctRotorLink:
             self._stalled(self.stall.reported(self.backend.stalled_axes()), "the rotor reports it")
         moving = self.stall.observe(self.clock.monotonic(), self._sent, self._position, self._axes)
         self._stalled(moving, f"no movement toward the target for {self.stall.timeout_s} s")
-        if not self.health.ok and not any(self.stall.stalled) and self.stall.progressed:
+        if not self.health.ok and not any(self.stall.stalled) and self.stall.errors == 0 and self.stall.progressed:
             self.health.succeeded()  # re-armed, accepted, and moving (or already there): the stall is over
+            self._alarmed = False
         if self._sent is None and self._target is not None:
             self._push(force=True)  # the rotor came back: send the target again
         return self._position
@@ -91,9 +94,9 @@ class KctRotorLink:
         if not axes:
             return
         names = " and ".join(AXES[i] for i in axes)
-        beginning = self.health.ok
         fault = self.health.failed(f"{names} rotor stalled ({why})")
-        if beginning:  # the alarm marks the start of a fault, not every try that finds it still there
+        if not self._alarmed:  # the alarm marks the start of a stall, not every try that finds it still there
+            self._alarmed = True
             self.annunciator.emit("alarm", f"{names} rotor stalled ({why}); held, trying again in "
                                            f"{fault.retry_at - self.clock.monotonic():.0f} s")
         self._stop_rotor()
@@ -110,6 +113,11 @@ class KctRotorLink:
         if any(self.stall.stalled) and self._enabled:
             self.health.retry_now()
             self._probe("an operator's action")
+
+    @property
+    def commanded_position(self) -> tuple[float, float] | None:
+        """The last (azimuth, elevation) the rotor accepted, rotor frame, degrees; None before any."""
+        return self._sent
 
     @property
     def backend_reachable(self) -> bool:
@@ -162,7 +170,9 @@ class KctRotorLink:
             self._sent = None
             return
         except RotorError as exc:
-            self._diagnostics.warning("refused", "rotor refused (%.1f, %.1f): %s", rotor_az, rotor_el, exc)
+            # Visible at once on the rotor link; three in a row make a stall (held, retried after back-off).
+            self.health.failed(f"the rotor refused a move to ({rotor_az:.1f}, {rotor_el:.1f}): {exc}", attempt=False)
+            self.stall.forget_progress()
             self._stalled(self.stall.backend_error(self._axes), f"the rotor refused {self.stall.errors} calls in a row")
             return
         self.stall.backend_ok()

@@ -58,6 +58,11 @@ class StallWatch:
         self._moved = [False, False]
         self._progress = [_Progress(), _Progress()]
 
+    def forget_progress(self) -> None:
+        """A move was refused: progress seen before it says nothing about the rotor now."""
+        self.progressed = False
+        self._moved = [False, False]
+
     def probe(self) -> None:
         """Re-arm the stalled axes on probation: the next refusal declares them stalled again."""
         self.reset()

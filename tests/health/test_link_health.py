@@ -95,3 +95,13 @@ def test_a_link_flapping_every_tick_writes_a_line_a_minute_not_two_a_tick(clock:
     assert lines[1].startswith("rotctld: recovered after 0.0 s (1 failures)")
     assert any("more like this" in line for line in lines[2:])
     assert h.ok and h.recoveries == 50 * 150
+
+
+def test_a_symptom_shows_the_fault_without_growing_the_back_off(clock: VirtualClock) -> None:
+    h = LinkHealth("rotor", clock, Backoff(5.0, 60.0))
+    h.failed("the rotor refused a move", attempt=False)
+    h.failed("the rotor refused a move", attempt=False)
+    assert not h.ok and h.fault is not None and h.fault.failures == 0
+    assert h.describe() == "the rotor refused a move (for 0 s)"
+    fault = h.failed("stalled")  # the first real attempt that failed: the first back-off step
+    assert fault.failures == 1 and fault.retry_at == clock.monotonic() + 5.0
