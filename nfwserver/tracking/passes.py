@@ -39,6 +39,7 @@ from nfwserver.tracking.frames import TopocentricFrame
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer
 from nfwserver.tracking.pass_assemble import assemble
+from nfwserver.tracking.pass_batch import Batch, Chunk
 from nfwserver.tracking.pass_kinematics import PairEvaluator
 from nfwserver.tracking.pass_records import Pass, PassList
 from nfwserver.tracking.pass_screen import screen
@@ -53,8 +54,10 @@ _SHORT_PERIOD_S = 3.0 * 3600.0
 _SLOW_REV_PER_DAY = 1.5
 #: Coarse grid steps (s) of the three groups: low, geosynchronous-like, the rest.
 _LOW_STEP_S, _SLOW_STEP_S, _OTHER_STEP_S = 1200.0, 3600.0, 1200.0
-#: Satellites searched together (bounds the memory of one search).
+#: Satellites screened together (bounds the memory of one screen).
 _CHUNK = 200
+#: Brackets refined together (at least; a batch takes whole chunks): bounds the memory of one refinement.
+_BATCH_BRACKETS = 10000
 
 #: Fork-time hand-over of the work to worker processes (Satrec objects cannot be pickled); set only
 #: for the duration of one parallel :func:`find_passes` call.
@@ -120,6 +123,7 @@ def find_passes(
     other = ~short & ~slow
     look_back = np.where((ecc < 0.05) & short, 0.5, 1.0) * periods  # s
     parts: list[dict[str, np.ndarray]] = []
+    batch = Batch()
     # The rest is split by period so that each part looks back and ahead only as far as it needs.
     for group, step in ((short, _LOW_STEP_S), (slow, _SLOW_STEP_S), (other & (periods <= 8 * 3600.0), _OTHER_STEP_S),
                         (other & (periods > 8 * 3600.0) & (periods <= 13 * 3600.0), _OTHER_STEP_S),
@@ -131,8 +135,13 @@ def find_passes(
             idx = members[c0 : c0 + _CHUNK]
             extension = float(min(np.max(look_back[idx]), SECONDS_PER_DAY))
             models = [_model(satellites[i]) for i in idx]
-            parts.append(_search(models, catalog_numbers[idx], observer, start, end, horizon, ut1_utc, fine_step_s,
-                                 step, extension))
+            batch.add(_screen_chunk(models, catalog_numbers[idx], observer, start, end, horizon, ut1_utc,
+                                    fine_step_s, step, extension))
+            if batch.size >= _BATCH_BRACKETS:
+                parts.append(_refine(batch, observer, horizon, ut1_utc))
+                batch = Batch()
+    if batch.chunks:
+        parts.append(_refine(batch, observer, horizon, ut1_utc))
     return PassList.concat(start, window_s, parts)
 
 
@@ -155,10 +164,10 @@ def _model(satellite: object) -> object:
     return transient() if transient is not None else getattr(satellite, "satrec", satellite)
 
 
-def _search(satrecs: list, catalog_numbers: np.ndarray, observer: Observer, start: datetime, end: datetime,
-            horizon: HorizonTable, ut1_utc: float, fine_step_s: float, coarse_step_s: float,
-            extension: float) -> dict[str, np.ndarray]:
-    """Passes (PassList columns) of one group of satellites searched over ``[start - extension, end + extension]``."""
+def _screen_chunk(satrecs: list, catalog_numbers: np.ndarray, observer: Observer, start: datetime, end: datetime,
+                  horizon: HorizonTable, ut1_utc: float, fine_step_s: float, coarse_step_s: float,
+                  extension: float) -> Chunk:
+    """One chunk of satellites screened over ``[start - extension, end + extension]``."""
     t0 = start - timedelta(seconds=extension)
     window_s = (end - start).total_seconds()
     span = window_s + 2.0 * extension
@@ -166,4 +175,11 @@ def _search(satrecs: list, catalog_numbers: np.ndarray, observer: Observer, star
     ev = PairEvaluator(satrecs, observer, jd0, fr0, ut1_utc, horizon)
     brackets = screen(satrecs, TopocentricFrame(observer), horizon, jd0, fr0, span, coarse_step_s, fine_step_s,
                       ut1_utc, ev)
-    return assemble(ev, brackets, horizon.is_flat, catalog_numbers, span, extension, extension + window_s)
+    return Chunk(satrecs, catalog_numbers, jd0, fr0, span, extension, extension + window_s, brackets)
+
+
+def _refine(batch: Batch, observer: Observer, horizon: HorizonTable, ut1_utc: float) -> dict[str, np.ndarray]:
+    """Passes (PassList columns, times after the window start) from the brackets of a batch of chunks."""
+    models, jd0, fr0, layout, brackets = batch.merged()
+    ev = PairEvaluator(models, observer, jd0, fr0, ut1_utc, horizon)
+    return assemble(ev, brackets, horizon.is_flat, layout)
