@@ -23,6 +23,8 @@ from nfwserver.tracking.timescale import julian_date
 MAX_PLAUSIBLE_RANGE_KM = 1.5e6
 #: Element sets older than this (days) before the time asked for are reported as stale.
 STALE_AFTER_DAYS = 30.0
+#: Satellites propagated at a time by :func:`usable_mask` (bounds the SGP4 models held at once).
+_BLOCK = 2048
 
 
 @dataclass
@@ -35,21 +37,42 @@ class Screened:
 
 def screen_satellites(satellites: list, observer: Observer, at: datetime, ut1_utc: float = 0.0,
                       max_range_km: float = MAX_PLAUSIBLE_RANGE_KM) -> Screened:
-    """Split ``satellites`` (objects with ``.satrec``) into usable and unusable at ``at``."""
+    """Split ``satellites`` (objects with ``.satrec``, or element sets) into usable and unusable at ``at``."""
     result = Screened()
-    if not satellites:
-        return result
-    jd, fr = julian_date(at)
-    arr = look_angles_array([s.satrec for s in satellites], observer, np.array([jd]), np.array([fr]), ut1_utc)
-    rng = arr.range_km[:, 0]
-    with np.errstate(invalid="ignore"):
-        good = np.isfinite(rng) & (rng <= max_range_km) & np.isfinite(arr.elevation_deg[:, 0])
-    for sat, ok in zip(satellites, good):
+    for sat, ok in zip(satellites, usable_mask(satellites, observer, at, ut1_utc, max_range_km).tolist()):
         (result.usable if ok else result.unusable).append(sat)
     return result
 
 
+def usable_mask(satellites: list, observer: Observer, at: datetime, ut1_utc: float = 0.0,
+                max_range_km: float = MAX_PLAUSIBLE_RANGE_KM) -> np.ndarray:
+    """True for each of ``satellites`` whose position at ``at`` is usable (see the module docstring).
+
+    Element sets (objects with ``transient_satrec``, also inside a satellite's ``elements``) are propagated
+    with models made for this check and dropped, a block at a time, so a whole catalog is checked
+    without keeping a model for every set.
+    """
+    good = np.zeros(len(satellites), dtype=bool)
+    jd, fr = julian_date(at)
+    for b0 in range(0, len(satellites), _BLOCK):
+        models = [_model(s) for s in satellites[b0 : b0 + _BLOCK]]
+        arr = look_angles_array(models, observer, np.array([jd]), np.array([fr]), ut1_utc)
+        rng = arr.range_km[:, 0]
+        with np.errstate(invalid="ignore"):
+            good[b0 : b0 + len(models)] = np.isfinite(rng) & (rng <= max_range_km) & np.isfinite(
+                arr.elevation_deg[:, 0])
+    return good
+
+
+def _model(satellite: object) -> object:
+    """An SGP4 model of ``satellite``: its element set's transient one when it has an element set, else its
+    ``.satrec``."""
+    elements = getattr(satellite, "elements", satellite)
+    transient = getattr(elements, "transient_satrec", None)
+    return transient() if transient is not None else satellite.satrec
+
+
 def stale_satellites(satellites: list, at: datetime, max_age_days: float = STALE_AFTER_DAYS) -> list:
-    """The satellites whose element epoch is more than ``max_age_days`` before ``at``."""
+    """The satellites (or element sets) whose element epoch is more than ``max_age_days`` before ``at``."""
     oldest = at - timedelta(days=max_age_days)
-    return [s for s in satellites if s.elements.epoch < oldest]
+    return [s for s in satellites if getattr(s, "elements", s).epoch < oldest]
