@@ -25,7 +25,7 @@ Times are seconds after the search start; angles degrees.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -88,26 +88,36 @@ class _Outputs:
             column[where] = value[picked]
 
 
-#: What each unfinished bracket carries from round to round (arrays of one length, in satellite order).
-_LIVE = ("idx", "sat", "cross", "top", "hidden", "tol", "a", "b", "ga", "gb", "c", "best_f", "best_t", "best_up",
-         "best_up_accel", "prev_step", "prev_t", "prev_accel")
-
-
+@dataclass(slots=True)
 class _Live:
-    """The unfinished brackets: their index among all brackets (``idx``), satellite, kind, tolerance (s),
-    bracket ends and the values there, next time to evaluate (``c``), the best f seen and where (with the
-    height above the horizontal plane there and its second derivative), and the previous round's Newton
-    step, time and f''."""
+    """The unfinished brackets (arrays of one length, in satellite order): what each carries from round to
+    round."""
 
-    __slots__ = _LIVE
-
-    def __init__(self, **arrays: np.ndarray) -> None:
-        for name in _LIVE:
-            setattr(self, name, arrays[name])
+    idx: np.ndarray  #: index among all the brackets
+    sat: np.ndarray
+    cross: np.ndarray  #: a crossing (else a maximum)
+    top: np.ndarray  #: a maximum of the elevation (else of f, or a crossing)
+    hidden: np.ndarray  #: a hidden peak (may be given up)
+    tol: np.ndarray  #: tolerance (s)
+    a: np.ndarray  #: bracket ends (s) and the bracketed function's values there
+    b: np.ndarray
+    ga: np.ndarray
+    gb: np.ndarray
+    c: np.ndarray  #: the next time to evaluate (s)
+    best_f: np.ndarray  #: the largest f seen (deg), where (s), the height above the horizontal plane there
+    best_t: np.ndarray  #: (km) and its second derivative (km/s^2)
+    best_up: np.ndarray
+    best_up_accel: np.ndarray
+    prev_step: np.ndarray  #: the previous round's Newton step (inf after a bisection), time and f''
+    prev_t: np.ndarray
+    prev_accel: np.ndarray
 
     def part(self, which: slice | np.ndarray) -> _Live:
         """The brackets ``which`` picks (views for a slice: a round updates them in place)."""
-        return _Live(**{name: getattr(self, name)[which] for name in _LIVE})
+        return _Live(*(getattr(self, name)[which] for name in _LIVE))
+
+
+_LIVE = tuple(f.name for f in fields(_Live))
 
 
 def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: np.ndarray, gb: np.ndarray,

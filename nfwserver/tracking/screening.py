@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from datetime import datetime, timedelta
+from typing import Any
 
 import numpy as np
 
@@ -64,7 +65,7 @@ def usable_mask(satellites: list, observer: Observer, at: datetime, ut1_utc: flo
     return good
 
 
-def _model(satellite: object) -> object:
+def _model(satellite: Any) -> Any:
     """An SGP4 model of ``satellite``: its element set's transient one when it has an element set, else its
     ``.satrec``."""
     elements = getattr(satellite, "elements", satellite)
