@@ -22,7 +22,6 @@ tie) is formatted by Python instead.
 from __future__ import annotations
 
 import csv
-import functools
 import io
 import json
 from collections.abc import Sequence
@@ -32,7 +31,7 @@ from typing import TextIO
 import numpy as np
 
 #: Rows formatted at a time (bounds the temporary matrices: a few MiB).
-BLOCK_ROWS = 4096
+BLOCK_ROWS = 2048
 #: Fewest decimals of a number in CSV and JSON.
 CSV_DECIMALS = 6
 _SPACE, _MINUS, _POINT, _ZERO = 32, 45, 46, 48
@@ -58,10 +57,11 @@ class Cells:
 
 def _codes_of(texts: Sequence[str]) -> np.ndarray:
     """Code points of ``texts`` as a zero-padded matrix (len(texts), longest): bytes when all are ASCII."""
-    array = np.array(list(texts) or [""], dtype=np.str_)
-    width = max(1, array.dtype.itemsize // 4)
-    codes = np.ascontiguousarray(array).view(np.uint32).reshape(len(array), width)[: len(texts)]
-    return codes.astype(np.uint8) if not codes.size or int(codes.max()) < 128 else codes
+    width = max(1, *map(len, texts)) if texts else 1
+    joined = "".join(text.ljust(width, "\0") for text in texts)
+    if joined.isascii():
+        return np.frombuffer(joined.encode("ascii"), dtype=np.uint8).reshape(len(texts), width).copy()
+    return np.frombuffer(joined.encode("utf-32-le"), dtype="<u4").reshape(len(texts), width).astype(np.uint32)
 
 
 class Column:
@@ -144,10 +144,13 @@ class Number(Column):
     def __len__(self) -> int:
         return len(self.values)
 
+    def _values(self, rows: slice) -> np.ndarray:
+        return self.values[rows]
+
     def _parts(self, rows: slice, style: str) -> tuple[int, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
                                                        np.ndarray]:
         decimals = self.decimals if style == "table" else max(self.decimals, CSV_DECIMALS)
-        values, empty = self.values[rows], self.empty[rows]
+        values, empty = self._values(rows), self.empty[rows]
         if style == "json":
             empty = empty | ~np.isfinite(values)
         with np.errstate(invalid="ignore", over="ignore"):
@@ -175,19 +178,23 @@ class Number(Column):
 
 
 class Time(Column):
-    """UTC instants as integer microseconds since 1970 (``empty`` rows have none), written with
-    milliseconds (truncated) and ``Z``, as :func:`~nfwserver.cli.tracking_options.format_time`."""
+    """UTC instants ``start + timedelta(seconds=s)`` (``empty`` rows have none), written with milliseconds
+    (truncated) and ``Z``, as :func:`~nfwserver.cli.tracking_options.format_time`."""
 
-    def __init__(self, name: str, epoch_us: np.ndarray, empty: np.ndarray | None = None) -> None:
-        self.name, self.epoch_us = name, np.asarray(epoch_us, dtype=np.int64)
-        self.empty = np.zeros(len(self.epoch_us), dtype=bool) if empty is None else np.asarray(empty, dtype=bool)
+    def __init__(self, name: str, start: datetime, seconds: np.ndarray, empty: np.ndarray | None = None) -> None:
+        self.name, self.start, self.seconds = name, start, np.asarray(seconds, dtype=np.float64)
+        self.empty = np.zeros(len(self.seconds), dtype=bool) if empty is None else np.asarray(empty, dtype=bool)
 
     def __len__(self) -> int:
-        return len(self.epoch_us)
+        return len(self.seconds)
+
+    def epoch_us(self, rows: slice) -> np.ndarray:
+        """The instants of ``rows`` in microseconds since 1970 (as ``timedelta`` rounds)."""
+        return epoch_us_after(self.start, self.seconds[rows])
 
     def cells(self, rows: slice, style: str) -> Cells:
         empty = self.empty[rows]
-        codes = _iso_codes(self.epoch_us[rows] // 1000, quoted=style == "json")
+        codes = _iso_codes(self.epoch_us(rows) // 1000, quoted=style == "json")
         codes[empty] = 0
         cells = Cells(codes, np.where(empty, 0, codes.shape[1]), ~empty)
         if style == "json":
@@ -196,6 +203,21 @@ class Time(Column):
 
     def longest(self, rows: slice, style: str) -> int:
         return 0 if self.empty[rows].all() else 24 + 2 * (style == "json")
+
+
+class Duration(Number):
+    """Seconds from one :class:`Time` to another, as ``(later - earlier).total_seconds()`` of the datetimes;
+    empty where either is."""
+
+    def __init__(self, name: str, earlier: Time, later: Time, decimals: int) -> None:
+        self.name, self.decimals, self.earlier, self.later = name, decimals, earlier, later
+        self.empty = earlier.empty | later.empty
+
+    def __len__(self) -> int:
+        return len(self.empty)
+
+    def _values(self, rows: slice) -> np.ndarray:
+        return (self.later.epoch_us(rows) - self.earlier.epoch_us(rows)) / 1e6
 
 
 class Flag(Column):
@@ -308,23 +330,17 @@ def _iso_codes(ms: np.ndarray, quoted: bool = False) -> np.ndarray:
         unique_days, which = np.unique(days, return_inverse=True)
         day_numbers = unique_days.tolist()
     codes[:, q : q + 11] = _codes_of([_civil_date(d) for d in day_numbers])[which]  # "YYYY-MM-DDT"
-    codes[:, q + 11 : q + 19] = _clock_codes()[ms_of_day // 1000]  # "HH:MM:SS"
+    seconds = ms_of_day // 1000
+    codes[:, q + 11 : q + 13] = _TWO[seconds // 3600]
+    codes[:, q + 14 : q + 16] = _TWO[seconds // 60 % 60]
+    codes[:, q + 17 : q + 19] = _TWO[seconds % 60]
+    codes[:, q + 13] = codes[:, q + 16] = ord(":")
     codes[:, q + 19] = _POINT
     codes[:, q + 20 : q + 23] = _THREE[ms_of_day % 1000]
     codes[:, q + 23] = ord("Z")
     if quoted:
         codes[:, 0] = codes[:, -1] = ord('"')
     return codes
-
-
-@functools.cache
-def _clock_codes() -> np.ndarray:
-    """``HH:MM:SS`` of every second of a day, as rows of codes (86,400 x 8; a constant, made when first used)."""
-    second = np.arange(86_400)
-    clock = np.empty((86_400, 8), dtype=np.uint8)
-    clock[:, 0:2], clock[:, 3:5], clock[:, 6:8] = _TWO[second // 3600], _TWO[second // 60 % 60], _TWO[second % 60]
-    clock[:, 2] = clock[:, 5] = ord(":")
-    return clock
 
 
 def _civil_date(days: int) -> str:

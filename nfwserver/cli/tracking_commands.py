@@ -14,9 +14,13 @@ from __future__ import annotations
 import argparse
 import sys
 from datetime import datetime, timedelta
+from typing import TYPE_CHECKING
 
 from nfwserver.cli.arguments import number_in, satellite_value, time_value
 from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs, warn
+
+if TYPE_CHECKING:
+    from nfwserver.tracking.pass_records import PassList
 
 EPHEMERIS_COLUMNS = ["time_utc", "azimuth_deg", "elevation_deg", "range_km", "range_rate_km_s", "above_horizon"]
 PASS_COLUMNS = ["catalog_number", "name", "aos_utc", "tca_utc", "los_utc", "max_elevation_deg",
@@ -102,7 +106,7 @@ def run_ephemeris(args: argparse.Namespace) -> int:
     import numpy as np
 
     from nfwserver.cli import CliError
-    from nfwserver.cli.bulk_output import Flag, Number, RowWriter, Time, epoch_us_after
+    from nfwserver.cli.bulk_output import Flag, Number, RowWriter, Time
     from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError
 
     start = args.start
@@ -130,7 +134,7 @@ def run_ephemeris(args: argparse.Namespace) -> int:
                          inputs.horizon.is_above(la.azimuth_deg, la.elevation_deg)))
         if rows:
             az, el, rng, rr, up = (np.array(c) for c in zip(*rows))
-            writer.write([Time("time_utc", epoch_us_after(start, np.array(offsets))), Number("azimuth_deg", az, 2),
+            writer.write([Time("time_utc", start, np.array(offsets)), Number("azimuth_deg", az, 2),
                           Number("elevation_deg", el, 2), Number("range_km", rng, 1),
                           Number("range_rate_km_s", rr, 4), Flag("above_horizon", up)])
     writer.close()
@@ -140,7 +144,30 @@ def run_ephemeris(args: argparse.Namespace) -> int:
 def run_passes(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from nfwserver.cli.bulk_output import Flag, Integer, Number, Text, Time, epoch_us_after, write_rows
+    from nfwserver.cli.bulk_output import Duration, Flag, Integer, Number, Text, Time, write_rows
+
+    start = args.start
+    passes, names = _find_passes(args)  # the catalog is gone: its memory serves the output
+    cols = passes.columns
+    numbers = np.array(sorted(names), dtype=np.int64)
+    which = np.searchsorted(numbers, cols["catalog_number"])
+    aos_unknown, los_unknown = np.isnan(cols["aos_s"]), np.isnan(cols["los_s"])
+    aos, los = Time("aos_utc", start, cols["aos_s"], aos_unknown), Time("los_utc", start, cols["los_s"], los_unknown)
+    write_rows([Integer("catalog_number", cols["catalog_number"]), Text("name", [names[n] for n in numbers.tolist()],
+                                                                          which),
+                aos, Time("tca_utc", start, cols["tca_s"]), los,
+                Number("max_elevation_deg", cols["max_elevation_deg"], 1),
+                Number("aos_azimuth_deg", cols["aos_azimuth_deg"], 1, aos_unknown),
+                Number("los_azimuth_deg", cols["los_azimuth_deg"], 1, los_unknown), Duration("duration_s", aos, los, 0),
+                Flag("in_progress", aos_unknown | (cols["aos_s"] < 0.0))], args.format, sys.stdout)
+    return 0
+
+
+def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str]]:
+    """The passes the options ask for, and the name to show for each satellite that has one (by catalog
+    number)."""
+    import numpy as np
+
     from nfwserver.cli.tracking_options import TrackingInputs
     from nfwserver.tracking.passes import find_passes
 
@@ -151,19 +178,8 @@ def run_passes(args: argparse.Namespace) -> int:
     sets = _screen(sets, catalog, observer, ut1_utc, start)
     passes = find_passes(sets, observer, start, start + timedelta(hours=args.hours), horizon=horizon,
                          ut1_utc=ut1_utc, workers=args.workers)
-    cols = passes.columns
-    numbers, which = np.unique(cols["catalog_number"], return_inverse=True)
-    aos_unknown, los_unknown = np.isnan(cols["aos_s"]), np.isnan(cols["los_s"])
-    aos_us, los_us = epoch_us_after(start, cols["aos_s"]), epoch_us_after(start, cols["los_s"])
-    write_rows([Integer("catalog_number", cols["catalog_number"]),
-                Text("name", _display_names(numbers.tolist(), sets, catalog), which),
-                Time("aos_utc", aos_us, aos_unknown), Time("tca_utc", epoch_us_after(start, cols["tca_s"])),
-                Time("los_utc", los_us, los_unknown), Number("max_elevation_deg", cols["max_elevation_deg"], 1),
-                Number("aos_azimuth_deg", cols["aos_azimuth_deg"], 1, aos_unknown),
-                Number("los_azimuth_deg", cols["los_azimuth_deg"], 1, los_unknown),
-                Number("duration_s", (los_us - aos_us) / 1e6, 0, aos_unknown | los_unknown),
-                Flag("in_progress", aos_unknown | (cols["aos_s"] < 0.0))], args.format, sys.stdout)
-    return 0
+    numbers = np.unique(passes.columns["catalog_number"]).tolist()
+    return passes, dict(zip(numbers, _display_names(numbers, sets, catalog)))
 
 
 def run_visible(args: argparse.Namespace) -> int:

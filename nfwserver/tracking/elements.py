@@ -282,14 +282,25 @@ def _take_tle(lines: list[str], i: int, source: str, pending: list) -> int:
 
 def _build_tles(pending: list, source: str, result: LoadResult) -> None:
     """Build the queued TLE sets: canonical ones checked and read in bulk (:mod:`~nfwserver.tracking.tle_bulk`),
-    the rest one by one by :func:`~nfwserver.tracking.tle.parse_tle`, which names what is wrong."""
-    if not pending:
-        return
+    the rest one by one by :func:`~nfwserver.tracking.tle.parse_tle`, which names what is wrong.
+
+    A block of ``_BUILD_BLOCK`` at a time: the temporary values of one block are freed before the next is
+    read, so a large catalog's load needs a block's worth of them, not the catalog's."""
+    years: dict[int, datetime] = {}
+    for b0 in range(0, len(pending), _BUILD_BLOCK):
+        _build_block(pending[b0 : b0 + _BUILD_BLOCK], source, result, years)
+    pending.clear()
+
+
+#: Queued sets built at a time by :func:`_build_tles`.
+_BUILD_BLOCK = 1024
+
+
+def _build_block(pending: list, source: str, result: LoadResult, years: dict[int, datetime]) -> None:
     pairs = [p for p in pending if not isinstance(p, Rejection)]
     good, values = read_canonical([p[2] for p in pairs], [p[3] for p in pairs])
     rows = zip(*(values[c].tolist() for c in _BULK_COLUMNS)) if values else iter(())
     good_list = good.tolist()
-    years: dict[int, datetime] = {}
     k = 0
     for item in pending:
         if isinstance(item, Rejection):
@@ -316,7 +327,6 @@ def _build_tles(pending: list, source: str, result: LoadResult) -> None:
             return ElementSet.from_fields(name, parse_tle(line1, line2), source, start, lines=(line1, line2))
 
         _accept(result, source, start, f"{name}: " if name else "", build)
-    pending.clear()
 
 
 #: Columns of tle_bulk.read_canonical used to build a set, in ElementSet's field order after the name.

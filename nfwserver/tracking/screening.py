@@ -25,7 +25,7 @@ MAX_PLAUSIBLE_RANGE_KM = 1.5e6
 #: Element sets older than this (days) before the time asked for are reported as stale.
 STALE_AFTER_DAYS = 30.0
 #: Satellites propagated at a time by :func:`usable_mask` (bounds the SGP4 models held at once).
-_BLOCK = 2048
+_BLOCK = 512
 
 
 @dataclass
