@@ -66,8 +66,8 @@ _FORK_JOB: tuple | None = None
 
 def _fork_worker(indices: list[int]) -> PassList:
     assert _FORK_JOB is not None
-    satrecs, args = _FORK_JOB
-    return find_passes([satrecs[i] for i in indices], *args)
+    satellites, args = _FORK_JOB
+    return find_passes([satellites[i] for i in indices], *args)
 
 
 def find_passes(
@@ -80,7 +80,9 @@ def find_passes(
     fine_step_s: float = 60.0,
     workers: int = 1,
 ) -> PassList:
-    """Passes of ``satellites`` (``sgp4`` Satrecs, or objects with a ``.satrec``) between ``start`` and ``end``.
+    """Passes of ``satellites`` between ``start`` and ``end``: element sets (whose SGP4 models are made for the
+    search and dropped unless they exist), catalog satellites (their element sets), ``sgp4`` Satrecs or objects
+    with a ``.satrec``.
 
     Returns the passes overlapping the window, sorted by AOS (TCA when AOS is unknown), as a
     :class:`~nfwserver.tracking.pass_records.PassList` (a read-only sequence of :class:`Pass`).  See the
@@ -94,14 +96,14 @@ def find_passes(
     with one worker.
     """
     global _FORK_JOB
+    satellites = [getattr(s, "elements", s) for s in satellites]  # a catalog satellite's element set
     if workers > 1 and len(satellites) >= 200 * workers and _FORK_JOB is None and threading.active_count() == 1:
         import multiprocessing
 
         if "fork" in multiprocessing.get_all_start_methods():
-            satrecs_all = [getattr(s, "satrec", s) for s in satellites]
-            _FORK_JOB = (satrecs_all, (observer, start, end, horizon, ut1_utc, fine_step_s))
+            _FORK_JOB = (satellites, (observer, start, end, horizon, ut1_utc, fine_step_s))
             try:
-                chunks = [list(range(k, len(satrecs_all), workers)) for k in range(workers)]
+                chunks = [list(range(k, len(satellites), workers)) for k in range(workers)]
                 with multiprocessing.get_context("fork").Pool(workers) as pool:
                     worker_parts = pool.map(_fork_worker, chunks)
             finally:
