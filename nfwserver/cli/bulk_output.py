@@ -355,8 +355,10 @@ def _justify(cells: Cells, width: int) -> np.ndarray:
     out = np.zeros((len(codes), width), dtype=codes.dtype)
     # Each row's content moves right by its shift; rows sharing a shift move together (a column has few).
     shift = np.where(cells.right, width - cells.lengths, 0) - cells.offsets
-    for value in np.unique(shift).tolist():
-        rows = np.flatnonzero(shift == value)
+    first = int(shift[0]) if len(shift) else 0
+    groups = [(first, slice(None))] if (shift == first).all() else [
+        (value, np.flatnonzero(shift == value)) for value in np.unique(shift).tolist()]
+    for value, rows in groups:
         lo, hi = max(0, -value), min(codes.shape[1], width - value)  # source columns that stay inside
         out[rows, lo + value : hi + value] = codes[rows, lo:hi]
     out[out == 0] = _SPACE
@@ -440,15 +442,19 @@ class RowWriter:
     def _table_rows(columns: Sequence[Column], rows: slice, widths: list[int]) -> str:
         k = rows.stop - rows.start
         pieces = []
+        end = np.zeros(k, dtype=np.intp)  # where each line's last non-blank character ends
+        at = 0
         for i, column in enumerate(columns):
             if i:
                 pieces.append(_column("  ", k))
-            pieces.append(_justify(column.cells(rows, "table"), widths[i]))
+                at += 2
+            cells = column.cells(rows, "table")
+            pieces.append(_justify(cells, widths[i]))
+            filled = cells.lengths > 0  # cell contents never end in a blank (names are stripped)
+            end = np.where(filled, at + np.where(cells.right, widths[i], cells.lengths), end)
+            at += widths[i]
         line = np.concatenate(pieces, axis=1)
-        # rstrip: drop everything after the last character that is not a blank
-        filled = line != _SPACE
-        last = np.where(filled.any(axis=1), line.shape[1] - 1 - np.argmax(filled[:, ::-1], axis=1), -1)
-        line[np.arange(line.shape[1])[None, :] > last[:, None]] = 0
+        line[np.arange(line.shape[1])[None, :] >= end[:, None]] = 0  # rstrip
         return _text_of([line, _column("\n", k)])
 
 
