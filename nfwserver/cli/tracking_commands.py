@@ -106,7 +106,8 @@ def run_ephemeris(args: argparse.Namespace) -> int:
     import numpy as np
 
     from nfwserver.cli import CliError
-    from nfwserver.cli.bulk_output import Flag, Number, RowWriter, Time
+    from nfwserver.cli.bulk_output import RowWriter
+    from nfwserver.cli.output_columns import Flag, Number, Time
     from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError
 
     start = args.start
@@ -144,7 +145,8 @@ def run_ephemeris(args: argparse.Namespace) -> int:
 def run_passes(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from nfwserver.cli.bulk_output import Duration, Flag, Integer, Number, Text, Time, write_rows
+    from nfwserver.cli.bulk_output import write_rows
+    from nfwserver.cli.output_columns import Duration, Flag, Integer, Number, Text, Time
 
     start = args.start
     passes, names = _find_passes(args)  # the catalog is gone: its memory serves the output
@@ -185,7 +187,8 @@ def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str]]:
 def run_visible(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from nfwserver.cli.bulk_output import Integer, Number, Text, write_rows
+    from nfwserver.cli.bulk_output import write_rows
+    from nfwserver.cli.output_columns import Integer, Number, Text
     from nfwserver.tracking.look_angles import look_angles_array
     from nfwserver.tracking.screening import MAX_PLAUSIBLE_RANGE_KM
     from nfwserver.tracking.timescale import julian_date

@@ -282,18 +282,12 @@ def _take_tle(lines: list[str], i: int, source: str, pending: list) -> int:
 
 def _build_tles(pending: list, source: str, result: LoadResult) -> None:
     """Build the queued TLE sets: canonical ones checked and read in bulk (:mod:`~nfwserver.tracking.tle_bulk`),
-    the rest one by one by :func:`~nfwserver.tracking.tle.parse_tle`, which names what is wrong.
-
-    A block of ``_BUILD_BLOCK`` at a time: the temporary values of one block are freed before the next is
-    read, so a large catalog's load needs a block's worth of them, not the catalog's."""
+    the rest one by one by :func:`~nfwserver.tracking.tle.parse_tle`, which names what is wrong.  1024 at a
+    time: the temporary values of a block are freed before the next (a catalog's would take ~8 MiB)."""
     years: dict[int, datetime] = {}
-    for b0 in range(0, len(pending), _BUILD_BLOCK):
-        _build_block(pending[b0 : b0 + _BUILD_BLOCK], source, result, years)
+    for b0 in range(0, len(pending), 1024):
+        _build_block(pending[b0 : b0 + 1024], source, result, years)
     pending.clear()
-
-
-#: Queued sets built at a time by :func:`_build_tles`.
-_BUILD_BLOCK = 1024
 
 
 def _build_block(pending: list, source: str, result: LoadResult, years: dict[int, datetime]) -> None:

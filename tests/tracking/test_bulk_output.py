@@ -1,4 +1,4 @@
-"""The bulk table/CSV/JSON writer gives, cell for cell, the text of per-cell Python formatting."""
+"""The bulk table/CSV/JSON writer and its columns give, cell for cell, the text of per-cell Python formatting."""
 
 from __future__ import annotations
 
@@ -11,7 +11,8 @@ from datetime import datetime, timedelta, timezone
 import numpy as np
 import pytest
 
-from nfwserver.cli import bulk_output as bo
+from nfwserver.cli import bulk_output
+from nfwserver.cli import output_columns as bo
 from nfwserver.cli.tracking_options import format_time
 
 _EPOCH = datetime(1970, 1, 1, tzinfo=timezone.utc)
@@ -36,7 +37,7 @@ def test_numbers_are_formatted_as_python_formats_them(decimals: int, style: str)
     empty[::7] = True
     column = bo.Number("x", values, decimals, empty)
     buf = io.StringIO()
-    bo.write_rows([column], style, buf)
+    bulk_output.write_rows([column], style, buf)
     lines = buf.getvalue().split("\n")
     got = lines[1:-1]
     d = decimals if style == "table" else max(decimals, 6)
@@ -54,7 +55,7 @@ def test_times_are_format_time_of_the_instant() -> None:
                                                                     253_402_300_799_000_000, -62_135_596_800_000_000]])
     column = bo.Time("t", _EPOCH, instants / 1e6)
     buf = io.StringIO()
-    bo.write_rows([column], "csv", buf)
+    bulk_output.write_rows([column], "csv", buf)
     want = [format_time(_EPOCH + timedelta(seconds=s)) for s in (instants / 1e6).tolist()]
     assert buf.getvalue().split("\n")[1:-1] == want
 
@@ -81,7 +82,7 @@ def test_table_csv_and_json_of_mixed_columns() -> None:
     writer.writerow(header)
     writer.writerows([[r[0], r[1], r[2], "" if r[3] is None else f"{r[3]:.6f}", r[4]] for r in rows])
     got = io.StringIO()
-    bo.write_rows(columns, "csv", got)
+    bulk_output.write_rows(columns, "csv", got)
     assert got.getvalue() == want.getvalue()
     # table: the old aligned writer
     cells = [[r[0], r[1], r[2], "" if r[3] is None else f"{r[3]:.1f}", r[4]] for r in rows]
@@ -90,11 +91,11 @@ def test_table_csv_and_json_of_mixed_columns() -> None:
     lines += ["  ".join(v.rjust(w) if v[:1].isdigit() or v[:1] == "-" else v.ljust(w)
                         for v, w in zip(r, widths)).rstrip() for r in cells]
     got = io.StringIO()
-    bo.write_rows(columns, "table", got)
+    bulk_output.write_rows(columns, "table", got)
     assert got.getvalue() == "\n".join(lines) + "\n"
     # json: an array of objects with typed values
     got = io.StringIO()
-    bo.write_rows(columns, "json", got)
+    bulk_output.write_rows(columns, "json", got)
     doc = json.loads(got.getvalue())
     assert [d["name"] for d in doc] == [names[i] for i in index]
     assert doc[0] == {"id": 5, "name": "ISS (ZARYA)", "when": "1970-01-01T00:00:00.000Z", "deg": 12.345,
@@ -107,7 +108,7 @@ def test_table_csv_and_json_of_mixed_columns() -> None:
 @pytest.mark.parametrize("style", ["table", "csv", "json"])
 def test_no_rows(style: str) -> None:
     buf = io.StringIO()
-    bo.write_rows([bo.Integer("a", np.array([], dtype=np.int64)), bo.Text("b", [])], style, buf)
+    bulk_output.write_rows([bo.Integer("a", np.array([], dtype=np.int64)), bo.Text("b", [])], style, buf)
     assert buf.getvalue() == {"table": "a  b\n", "csv": "a,b\n", "json": "[]\n"}[style]
 
 
