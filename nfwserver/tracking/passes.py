@@ -16,7 +16,10 @@ The search runs in three stages, each batched over every satellite of the catalo
    middle of their pass; rises and sets are paired into passes and each pass gets its TCA.
 
 Satellites are searched in groups of similar orbits (low, geosynchronous-like, the rest), each
-with its own grid step and look-back.  Passes already in progress at ``start`` are reported with
+with its own grid step and look-back, a chunk of 200 at a time; the brackets of several chunks are
+refined together (:mod:`~nfwserver.tracking.pass_batch`), each satellite against its own chunk's
+reference instant, which gives the passes of refining every chunk alone, bit for bit, in fewer rounds.
+Passes already in progress at ``start`` are reported with
 their true AOS before ``start`` (``aos_before_start``), passes in progress at ``end`` with their
 LOS after it: the search looks back and ahead by up to one orbital period (at most a day; half a
 period for near-circular orbits shorter than three hours, whose passes last less than that).  A
