@@ -28,9 +28,9 @@ log = logging.getLogger(__name__)
 
 
 class TrackingInputs:
-    """What the options resolve to, each value resolved when first read: the configuration is read only
-    when a value the options leave open needs it (``passes --elements F --observer X --ut1-utc 0`` never
-    reads it unless a satellite without a name needs its DDE name)."""
+    """What the options resolve to, each value resolved when first read: the configuration is read (once) when
+    a value the options leave open needs it: the observer and horizon without ``--observer``, UT1-UTC without
+    ``--ut1-utc``, the DDE-name overrides of an ``--elements`` catalog, or the station's catalog."""
 
     def __init__(self, args: argparse.Namespace) -> None:
         self._args = args
