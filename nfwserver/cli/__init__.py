@@ -18,6 +18,7 @@ import sys
 from collections.abc import Sequence
 
 from nfwserver import __version__
+from nfwserver.blas_threads import single_threaded_blas
 from nfwserver.cli.arguments import COMMANDS, command_word, join_negative_values
 
 #: Command modules, in the order their commands appear in ``--help``.
@@ -56,6 +57,7 @@ def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the process exit code."""
+    single_threaded_blas()  # before a command loads numpy
     args_list = join_negative_values(list(sys.argv[1:] if argv is None else argv))
     parser = build_parser(args_list)
     args = parser.parse_args(args_list)

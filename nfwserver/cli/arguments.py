@@ -11,8 +11,10 @@ import math
 import re
 from collections.abc import Callable, Iterable
 from datetime import datetime, timedelta, timezone
+from typing import TYPE_CHECKING
 
-from nfwserver.tracking.observer import Observer, parse_observer
+if TYPE_CHECKING:  # imported by observer_value when it runs: every command parses with this module
+    from nfwserver.tracking.observer import Observer
 
 #: Every command: (name, module under ``nfwserver.cli``, help line), in ``--help`` order.  A module
 #: registering several commands is imported once, when any of them runs.
@@ -111,6 +113,8 @@ def time_value(text: str) -> datetime:
 
 def observer_value(text: str) -> Observer:
     """``type=`` for ``--observer``: ``LAT,LON[,ALT_M]`` or a Maidenhead locator."""
+    from nfwserver.tracking.observer import parse_observer
+
     try:
         return parse_observer(text)
     except ValueError as exc:

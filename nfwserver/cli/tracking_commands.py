@@ -12,12 +12,15 @@ time asked (:mod:`nfwserver.tracking.screening`) and name the stale element sets
 from __future__ import annotations
 
 import argparse
-import csv
 import sys
 from datetime import datetime, timedelta
+from typing import TYPE_CHECKING
 
 from nfwserver.cli.arguments import number_in, satellite_value, time_value
 from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs, warn
+
+if TYPE_CHECKING:
+    from nfwserver.tracking.pass_records import PassList
 
 EPHEMERIS_COLUMNS = ["time_utc", "azimuth_deg", "elevation_deg", "range_km", "range_rate_km_s", "above_horizon"]
 PASS_COLUMNS = ["catalog_number", "name", "aos_utc", "tca_utc", "los_utc", "max_elevation_deg",
@@ -68,49 +71,43 @@ def _pick(catalog, text: str):
     return sat
 
 
-def _screen(sats: list, inputs, at: datetime) -> list:
-    """The satellites whose positions at ``at`` are usable; the rest and stale sets are reported."""
-    from nfwserver.tracking.screening import STALE_AFTER_DAYS, screen_satellites, stale_satellites
+def _screen(sats: list, catalog, observer, ut1_utc: float, at: datetime) -> list:
+    """The satellites (or element sets) whose positions at ``at`` are usable; the rest and stale sets are
+    reported (by DDE name)."""
+    from nfwserver.tracking.screening import STALE_AFTER_DAYS, stale_satellites, usable_mask
 
-    screened = screen_satellites(sats, inputs.observer, at, inputs.ut1_utc)
-    if screened.unusable:
-        names = ", ".join(s.dde_name for s in screened.unusable[:5]) + (", ..." if len(screened.unusable) > 5 else "")
-        warn(f"skipped {len(screened.unusable)} object(s) whose position at {format_time(at)} cannot be computed "
+    usable = usable_mask(sats, observer, at, ut1_utc).tolist()
+    if not all(usable):
+        unusable = [s for s, ok in zip(sats, usable) if not ok]
+        names = _dde_names(unusable[:5], catalog) + (", ..." if len(unusable) > 5 else "")
+        warn(f"skipped {len(unusable)} object(s) whose position at {format_time(at)} cannot be computed "
              f"or is implausibly far (decayed or elements far outside their validity): {names}")
-    stale = stale_satellites(screened.usable, at)
+        sats = [s for s, ok in zip(sats, usable) if ok]
+    stale = stale_satellites(sats, at)
     if stale:
-        names = ", ".join(s.dde_name for s in stale[:5]) + (", ..." if len(stale) > 5 else "")
+        names = _dde_names(stale[:5], catalog) + (", ..." if len(stale) > 5 else "")
         warn(f"{len(stale)} element set(s) are more than {STALE_AFTER_DAYS:g} days older than {format_time(at)}, "
              f"so their positions drift ({names}); `nfwserver elements update` fetches newer ones")
-    return screened.usable
+    return sats
 
 
-def _writer(fmt: str, columns: list[str]):
-    """A row writer: CSV with header, or an aligned table."""
-    if fmt == "csv":
-        w = csv.writer(sys.stdout, lineterminator="\n")
-        w.writerow(columns)
-        return w.writerow, lambda: None
-    rows: list[list[str]] = []
-
-    def flush() -> None:
-        widths = [max(len(c), *(len(r[i]) for r in rows)) if rows else len(c) for i, c in enumerate(columns)]
-        print("  ".join(c.ljust(w) for c, w in zip(columns, widths)).rstrip())
-        for r in rows:
-            print("  ".join(v.rjust(w) if v[:1].isdigit() or v[:1] == "-" else v.ljust(w)
-                            for v, w in zip(r, widths)).rstrip())
-
-    return rows.append, flush
+def _dde_names(sats: list, catalog) -> str:
+    """The DDE names of satellites or element sets (those of the catalog's satellites), comma-separated."""
+    return ", ".join(s.dde_name if hasattr(s, "dde_name") else catalog.get(s.catalog_number).dde_name for s in sats)
 
 
-def _num(value: float | None, decimals: int, fmt: str) -> str:
-    if value is None:
-        return ""
-    return f"{value:.{max(decimals, 6) if fmt == 'csv' else decimals}f}"
+def _display_names(numbers, sets: list, catalog) -> list[str]:
+    """The name shown for each catalog number: the element set's name, else the satellite's DDE name."""
+    by_number = {es.catalog_number: es for es in sets}
+    return [by_number[n].name or catalog.get(n).dde_name for n in numbers]
 
 
 def run_ephemeris(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from nfwserver.cli import CliError
+    from nfwserver.cli.bulk_output import RowWriter
+    from nfwserver.cli.output_columns import Flag, Number, Time
     from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError
 
     start = args.start
@@ -120,72 +117,102 @@ def run_ephemeris(args: argparse.Namespace) -> int:
     if args.sat is None and inputs.satellite is None:
         raise CliError("no --sat given and no [server] satellite configured")
     sat = _pick(inputs.catalog, str(args.sat if args.sat is not None else inputs.satellite))
-    _screen([sat], inputs, start)
+    _screen([sat], inputs.catalog, inputs.observer, inputs.ut1_utc, start)
     calc = LookAngleCalculator(inputs.observer, inputs.ut1_utc)
-    write, flush = _writer(args.format, EPHEMERIS_COLUMNS)
+    writer = RowWriter(EPHEMERIS_COLUMNS, args.format, sys.stdout)
     count = int(args.duration // args.step) + 1
-    for k in range(count):
-        when = start + timedelta(seconds=k * args.step)
-        try:
-            la = calc.compute(sat.satrec, when)
-        except PropagationError as exc:
-            print(f"nfwserver: {format_time(when)}: {exc}", file=sys.stderr)
-            continue
-        up = inputs.horizon.is_above(la.azimuth_deg, la.elevation_deg)
-        write([format_time(when), _num(la.azimuth_deg, 2, args.format), _num(la.elevation_deg, 2, args.format),
-               _num(la.range_km, 1, args.format), _num(la.range_rate_km_s, 4, args.format), "Y" if up else "N"])
-    flush()
+    for b0 in range(0, count, 4096):
+        offsets, rows = [], []
+        for k in range(b0, min(b0 + 4096, count)):
+            when = start + timedelta(seconds=k * args.step)
+            try:
+                la = calc.compute(sat.satrec, when)
+            except PropagationError as exc:
+                print(f"nfwserver: {format_time(when)}: {exc}", file=sys.stderr)
+                continue
+            offsets.append(k * args.step)
+            rows.append((la.azimuth_deg, la.elevation_deg, la.range_km, la.range_rate_km_s,
+                         inputs.horizon.is_above(la.azimuth_deg, la.elevation_deg)))
+        if rows:
+            az, el, rng, rr, up = (np.array(c) for c in zip(*rows))
+            writer.write([Time("time_utc", start, np.array(offsets)), Number("azimuth_deg", az, 2),
+                          Number("elevation_deg", el, 2), Number("range_km", rng, 1),
+                          Number("range_rate_km_s", rr, 4), Flag("above_horizon", up)])
+    writer.close()
     return 0
 
 
 def run_passes(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from nfwserver.cli.bulk_output import write_rows
+    from nfwserver.cli.output_columns import Duration, Flag, Integer, Number, Text, Time
+
+    start = args.start
+    passes, names = _find_passes(args)  # the catalog is gone: its memory serves the output
+    cols = passes.columns
+    numbers = np.array(sorted(names), dtype=np.int64)
+    which = np.searchsorted(numbers, cols["catalog_number"])
+    aos_unknown, los_unknown = np.isnan(cols["aos_s"]), np.isnan(cols["los_s"])
+    aos, los = Time("aos_utc", start, cols["aos_s"], aos_unknown), Time("los_utc", start, cols["los_s"], los_unknown)
+    write_rows([Integer("catalog_number", cols["catalog_number"]), Text("name", [names[n] for n in numbers.tolist()],
+                                                                          which),
+                aos, Time("tca_utc", start, cols["tca_s"]), los,
+                Number("max_elevation_deg", cols["max_elevation_deg"], 1),
+                Number("aos_azimuth_deg", cols["aos_azimuth_deg"], 1, aos_unknown),
+                Number("los_azimuth_deg", cols["los_azimuth_deg"], 1, los_unknown), Duration("duration_s", aos, los, 0),
+                Flag("in_progress", aos_unknown | (cols["aos_s"] < 0.0))], args.format, sys.stdout)
+    return 0
+
+
+def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str]]:
+    """The passes the options ask for, and the name to show for each satellite that has one (by catalog
+    number)."""
+    import numpy as np
+
+    from nfwserver.cli.tracking_options import TrackingInputs
     from nfwserver.tracking.passes import find_passes
 
     start = args.start
-    inputs = load_tracking_inputs(args)
-    sats = [_pick(inputs.catalog, text) for text in args.sat] if args.sat else inputs.catalog.satellites()
-    sats = _screen(sats, inputs, start)
-    passes = find_passes(sats, inputs.observer, start, start + timedelta(hours=args.hours),
-                         horizon=inputs.horizon, ut1_utc=inputs.ut1_utc, workers=args.workers)
-    write, flush = _writer(args.format, PASS_COLUMNS)
-    for p in passes:
-        sat = inputs.catalog.get(p.catalog_number)
-        if sat is None:  # passes are only found for catalog satellites
-            continue
-        write([str(p.catalog_number), sat.name or sat.dde_name,
-               format_time(p.aos) if p.aos else "", format_time(p.tca), format_time(p.los) if p.los else "",
-               _num(p.max_elevation_deg, 1, args.format), _num(p.aos_azimuth_deg, 1, args.format),
-               _num(p.los_azimuth_deg, 1, args.format), _num(p.duration_s, 0, args.format),
-               "Y" if p.aos_before_start else "N"])
-    flush()
-    return 0
+    inputs = TrackingInputs(args)  # the configuration only if an option leaves a value to it
+    horizon, observer, ut1_utc, catalog = inputs.horizon, inputs.observer, inputs.ut1_utc, inputs.catalog
+    sets = [_pick(catalog, text).elements for text in args.sat] if args.sat else catalog.element_sets()
+    sets = _screen(sets, catalog, observer, ut1_utc, start)
+    passes = find_passes(sets, observer, start, start + timedelta(hours=args.hours), horizon=horizon,
+                         ut1_utc=ut1_utc, workers=args.workers)
+    numbers = np.unique(passes.columns["catalog_number"]).tolist()
+    return passes, dict(zip(numbers, _display_names(numbers, sets, catalog)))
 
 
 def run_visible(args: argparse.Namespace) -> int:
     import numpy as np
 
+    from nfwserver.cli.bulk_output import write_rows
+    from nfwserver.cli.output_columns import Integer, Number, Text
     from nfwserver.tracking.look_angles import look_angles_array
     from nfwserver.tracking.screening import MAX_PLAUSIBLE_RANGE_KM
     from nfwserver.tracking.timescale import julian_date
 
     at = args.at
     inputs = load_tracking_inputs(args)
-    sats = _screen(inputs.catalog.satellites(), inputs, at)
-    if not sats:
-        _writer(args.format, VISIBLE_COLUMNS)[1]()
-        return 0
-    jd, fr = julian_date(at)
-    arr = look_angles_array([s.satrec for s in sats], inputs.observer, np.array([jd]), np.array([fr]),
-                            inputs.ut1_utc)
-    az, el = arr.azimuth_deg[:, 0], arr.elevation_deg[:, 0]
-    with np.errstate(invalid="ignore"):
-        up = np.flatnonzero((el > inputs.horizon.min_elevation_array(np.nan_to_num(az)))
-                            & (arr.range_km[:, 0] <= MAX_PLAUSIBLE_RANGE_KM))
-    write, flush = _writer(args.format, VISIBLE_COLUMNS)
-    for i in up[np.argsort(-el[up])]:
-        sat = sats[i]
-        write([str(sat.catalog_number), sat.name or sat.dde_name, _num(az[i], 2, args.format),
-               _num(el[i], 2, args.format), _num(arr.range_km[i, 0], 1, args.format),
-               _num(arr.range_rate_km_s[i, 0], 4, args.format)])
-    flush()
+    sats = _screen(inputs.catalog.satellites(), inputs.catalog, inputs.observer, inputs.ut1_utc, at)
+    if sats:
+        jd, fr = julian_date(at)
+        arr = look_angles_array([s.satrec for s in sats], inputs.observer, np.array([jd]), np.array([fr]),
+                                inputs.ut1_utc)
+        az, el = arr.azimuth_deg[:, 0], arr.elevation_deg[:, 0]
+        with np.errstate(invalid="ignore"):
+            up = np.flatnonzero((el > inputs.horizon.min_elevation_array(np.nan_to_num(az)))
+                                & (arr.range_km[:, 0] <= MAX_PLAUSIBLE_RANGE_KM))
+        rows = up[np.argsort(-el[up])]
+    else:
+        rows = np.empty(0, dtype=np.intp)
+        az = el = np.empty(0)
+    picked = [sats[i] for i in rows.tolist()]
+    write_rows([Integer("catalog_number", np.array([s.catalog_number for s in picked], dtype=np.int64)),
+                Text("name", [s.name or s.dde_name for s in picked]), Number("azimuth_deg", az[rows], 2),
+                Number("elevation_deg", el[rows], 2),
+                Number("range_km", arr.range_km[rows, 0] if sats else np.empty(0), 1),
+                Number("range_rate_km_s", arr.range_rate_km_s[rows, 0] if sats else np.empty(0), 4)],
+               args.format, sys.stdout)
     return 0

@@ -12,13 +12,14 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
-from dataclasses import dataclass
 from datetime import datetime, timezone
+from functools import cached_property
 from typing import TYPE_CHECKING
 
 from nfwserver.cli.arguments import number_in, observer_value, parse_time_text
 
 if TYPE_CHECKING:  # imported when the options are resolved: `--help` and parsing stay light
+    from nfwserver.config import Config
     from nfwserver.tracking.catalog import Catalog
     from nfwserver.tracking.horizon import HorizonTable
     from nfwserver.tracking.observer import Observer
@@ -26,15 +27,86 @@ if TYPE_CHECKING:  # imported when the options are resolved: `--help` and parsin
 log = logging.getLogger(__name__)
 
 
-@dataclass
 class TrackingInputs:
-    """What the options resolved to."""
+    """What the options resolve to, each value resolved when first read: the configuration is read (once) when
+    a value the options leave open needs it: the observer and horizon without ``--observer``, UT1-UTC without
+    ``--ut1-utc``, the DDE-name overrides of an ``--elements`` catalog, or the station's catalog."""
 
-    catalog: Catalog
-    observer: Observer
-    horizon: HorizonTable
-    ut1_utc: float
-    satellite: int | None = None  #: the configured AutoTracking satellite (``[server] satellite``)
+    def __init__(self, args: argparse.Namespace) -> None:
+        self._args = args
+        self._config: Config | None = None
+
+    def config(self) -> Config:
+        """The configuration (``--config FILE``, else the user's, else the built-in defaults), read once."""
+        if self._config is None:
+            self._config = _load_config(self._args)
+        return self._config
+
+    @cached_property
+    def _given_observer(self) -> Observer | None:
+        from nfwserver.cli import CliError
+        from nfwserver.tracking.observer import parse_observer
+
+        observer = getattr(self._args, "observer", None)
+        if isinstance(observer, str):  # a parser that did not use observer_value
+            try:
+                observer = parse_observer(observer)
+            except ValueError as exc:
+                raise CliError(f"--observer: {exc}") from None
+        return observer
+
+    @cached_property
+    def horizon(self) -> HorizonTable:
+        """``--horizon``, else flat with ``--observer``, else the configured table."""
+        from nfwserver.cli import CliError
+        from nfwserver.tracking.horizon import HorizonTable, load_horizon
+
+        if getattr(self._args, "horizon", None):
+            try:
+                return load_horizon(self._args.horizon)
+            except (OSError, ValueError) as exc:
+                raise CliError(f"--horizon: {exc}") from None
+        if self._given_observer is not None:
+            return HorizonTable()
+        return self.config().horizon
+
+    @cached_property
+    def observer(self) -> Observer:
+        """``--observer``, else the configured observer (with a warning when none is configured)."""
+        observer = self._given_observer
+        if observer is None:
+            config = self.config()
+            observer = config.observer
+            if not config.observer_configured:
+                warn(f"no observer configured: using {observer}; set [observer] location in {config_file(config)} "
+                     "(`nfwserver config init` writes a starting file) or give --observer")
+        return observer
+
+    @cached_property
+    def ut1_utc(self) -> float:
+        """``--ut1-utc``, else the configuration's (s)."""
+        ut1_utc = getattr(self._args, "ut1_utc", None)
+        return float(self.config().server.ut1_utc_s if ut1_utc is None else ut1_utc)
+
+    @cached_property
+    def catalog(self) -> Catalog:
+        """The ``--elements`` files (rejected sets reported on stderr), else the station's catalog."""
+        elements = getattr(self._args, "elements", None)
+        if elements:
+            return _catalog_from_files(elements, self)
+        return _station_catalog(self.config())
+
+    @property
+    def satellite(self) -> int | None:
+        """The configured AutoTracking satellite (``[server] satellite``)."""
+        return self.config().server.satellite
+
+    def resolve(self) -> TrackingInputs:
+        """Resolve every value now, in the order errors and warnings are reported: horizon and observer,
+        UT1-UTC, then the catalog."""
+        for name in ("horizon", "observer", "ut1_utc", "catalog"):
+            getattr(self, name)
+        return self
 
 
 def add_tracking_options(parser: argparse.ArgumentParser, output_format: bool = True) -> None:
@@ -54,7 +126,8 @@ def add_tracking_options(parser: argparse.ArgumentParser, output_format: bool = 
     parser.add_argument("--ut1-utc", type=number_in(-1.0, 1.0, unit="s"), default=None, metavar="SECONDS",
                         help="UT1-UTC in seconds (IERS Bulletin A; default: the configuration's, else 0)")
     if output_format:
-        parser.add_argument("--format", choices=("table", "csv"), default="table", help="output format")
+        parser.add_argument("--format", choices=("table", "csv", "json"), default="table",
+                            help="output format: an aligned table, CSV with a header row, or a JSON array of objects")
 
 
 def parse_time(text: str) -> datetime:
@@ -98,7 +171,7 @@ def _load_config(args: argparse.Namespace):
         raise CliError(f"configuration refused: {exc}") from None
 
 
-def _catalog_from_files(paths: list[str], dde_names: dict[int, str]) -> Catalog:
+def _catalog_from_files(paths: list[str], inputs: TrackingInputs) -> Catalog:
     from nfwserver.cli import CliError
     from nfwserver.tracking.catalog import Catalog
     from nfwserver.tracking.elements import load_element_file
@@ -109,9 +182,10 @@ def _catalog_from_files(paths: list[str], dde_names: dict[int, str]) -> Catalog:
         for rejection in result.rejected:
             warn(f"skipped element set: {rejection}")
         sets.extend(result.sets)
+        del result
     if not sets:
         raise CliError("no usable element sets in " + ", ".join(paths))
-    return Catalog(sets, dde_names=dde_names)
+    return Catalog(sets, dde_names=inputs.config().dde_names)
 
 
 def _station_catalog(config) -> Catalog:
@@ -130,37 +204,11 @@ def _station_catalog(config) -> Catalog:
 
 
 def load_tracking_inputs(args: argparse.Namespace) -> TrackingInputs:
-    """Resolve the options against the configuration; rejected element sets are reported on stderr.
+    """Resolve the options against the configuration now (read first); rejected element sets are reported
+    on stderr.  (:class:`TrackingInputs` alone resolves each value when first read.)
 
     Raises :class:`nfwserver.cli.CliError` when nothing usable remains.
     """
-    from nfwserver.cli import CliError
-    from nfwserver.tracking.horizon import HorizonTable, load_horizon
-    from nfwserver.tracking.observer import parse_observer
-
-    config = _load_config(args)
-    observer = getattr(args, "observer", None)
-    if isinstance(observer, str):  # a parser that did not use observer_value
-        try:
-            observer = parse_observer(observer)
-        except ValueError as exc:
-            raise CliError(f"--observer: {exc}") from None
-    horizon = HorizonTable()
-    if getattr(args, "horizon", None):
-        try:
-            horizon = load_horizon(args.horizon)
-        except (OSError, ValueError) as exc:
-            raise CliError(f"--horizon: {exc}") from None
-    elif observer is None:
-        horizon = config.horizon
-    if observer is None:
-        observer = config.observer
-        if not config.observer_configured:
-            warn(f"no observer configured: using {observer}; set [observer] location in {config_file(config)} "
-                 "(`nfwserver config init` writes a starting file) or give --observer")
-    ut1_utc = getattr(args, "ut1_utc", None)
-    if ut1_utc is None:
-        ut1_utc = config.server.ut1_utc_s
-    elements = getattr(args, "elements", None)
-    catalog = _catalog_from_files(elements, config.dde_names) if elements else _station_catalog(config)
-    return TrackingInputs(catalog, observer, horizon, float(ut1_utc), config.server.satellite)
+    inputs = TrackingInputs(args)
+    inputs.config()
+    return inputs.resolve()

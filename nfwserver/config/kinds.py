@@ -196,7 +196,7 @@ def _names(setting: Setting, value: Any, base: Path | None) -> dict[int, str]:
 
 
 def _schedules(setting: Setting, value: Any, base: Path | None) -> dict[int, str]:
-    from nfwserver.tracking.derived import parse_schedule
+    from nfwserver.tracking.mode_schedule import parse_schedule
 
     def checked(text: str) -> str:
         parse_schedule(text)

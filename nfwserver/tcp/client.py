@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import socket
 
-from nfwserver.tcp.protocol import GREETING
+from nfwserver.tcp.greeting import GREETING
 
 WILDCARDS = {"", "0.0.0.0", "::"}
 

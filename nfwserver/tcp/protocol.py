@@ -41,8 +41,8 @@ from dataclasses import dataclass
 from nfwserver.core.events import Direction
 from nfwserver.core.nova_protocol import format_azimuth, format_elevation, format_range_rate
 from nfwserver.core.station_core import StationCore
+from nfwserver.tcp.greeting import GREETING as GREETING  # the server sends it
 
-GREETING = "Hello, this is Nova for Windows."
 StatusFields = Callable[[], Mapping[str, object]]
 
 

@@ -7,14 +7,9 @@ number, update semantics, DDE names), ``observer`` and ``maidenhead`` (station p
 ``doppler`` and ``derived`` (InstantTrack's realtime values).
 """
 
-import os
-import sys
+from nfwserver.blas_threads import single_threaded_blas
 
-if "numpy" not in sys.modules:
-    # The engine's arrays are small (thousands of 3-vectors): BLAS threads gain nothing on them, yet
-    # OpenBLAS starts one per core when numpy loads (~0.1 s of CPU, 40 ms of wall time on a 2-core
-    # machine) and they spin after every large matrix product.  One thread, unless the user chose.
-    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+single_threaded_blas()  # before numpy loads (nfwserver.blas_threads)
 
 from nfwserver.tracking.sgp4_selfcheck import ensure_working_sgp4  # noqa: E402
 

@@ -3,7 +3,9 @@
 :meth:`Catalog.update` follows InstantTrack's UPDATE: a set replaces the stored one only when
 its epoch is newer; new satellites are added.  Each satellite has a unique DDE name
 (:mod:`nfwserver.tracking.dde_names`); user overrides win.  Thread-safe for concurrent readers and
-one writer: updates build new objects and swap them in.
+one writer: updates build new objects and swap them in.  DDE names are assigned when first needed
+(a reader asking for a :class:`Satellite`): a catalog used only for its element sets (a pass search
+over tens of thousands of objects) never pays for them.
 """
 
 from __future__ import annotations
@@ -73,7 +75,8 @@ class Catalog:
         self._lock = threading.Lock()
         self._elements: dict[int, ElementSet] = {}
         self._overrides: dict[int, str] = {}
-        self._satellites: dict[int, Satellite] = {}
+        #: satellites with their DDE names, made on first use from ``_elements`` (None: not made yet)
+        self._satellites: dict[int, Satellite] | None = {}
         for catnr, name in (dde_names or {}).items():
             self._overrides[int(catnr)] = validate_dde_name(name)
         self.update(sets)
@@ -97,12 +100,24 @@ class Catalog:
         return summary
 
     def _rebuild(self, elements: dict[int, ElementSet]) -> None:
-        names = assign_dde_names(
-            {k: v.name for k, v in elements.items()},
-            {k: v for k, v in self._overrides.items() if k in elements},
-        )
+        """Swap in ``elements`` (the caller holds the lock); the satellites are made when first read."""
         self._elements = elements
-        self._satellites = {k: Satellite(elements[k], names[k]) for k in sorted(elements)}
+        self._satellites = None
+
+    def _named(self) -> dict[int, Satellite]:
+        """The satellites with their DDE names, made now if no reader needed them since the last change."""
+        satellites = self._satellites
+        if satellites is None:
+            with self._lock:
+                satellites = self._satellites
+                if satellites is None:
+                    elements = self._elements
+                    names = assign_dde_names(
+                        {k: v.name for k, v in elements.items()},
+                        {k: v for k, v in self._overrides.items() if k in elements},
+                    )
+                    satellites = self._satellites = {k: Satellite(elements[k], names[k]) for k in sorted(elements)}
+        return satellites
 
     def set_dde_name(self, catalog_number: int, name: str) -> None:
         """Override the DDE name of a satellite (may be set before its elements arrive).
@@ -118,20 +133,25 @@ class Catalog:
             self._rebuild(self._elements)
 
     def get(self, catalog_number: int) -> Satellite | None:
-        return self._satellites.get(catalog_number)
+        return self._named().get(catalog_number)
 
     def __contains__(self, catalog_number: object) -> bool:
-        return catalog_number in self._satellites
+        return catalog_number in self._elements
 
     def __len__(self) -> int:
-        return len(self._satellites)
+        return len(self._elements)
 
     def __iter__(self) -> Iterator[Satellite]:
-        return iter(list(self._satellites.values()))
+        return iter(list(self._named().values()))
 
     def satellites(self) -> list[Satellite]:
         """All satellites, ascending catalog number."""
-        return list(self._satellites.values())
+        return list(self._named().values())
+
+    def element_sets(self) -> list[ElementSet]:
+        """Every satellite's element set, ascending catalog number (no DDE names are made)."""
+        elements = self._elements
+        return [elements[k] for k in sorted(elements)]
 
     def find(self, text: str) -> Satellite | None:
         """A satellite by catalog number, DDE name or element name (case-insensitive)."""
@@ -139,7 +159,7 @@ class Catalog:
         if text.isdigit():
             return self.get(int(text))
         key = text.upper()
-        sats = self._satellites.values()
+        sats = self._named().values()
         for sat in sats:
             if sat.dde_name.upper() == key:
                 return sat

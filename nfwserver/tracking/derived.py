@@ -14,7 +14,6 @@
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 from datetime import datetime
 
@@ -34,12 +33,12 @@ from nfwserver.tracking.elements import ElementSet
 from nfwserver.tracking.frames import ScalarLookAngles, teme_to_itrs
 from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError
 from nfwserver.tracking.maidenhead import latlon_to_locator
+from nfwserver.tracking.mode_schedule import mode_at
 from nfwserver.tracking.observer import Observer
 from nfwserver.tracking.sun import is_sunlit, sun_position_km
 from nfwserver.tracking.timescale import julian_date
 
 _E2 = WGS84_E2
-_SCHEDULE = re.compile(r"(\d{3})(.)")
 
 
 @dataclass(frozen=True)
@@ -97,30 +96,6 @@ def _ndot(elements: ElementSet) -> float:
         return float(elements.line1[33:43])
     except ValueError:
         return 0.0
-
-
-def parse_schedule(schedule: str) -> list[tuple[int, str]]:
-    """``003B100J150B240-`` -> [(3, 'B'), (100, 'J'), (150, 'B'), (240, '-')]; ValueError if malformed."""
-    text = schedule.strip()
-    entries = [(int(m.group(1)), m.group(2)) for m in _SCHEDULE.finditer(text)]
-    if not entries or "".join(f"{p:03d}{c}" for p, c in entries) != text:
-        raise ValueError(f"schedule {schedule!r} is not a series of three-digit phases each followed by a mode")
-    if len(entries) > 12:
-        raise ValueError("a schedule holds at most 12 mode changes")
-    phases = [p for p, _ in entries]
-    if phases != sorted(set(phases)) or phases[-1] > 255:
-        raise ValueError("schedule phases must ascend and lie in 0..255")
-    return entries
-
-
-def mode_at(schedule: str, phase: int) -> str:
-    """The mode letter in force at ``phase`` (the schedule wraps around the orbit)."""
-    entries = parse_schedule(schedule)
-    mode = entries[-1][1]
-    for start, letter in entries:
-        if phase >= start:
-            mode = letter
-    return mode
 
 
 def path_loss_db(range_km: float, frequency_hz: float) -> float:

@@ -21,140 +21,26 @@ import csv
 import gc
 import json
 import os
-import re
 from collections.abc import Callable
-from dataclasses import MISSING, dataclass, field, fields, make_dataclass, replace
 from datetime import datetime, timedelta
 from pathlib import Path
 
-from sgp4.api import WGS72, Satrec
-
 from nfwserver.tracking import amsat, omm
 from nfwserver.tracking.element_names import MAX_NAME_LENGTH, sanitize_element_name
-from nfwserver.tracking.tle import TleError, TleFields, epoch_from_tle, format_tle, parse_tle
+from nfwserver.tracking.element_set import (
+    MAX_CSV_ROW,
+    TLE_LIKE,
+    ElementSet,
+    ElementSetDraft,
+    LoadResult,
+    Rejection,
+    is_csv_header,
+)
+from nfwserver.tracking.tle import TleError, epoch_from_tle, parse_tle
 from nfwserver.tracking.tle_bulk import read_canonical
 
-
-@dataclass(frozen=True, slots=True)
-class ElementSet:
-    """One satellite's mean elements at an epoch, with its SGP4 model (slots: catalogs hold tens of thousands).
-
-    The SGP4 model (:attr:`satrec`) of a set read from canonical TLE lines is initialised when first
-    used: a station propagates a handful of a catalog's satellites, and the model is most of a set's
-    loading time (about 3 us) and memory (about 1 KiB).  Sets from AMSAT, OMM or irregular TLE text
-    get theirs at once, since initialising it is part of checking them."""
-
-    name: str  #: name as given ("ISS (ZARYA)"), sanitised (element_names); "" when the set had none
-    catalog_number: int
-    international_designator: str
-    epoch: datetime  #: aware UTC
-    inclination_deg: float
-    raan_deg: float
-    eccentricity: float
-    arg_perigee_deg: float
-    mean_anomaly_deg: float
-    mean_motion_rev_per_day: float
-    bstar: float  #: 1/earth radii
-    rev_number: int  #: revolution number at epoch
-    line1: str  #: canonical TLE line 1 (generated for AMSAT and OMM input)
-    line2: str
-    source: str = ""
-    line_number: int = 0  #: 1-based line where the set started in ``source``
-    _satrec: Satrec | None = field(default=None, compare=False, repr=False)
-
-    @property
-    def satrec(self) -> Satrec:
-        """The initialised SGP4 model (WGS-72 constants, as the elements were fitted), made on first use."""
-        satrec = self._satrec
-        if satrec is None:
-            satrec = Satrec.twoline2rv(self.line1, self.line2, WGS72)
-            object.__setattr__(self, "_satrec", satrec)  # a cache: the same model every time
-        return satrec
-
-    def transient_satrec(self) -> Satrec:
-        """The SGP4 model for one-off bulk work (a catalog-wide pass search): the one already made, or a
-        new one that is not kept, so a search over many sets holds only the models it is using."""
-        return self._satrec or Satrec.twoline2rv(self.line1, self.line2, WGS72)
-
-    @classmethod
-    def from_fields(cls, name: str, fields: TleFields, source: str = "", line_number: int = 0,
-                    lines: tuple[str, str] | None = None) -> ElementSet:
-        """Build from parsed values; ``lines`` are the original TLE lines when there were any.
-
-        Lines generated here (AMSAT, OMM) hold the epoch on the TLE's 1e-8-day grid; the set takes that
-        epoch, so memory, the stored catalog and SGP4 agree on one value (an OMM epoch may be finer)."""
-        if lines is None:
-            line1, line2 = format_tle(fields)
-            fields = replace(fields, epoch=epoch_from_tle(int(line1[18:20]), float(line1[20:32])))
-        else:
-            line1, line2 = lines
-        satrec = Satrec.twoline2rv(line1, line2, WGS72)
-        return cls(
-            name=sanitize_element_name(name), catalog_number=fields.catalog_number,
-            international_designator=fields.international_designator, epoch=fields.epoch,
-            inclination_deg=fields.inclination_deg, raan_deg=fields.raan_deg, eccentricity=fields.eccentricity,
-            arg_perigee_deg=fields.arg_perigee_deg, mean_anomaly_deg=fields.mean_anomaly_deg,
-            mean_motion_rev_per_day=fields.mean_motion_rev_per_day, bstar=fields.bstar,
-            rev_number=fields.rev_number, line1=line1, line2=line2, source=source, line_number=line_number,
-            _satrec=satrec,
-        )
-
-    def tle_text(self) -> str:
-        """The set as three lines (name, line 1, line 2), newline-terminated.
-
-        A name that would be read back as something else (a TLE line, an AMSAT or CSV header) is
-        written in CelesTrak's ``0 NAME`` form, which the loader reads as a name.
-        """
-        name = self.name or str(self.catalog_number)
-        if _TLE_LIKE.match(name) or name.startswith(("1 ", "2 ", "0 ")) or amsat.is_satellite_line(name) \
-                or _is_csv_header(name):
-            name = "0 " + name
-        return f"{name}\n{self.line1}\n{self.line2}\n"
-
-
-#: ElementSet's mutable twin: the same slots in the same order.  The bulk loader fills one and makes it an
-#: ElementSet by assigning its class, which skips the frozen ``__init__``'s per-field ``object.__setattr__``
-#: (about 1.2 us a set, a fifth of loading a large catalog); the result is an ordinary, frozen ElementSet.
-_ElementSetDraft = make_dataclass(
-    "_ElementSetDraft",
-    [(f.name, f.type) if f.default is MISSING else (f.name, f.type, field(default=f.default))
-     for f in fields(ElementSet)], slots=True)
-
-
-@dataclass(frozen=True)
-class Rejection:
-    """A set that was not loaded: where it started and why."""
-
-    source: str
-    line_number: int
-    reason: str
-
-    def __str__(self) -> str:
-        return f"{self.source} line {self.line_number}: {self.reason}"
-
-
-@dataclass
-class LoadResult:
-    """What a load found: the accepted sets (file order) and the rejections."""
-
-    sets: list[ElementSet] = field(default_factory=list)
-    rejected: list[Rejection] = field(default_factory=list)
-
-
-# A line that claims to be a TLE line: line number, blank, 5-character catalog field.
-_TLE_LIKE = re.compile(r"^[12] [0-9A-Z ]{4}[0-9]")
+__all__ = ["MAX_CSV_ROW", "ElementSet", "LoadResult", "Rejection", "load_element_file", "load_elements"]
 _MAX_NAME = MAX_NAME_LENGTH
-#: Longest CSV row read (characters); longer rows are rejected before the csv module sees them.
-MAX_CSV_ROW = 4096
-_CSV_COLUMN = re.compile(r"[A-Z_]+")
-
-
-def _is_csv_header(line: str) -> bool:
-    """True for an OMM CSV header row: upper-case column names including NORAD_CAT_ID and MEAN_MOTION."""
-    if "NORAD_CAT_ID" not in line or "MEAN_MOTION" not in line or "," not in line:
-        return False
-    columns = [c.strip().strip('"') for c in line.strip().split(",")]
-    return all(_CSV_COLUMN.fullmatch(c) for c in columns)
 
 
 def _clean_name(line: str) -> str:
@@ -166,7 +52,7 @@ def _clean_name(line: str) -> str:
 
 def _could_be_name(line: str) -> bool:
     text = line.strip()
-    if not 0 < len(text) <= _MAX_NAME + 2 or _TLE_LIKE.match(text):
+    if not 0 < len(text) <= _MAX_NAME + 2 or TLE_LIKE.match(text):
         return False
     return text.isprintable() or bool(sanitize_element_name(text))
 
@@ -213,13 +99,13 @@ def _load_three_line_file(lines: list[str], source: str, result: LoadResult) -> 
     if not lines or len(lines) % 3:
         return False
     names, ones, twos = lines[0::3], [x.rstrip() for x in lines[1::3]], lines[2::3]
-    match = _TLE_LIKE.match
+    match = TLE_LIKE.match
     if not (all([x.startswith("1 ") and match(x) for x in ones]) and all([x.startswith("2") for x in twos])
             and all([_could_be_name(x) and not x.startswith("2 ") for x in names])):
         return False
     all_names = "\n".join(names)  # AMSAT and CSV headers need a colon or a column name: rare, tested one by one
     if (":" in all_names and any([amsat.is_satellite_line(x) for x in names])) or (
-            "NORAD_CAT_ID" in all_names and any([_is_csv_header(x) for x in names])):
+            "NORAD_CAT_ID" in all_names and any([is_csv_header(x) for x in names])):
         return False
     pending: list = [(sanitize_element_name(_clean_name(name)), 3 * k + 1, one, two.rstrip())
                      for k, (name, one, two) in enumerate(zip(names, ones, twos))]
@@ -233,14 +119,14 @@ def _load_lines(lines: list[str], source: str, result: LoadResult) -> None:
     pending: list = []  # TLE pairs (and their structural rejections) not yet built, in file order
     while i < n:
         line = lines[i].rstrip()
-        if _TLE_LIKE.match(line):
+        if TLE_LIKE.match(line):
             i = _take_tle(lines, i, source, pending)
             continue
         if amsat.is_satellite_line(line):
             _build_tles(pending, source, result)
             i = _take_amsat(lines, i, source, result)
             continue
-        if _is_csv_header(line):
+        if is_csv_header(line):
             _build_tles(pending, source, result)
             i = _take_csv(lines, i, source, result)
             continue
@@ -282,14 +168,19 @@ def _take_tle(lines: list[str], i: int, source: str, pending: list) -> int:
 
 def _build_tles(pending: list, source: str, result: LoadResult) -> None:
     """Build the queued TLE sets: canonical ones checked and read in bulk (:mod:`~nfwserver.tracking.tle_bulk`),
-    the rest one by one by :func:`~nfwserver.tracking.tle.parse_tle`, which names what is wrong."""
-    if not pending:
-        return
+    the rest one by one by :func:`~nfwserver.tracking.tle.parse_tle`, which names what is wrong.  1024 at a
+    time: the temporary values of a block are freed before the next (a catalog's would take ~8 MiB)."""
+    years: dict[int, datetime] = {}
+    for b0 in range(0, len(pending), 1024):
+        _build_block(pending[b0 : b0 + 1024], source, result, years)
+    pending.clear()
+
+
+def _build_block(pending: list, source: str, result: LoadResult, years: dict[int, datetime]) -> None:
     pairs = [p for p in pending if not isinstance(p, Rejection)]
     good, values = read_canonical([p[2] for p in pairs], [p[3] for p in pairs])
     rows = zip(*(values[c].tolist() for c in _BULK_COLUMNS)) if values else iter(())
     good_list = good.tolist()
-    years: dict[int, datetime] = {}
     k = 0
     for item in pending:
         if isinstance(item, Rejection):
@@ -303,7 +194,7 @@ def _build_tles(pending: list, source: str, result: LoadResult) -> None:
             base = years.get(year2)
             if base is None:
                 base = years[year2] = epoch_from_tle(year2, 1.0)
-            element_set = _ElementSetDraft(
+            element_set = ElementSetDraft(
                 name, cat, line1[9:17].strip(), base + timedelta(days=day - 1.0), inc, raan, ecc, argp, ma, mm,
                 bstar, rev, line1, line2, source, start)
             element_set.__class__ = ElementSet
@@ -316,7 +207,6 @@ def _build_tles(pending: list, source: str, result: LoadResult) -> None:
             return ElementSet.from_fields(name, parse_tle(line1, line2), source, start, lines=(line1, line2))
 
         _accept(result, source, start, f"{name}: " if name else "", build)
-    pending.clear()
 
 
 #: Columns of tle_bulk.read_canonical used to build a set, in ElementSet's field order after the name.
@@ -331,7 +221,7 @@ def _take_amsat(lines: list[str], i: int, source: str, result: LoadResult) -> in
     i += 1
     while i < len(lines):
         line = lines[i].rstrip()
-        if amsat.is_satellite_line(line) or _TLE_LIKE.match(line):
+        if amsat.is_satellite_line(line) or TLE_LIKE.match(line):
             break
         if not line.strip():
             # A blank line right after "Satellite:" (the ARRL layout) does not end the set.

@@ -20,17 +20,16 @@ from __future__ import annotations
 
 import numpy as np
 
+from nfwserver.tracking.pass_batch import Layout
 from nfwserver.tracking.pass_kinematics import PairEvaluator
 from nfwserver.tracking.pass_refine import CROSSING, F_TOP, TOP, solve
 from nfwserver.tracking.pass_screen import Brackets, Intervals
 
-#: Key spacing per satellite when sorting (sat, t) pairs as one float (s; far above any span).
-_KEY = 1e8
 #: Passes shorter than this (s) get the middle of their rise and set as the first guess of their TCA.
 _SHORT_PASS_S = 1800.0
 
 
-def _events(ev: PairEvaluator, br: Brackets, flat: bool):
+def _events(ev: PairEvaluator, br: Brackets, flat: bool, layout: Layout):
     """Refined crossings (sat, t, rising, az, el, el rate), the maxima of the hidden peaks that rose,
     and the refined culminations (t, el)."""
     cr, pk, cu = br.crossings, br.peaks, br.culminations
@@ -58,7 +57,7 @@ def _events(ev: PairEvaluator, br: Brackets, flat: bool):
                np.concatenate((cu.b, top_t, pk.b[up])), np.concatenate((cu.ga, np.full(m, -1.0), f_top)),
                np.concatenate((cu.gb, f_top, np.full(m, -1.0))),
                np.concatenate((np.full(len(cu), TOP), np.full(2 * m, CROSSING))),
-               guess=np.concatenate((_middle_of_pass(sat, t, rising, cu), top_t - half, top_t + half)))
+               guess=np.concatenate((_middle_of_pass(sat, t, rising, cu, layout), top_t - half, top_t + half)))
     culminations = (s2.t[: len(cu)], s2.el[: len(cu)])
     if m:
         sat = np.concatenate((sat, ps, ps))
@@ -72,7 +71,8 @@ def _events(ev: PairEvaluator, br: Brackets, flat: bool):
     return sat, t, rising, az, el, el_rate, tops, culminations
 
 
-def _middle_of_pass(sat: np.ndarray, t: np.ndarray, rising: np.ndarray, cu: Intervals) -> np.ndarray:
+def _middle_of_pass(sat: np.ndarray, t: np.ndarray, rising: np.ndarray, cu: Intervals, layout: Layout
+                    ) -> np.ndarray:
     """For each culmination bracket, the middle of the pass it lies in (a rise followed by a set
     around one of its ends), when that pass is shorter than ``_SHORT_PASS_S`` and the middle lies in
     the bracket; else NaN.  (The maximum of a short pass lies within seconds of its middle.)"""
@@ -80,11 +80,11 @@ def _middle_of_pass(sat: np.ndarray, t: np.ndarray, rising: np.ndarray, cu: Inte
     if not len(t) or not len(cu):
         return guess
     order = np.lexsort((t, sat))
-    keys = sat[order] * _KEY + t[order]
     t_s, up_s, sat_s = t[order], rising[order], sat[order]
+    keys = layout.keys(sat_s, t_s)
     n = len(keys)
     for end in (cu.b, cu.a):
-        i = np.searchsorted(keys, cu.sat * _KEY + end)
+        i = layout.search(sat_s, keys, cu.sat, layout.keys(cu.sat, end), "left")
         r, s = np.clip(i - 1, 0, n - 1), np.clip(i, 0, n - 1)
         inside = (i >= 1) & (i < n) & (sat_s[r] == cu.sat) & (sat_s[s] == cu.sat) & up_s[r] & ~up_s[s]
         mid = 0.5 * (t_s[r] + t_s[s])
@@ -93,7 +93,7 @@ def _middle_of_pass(sat: np.ndarray, t: np.ndarray, rising: np.ndarray, cu: Inte
     return guess
 
 
-def _within_window(br: Brackets, win_lo: float, win_hi: float) -> Brackets:
+def _within_window(br: Brackets, win_lo: np.ndarray, win_hi: np.ndarray) -> Brackets:
     """``br`` without the brackets of passes that cannot overlap ``[win_lo, win_hi]``, before refining.
 
     A hidden peak holds its whole pass.  A set bracket ending before ``win_lo`` ends a pass that is
@@ -101,13 +101,13 @@ def _within_window(br: Brackets, win_lo: float, win_hi: float) -> Brackets:
     after it: both go, with the rise just before (set just after) them of the same satellite.
     """
     pk, cr = br.peaks, br.crossings
-    peaks = pk.select((pk.b >= win_lo) & (pk.a <= win_hi))
+    peaks = pk.select((pk.b >= win_lo[pk.sat]) & (pk.a <= win_hi[pk.sat]))
     n = len(cr)
     if not n:
         return Brackets(cr, peaks, br.culminations)
     order = np.lexsort((cr.a, cr.sat))
     sat, a, b, rising = cr.sat[order], cr.a[order], cr.b[order], cr.ga[order] <= 0.0
-    drop = (~rising & (np.maximum(a, b) < win_lo)) | (rising & (np.minimum(a, b) > win_hi))
+    drop = (~rising & (np.maximum(a, b) < win_lo[sat])) | (rising & (np.minimum(a, b) > win_hi[sat]))
     same_prev = np.zeros(n, dtype=bool)
     same_prev[1:] = sat[1:] == sat[:-1]
     # the rise before a dropped early set, the set after a dropped late rise
@@ -134,24 +134,25 @@ def _pair(sat: np.ndarray, t: np.ndarray, rising: np.ndarray) -> tuple[np.ndarra
     return p_sat, p_rise, p_set
 
 
-def assemble(ev: PairEvaluator, br: Brackets, flat: bool, catalog_numbers: np.ndarray, span: float, win_lo: float,
-             win_hi: float) -> dict[str, np.ndarray]:
-    """Passes overlapping ``[win_lo, win_hi]`` (s after the search start) from the brackets of a search,
-    as :class:`~nfwserver.tracking.pass_records.PassList` columns (unsorted)."""
+def assemble(ev: PairEvaluator, br: Brackets, flat: bool, layout: Layout) -> dict[str, np.ndarray]:
+    """Passes overlapping each satellite's window from the brackets of a search (``layout``: the satellites'
+    catalog numbers, spans and windows), as :class:`~nfwserver.tracking.pass_records.PassList` columns
+    (unsorted)."""
+    span, win_lo, win_hi = layout.span, layout.win_lo, layout.win_hi
     br = _within_window(br, win_lo, win_hi)
-    sat, t, rising, az, el, el_rate, tops, (cu_t, cu_el) = _events(ev, br, flat)
+    sat, t, rising, az, el, el_rate, tops, (cu_t, cu_el) = _events(ev, br, flat, layout)
     order = np.lexsort((t, sat))
     sat, t, rising, az, el, el_rate = sat[order], t[order], rising[order], az[order], el[order], el_rate[order]
     p_sat, p_rise, p_set = _pair(sat, t, rising)
     lo = np.where(p_rise >= 0, t[p_rise], -np.inf)
     hi = np.where(p_set >= 0, t[p_set], np.inf)
-    keep = (hi >= win_lo) & (lo <= win_hi)
+    keep = (hi >= win_lo[p_sat]) & (lo <= win_hi[p_sat])
     p_sat, p_rise, p_set, lo, hi = p_sat[keep], p_rise[keep], p_set[keep], lo[keep], hi[keep]
     if not len(p_sat):
         return {}
     porder = np.lexsort((lo, p_sat))
     p_sat, p_rise, p_set, lo, hi = p_sat[porder], p_rise[porder], p_set[porder], lo[porder], hi[porder]
-    lo_c, hi_c = np.maximum(lo, 0.0), np.minimum(hi, span)
+    lo_c, hi_c = np.maximum(lo, 0.0), np.minimum(hi, span[p_sat])
     # Candidates for each pass's TCA: its known ends, refined culminations, hidden-peak maxima.
     best_el = np.full(len(p_sat), -np.inf)
     best_t = 0.5 * (lo_c + hi_c)
@@ -162,11 +163,11 @@ def assemble(ev: PairEvaluator, br: Brackets, flat: bool, catalog_numbers: np.nd
         better = end_el > best_el
         best_el, best_t = np.where(better, end_el, best_el), np.where(better, t[np.maximum(ends, 0)], best_t)
     cu = br.culminations
-    owner = _owner(p_sat, lo_c, hi_c, cu.sat, cu.a, cu.b)
+    owner = _owner(p_sat, lo_c, hi_c, cu.sat, cu.a, cu.b, layout)
     cand_pass = [owner[owner >= 0]]
     sel = owner >= 0
     cand_t, cand_el = [cu_t[sel]], [cu_el[sel]]
-    tp = _owner(p_sat, lo_c, hi_c, tops[0], tops[1], tops[1])
+    tp = _owner(p_sat, lo_c, hi_c, tops[0], tops[1], tops[1], layout)
     cand_pass.append(tp[tp >= 0])
     cand_t.append(tops[1][tp >= 0])
     cand_el.append(tops[2][tp >= 0])
@@ -192,22 +193,22 @@ def assemble(ev: PairEvaluator, br: Brackets, flat: bool, catalog_numbers: np.nd
     cp, ct, ce = cp[top], ct[top], ce[top]
     better = ce > best_el[cp]
     best_el[cp[better]], best_t[cp[better]] = ce[better], ct[better]
-    return _records(p_sat, p_rise, p_set, t, az, best_t, best_el, catalog_numbers, win_lo)
+    return _records(p_sat, p_rise, p_set, t, az, best_t, best_el, layout.catalog_numbers, win_lo[p_sat])
 
 
 def _owner(p_sat: np.ndarray, lo: np.ndarray, hi: np.ndarray, sat: np.ndarray, a: np.ndarray,
-           b: np.ndarray) -> np.ndarray:
+           b: np.ndarray, layout: Layout) -> np.ndarray:
     """Index of the pass (sorted by sat, lo) overlapping each interval ``[a, b]`` of ``sat``, or -1."""
     if not len(sat) or not len(p_sat):
         return np.full(len(sat), -1)
-    keys = p_sat * _KEY + lo
-    i = np.searchsorted(keys, sat * _KEY + b, side="right") - 1
+    keys = layout.keys(p_sat, lo)
+    i = layout.search(p_sat, keys, sat, layout.keys(sat, b), "right") - 1
     ic = np.maximum(i, 0)
     ok = (i >= 0) & (p_sat[ic] == sat) & (hi[ic] >= a)
     return np.where(ok, i, -1)
 
 
-def _records(p_sat, p_rise, p_set, t, az, tca_t, tca_el, catalog_numbers: np.ndarray, win_lo: float
+def _records(p_sat, p_rise, p_set, t, az, tca_t, tca_el, catalog_numbers: np.ndarray, win_lo: np.ndarray
              ) -> dict[str, np.ndarray]:
     """PassList columns (times in s after the window start, ``win_lo`` after the search start)."""
     rise, fall = p_rise >= 0, p_set >= 0

@@ -79,6 +79,16 @@ class Kinematics:
         """d2(azimuth)/dt2 (deg/s^2)."""
         return self._azimuth_rates()[1]
 
+    def azimuth_rates(self, picked: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """d(azimuth)/dt (deg/s) and d2(azimuth)/dt2 (deg/s^2) at the pairs ``picked`` (indices), computed for
+        those pairs only unless they are known already."""
+        if self._az_rates is not None:
+            return self._az_rates[0][picked], self._az_rates[1][picked]
+        e, n, e1, n1, e2, n2, q, h, bad = self.plane
+        az1, az2 = _azimuth_derivatives(e[picked], n[picked], e1[picked], n1[picked], e2[picked], n2[picked],
+                                        q[picked], h[picked], None if bad is None else bad[picked])
+        return az1 * _DEG, az2 * _DEG
+
     def _azimuth_rates(self) -> tuple[np.ndarray, np.ndarray]:
         if self._az_rates is None:
             az1, az2 = _azimuth_derivatives(*self.plane)
@@ -101,19 +111,27 @@ def _azimuth_derivatives(e: np.ndarray, n: np.ndarray, e1: np.ndarray, n1: np.nd
 
 
 class PairEvaluator:
-    """Propagates (satellite index, seconds after ``t0``) pairs of a list of ``Satrec`` objects.
+    """Propagates (satellite index, seconds after the satellite's reference instant) pairs of a list of ``Satrec``.
 
-    ``jd0 + fr0`` is the reference instant (split UTC Julian date), ``ut1_utc`` seconds.
+    ``jd0 + fr0`` is the reference instant (split UTC Julian date): one for every satellite, or an
+    array holding each satellite's own (searches of several groups refined together); ``ut1_utc`` seconds.
     """
 
-    def __init__(self, satrecs: list, observer: Observer, jd0: float, fr0: float, ut1_utc: float,
-                 horizon: HorizonTable) -> None:
+    def __init__(self, satrecs: list, observer: Observer, jd0: float | np.ndarray, fr0: float | np.ndarray,
+                 ut1_utc: float, horizon: HorizonTable) -> None:
         self.satrecs = satrecs
         self.frame = TopocentricFrame(observer)
         self.jd0, self.fr0, self.ut1_utc = jd0, fr0, ut1_utc
         self.horizon = horizon
         self.calls = 0  #: compiled SGP4 calls made (for profiling and tests)
         self.pairs = 0  #: satellite-time pairs propagated
+
+    def _epoch(self, sat: np.ndarray) -> tuple[float | np.ndarray, float | np.ndarray]:
+        """The reference instant (jd0, fr0) of each pair's satellite (one pair of floats when all share it)."""
+        jd0, fr0 = self.jd0, self.fr0
+        if isinstance(jd0, np.ndarray) and isinstance(fr0, np.ndarray):
+            return jd0[sat], fr0[sat]
+        return jd0, fr0
 
     def teme(self, sat: np.ndarray, t: np.ndarray, grouped: bool = False
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -122,14 +140,18 @@ class PairEvaluator:
         ``grouped``: the pairs of each satellite are already contiguous (no sorting needed).
         """
         if grouped:
-            return self._propagate(sat, self.fr0 + t / SECONDS_PER_DAY)
+            jd0, fr0 = self._epoch(sat)
+            return self._propagate(sat, jd0, fr0 + t / SECONDS_PER_DAY)
         order = np.argsort(sat, kind="stable")
-        r, v, e = self._propagate(sat[order], self.fr0 + t[order] / SECONDS_PER_DAY)
+        sat_sorted = sat[order]
+        jd0, fr0 = self._epoch(sat_sorted)
+        r, v, e = self._propagate(sat_sorted, jd0, fr0 + t[order] / SECONDS_PER_DAY)
         back = np.empty_like(order)
         back[order] = np.arange(len(t))
         return r[back], v[back], e[back]
 
-    def _propagate(self, sat: np.ndarray, fr: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _propagate(self, sat: np.ndarray, jd0: float | np.ndarray, fr: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """SGP4 at UTC ``jd0 + fr`` (days) for pairs grouped by satellite: one compiled call per satellite.
 
         The calls get memoryview slices (the extension reads any buffer of the right length; slicing a
@@ -142,12 +164,13 @@ class PairEvaluator:
         edges = np.flatnonzero(sat[1:] != sat[:-1]) + 1
         starts = np.concatenate(([0], edges))
         stops = np.concatenate((edges, [n]))
-        jd_m, fr_m, e_m = np.full(n, self.jd0).data, np.ascontiguousarray(fr).data, e.data
+        jd = np.ascontiguousarray(np.broadcast_to(jd0, (n,)), dtype=np.float64)
+        jd_m, fr_m, e_m = jd.data, np.ascontiguousarray(fr).data, e.data
         r_m, v_m = r.reshape(-1).data, v.reshape(-1).data
         satrecs = self.satrecs
         if not hasattr(satrecs[0], "_sgp4"):  # sgp4's pure-Python model (sgp4_selfcheck's last resort)
             for a, b, i in zip(starts.tolist(), stops.tolist(), sat[starts].tolist()):
-                e[a:b], r[a:b], v[a:b] = satrecs[i].sgp4_array(np.full(b - a, self.jd0), fr[a:b])
+                e[a:b], r[a:b], v[a:b] = satrecs[i].sgp4_array(jd[a:b], fr[a:b])
             return r, v, e
         for a, b, a3, b3, i in zip(starts.tolist(), stops.tolist(), (3 * starts).tolist(), (3 * stops).tolist(),
                                    sat[starts].tolist()):
@@ -160,10 +183,11 @@ class PairEvaluator:
         """Angles and derivatives at each pair (``sat`` intp, ``t`` float seconds; see :meth:`teme`)."""
         if not len(sat):
             return Kinematics.empty()
-        fr = self.fr0 + t / SECONDS_PER_DAY
-        r, v, err = self._propagate(sat, fr) if grouped else self.teme(sat, t)
+        jd0, fr0 = self._epoch(sat)
+        fr = fr0 + t / SECONDS_PER_DAY
+        r, v, err = self._propagate(sat, jd0, fr) if grouped else self.teme(sat, t)
         # TEME to ITRS as in frames.teme_to_itrs (the same arithmetic), kept as separate components.
-        theta, theta_dot = gmst1982(self.jd0, fr + self.ut1_utc / SECONDS_PER_DAY)
+        theta, theta_dot = gmst1982(jd0, fr + self.ut1_utc / SECONDS_PER_DAY)
         c, s = np.cos(theta), np.sin(theta)
         ms = -s
         rx, ry, vx, vy = r[:, 0], r[:, 1], v[:, 0], v[:, 1]

@@ -25,7 +25,7 @@ Times are seconds after the search start; angles degrees.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -52,6 +52,8 @@ _JERK_MARGIN = 3.0
 _TOP_S_TOL = 3.5e-8
 #: A hidden peak whose modelled height stays this far below the horizon (deg) is given up.
 _HOPELESS_DEG = -2.0
+#: Brackets evaluated at once within a round (bounds the memory of a round's kinematics and steps).
+_SLICE = 4096
 
 
 @dataclass
@@ -71,6 +73,53 @@ class Solution:
     rounds: int  #: iterations the slowest bracket needed
 
 
+class _Outputs:
+    """The columns of a :class:`Solution` (in the solver's order), filled as brackets finish."""
+
+    def __init__(self, n: int, first: np.ndarray) -> None:
+        #: in the order of Solution's fields: t, el, az, f, el_rate, best_f, best_t, best_up, best_up_accel, f_accel
+        self.columns = [first.copy(), np.full(n, np.nan), np.full(n, np.nan), np.full(n, -np.inf),
+                        np.full(n, np.nan), np.full(n, -np.inf), first.copy(), np.full(n, np.nan),
+                        np.full(n, np.nan), np.full(n, np.nan)]
+
+    def store(self, where: np.ndarray, values: tuple, picked: np.ndarray) -> None:
+        """Write ``values[j][picked]`` (one array per column, in the order of :attr:`columns`) at ``where``."""
+        for column, value in zip(self.columns, values):
+            column[where] = value[picked]
+
+
+@dataclass(slots=True)
+class _Live:
+    """The unfinished brackets (arrays of one length, in satellite order): what each carries from round to
+    round."""
+
+    idx: np.ndarray  #: index among all the brackets
+    sat: np.ndarray
+    cross: np.ndarray  #: a crossing (else a maximum)
+    top: np.ndarray  #: a maximum of the elevation (else of f, or a crossing)
+    hidden: np.ndarray  #: a hidden peak (may be given up)
+    tol: np.ndarray  #: tolerance (s)
+    a: np.ndarray  #: bracket ends (s) and the bracketed function's values there
+    b: np.ndarray
+    ga: np.ndarray
+    gb: np.ndarray
+    c: np.ndarray  #: the next time to evaluate (s)
+    best_f: np.ndarray  #: the largest f seen (deg), where (s), the height above the horizontal plane there
+    best_t: np.ndarray  #: (km) and its second derivative (km/s^2)
+    best_up: np.ndarray
+    best_up_accel: np.ndarray
+    prev_step: np.ndarray  #: the previous round's Newton step (inf after a bisection), time and f''
+    prev_t: np.ndarray
+    prev_accel: np.ndarray
+
+    def part(self, which: slice | np.ndarray) -> _Live:
+        """The brackets ``which`` picks (views for a slice: a round updates them in place)."""
+        return _Live(*(getattr(self, name)[which] for name in _LIVE))
+
+
+_LIVE = tuple(f.name for f in fields(_Live))
+
+
 def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: np.ndarray, gb: np.ndarray,
           kind: np.ndarray, hidden: np.ndarray | None = None, guess: np.ndarray | None = None) -> Solution:
     """Refine brackets ``[a, b]`` of satellites ``sat``; ``ga``/``gb`` hold the sign-carrying values at
@@ -84,106 +133,110 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
     undo[perm] = np.arange(n)
     sat, kind = sat[perm], kind[perm]
     a, b, ga, gb = a[perm], b[perm], ga[perm], gb[perm]
-    hidden = None if hidden is None else hidden[perm]
+    hidden = np.zeros(n, dtype=bool) if hidden is None else hidden[perm]
     guess = None if guess is None else guess[perm]
     a, b = a.astype(float).copy(), b.astype(float).copy()
     ga = np.nan_to_num(ga.astype(float), nan=0.0, neginf=-180.0, posinf=180.0)
     gb = np.nan_to_num(gb.astype(float), nan=0.0, neginf=-180.0, posinf=180.0)
-    hidden = np.zeros(n, dtype=bool) if hidden is None else hidden
-    tol = np.where(kind == CROSSING, CROSSING_TOL_S, TOP_TOL_S)
     with np.errstate(invalid="ignore", divide="ignore"):
         c = np.where(gb != ga, (a * gb - b * ga) / (gb - ga), 0.5 * (a + b))
     if guess is not None:
         c = np.where(np.isfinite(guess), guess, c)
     c = np.where(np.isfinite(c), np.clip(c, np.minimum(a, b), np.maximum(a, b)), 0.5 * (a + b))
-    t_out = c.copy()
-    el_out = np.full(n, np.nan)
-    az_out = np.full(n, np.nan)
-    f_out = np.full(n, -np.inf)
-    el_rate_out = np.full(n, np.nan)
-    f_accel_out = np.full(n, np.nan)
-    best_f = np.full(n, -np.inf)
-    best_t = c.copy()
-    best_up = np.full(n, np.nan)
-    best_up_accel = np.full(n, np.nan)
-    prev_step = np.full(n, np.inf)  # the previous round's Newton step (inf after a bisection)
-    prev_t = np.full(n, np.nan)  # the previous round's time and f'' there (crossings)
-    prev_accel = np.full(n, np.nan)
-    active = np.arange(n)
+    out = _Outputs(n, c)
+    live = _Live(idx=np.arange(n), sat=sat, cross=kind == CROSSING, top=kind == TOP, hidden=hidden,
+                 tol=np.where(kind == CROSSING, CROSSING_TOL_S, TOP_TOL_S), a=a, b=b, ga=ga, gb=gb, c=c,
+                 best_f=np.full(n, -np.inf), best_t=c.copy(), best_up=np.full(n, np.nan),
+                 best_up_accel=np.full(n, np.nan), prev_step=np.full(n, np.inf), prev_t=np.full(n, np.nan),
+                 prev_accel=np.full(n, np.nan))
+    del sat, kind, a, b, ga, gb, c, hidden, guess
     rounds = 0
-    while len(active) and rounds < _MAX_ROUNDS:
+    while len(live.idx) and rounds < _MAX_ROUNDS:
         rounds += 1
-        ca = c[active]
-        k = ev.evaluate(sat[active], ca, grouped=True)
-        kd = kind[active]
-        cross, top = kd == CROSSING, kd == TOP
-        f = np.fmax(k.f, -180.0)  # NaN and -inf (SGP4 failed) count as -180
-        g = np.where(cross, f, np.where(top, k.s_rate, k.f_rate))
-        g1 = np.where(cross, k.f_rate, np.where(top, k.s_accel, k.f_accel))
-        el_out[active], az_out[active], f_out[active], t_out[active] = k.el, k.az, f, ca
-        el_rate_out[active] = k.el_rate
-        f_accel_out[active] = k.f_accel
-        better = f > best_f[active]
-        best_f[active] = np.where(better, f, best_f[active])
-        best_t[active] = np.where(better, ca, best_t[active])
-        best_up[active] = np.where(better, k.up, best_up[active])
-        best_up_accel[active] = np.where(better, k.up_accel, best_up_accel[active])
-        aa, bb, gaa = a[active], b[active], ga[active]
-        same_as_a = (g > 0.0) == (gaa > 0.0)
-        a[active] = aa = np.where(same_as_a, ca, aa)
-        b[active] = bb = np.where(same_as_a, bb, ca)
-        ga[active] = np.where(same_as_a, g, gaa)
-        gb[active] = np.where(same_as_a, gb[active], g)
-        lo, hi = np.minimum(aa, bb), np.maximum(aa, bb)
+        # A round in slices: its temporaries (the kinematics and the steps) are held for one slice at a time.
+        done = np.concatenate([_round(ev, live.part(slice(s0, s0 + _SLICE)), out, rounds == _MAX_ROUNDS)
+                               for s0 in range(0, len(live.idx), _SLICE)])
+        if done.any():
+            live = live.part(~done)
+    t, el, az, f_end, el_rate, best_f, best_t, best_up, best_up_accel, f_accel = (col[undo] for col in out.columns)
+    return Solution(t, el, az, f_end, el_rate, best_f, best_t, best_up, best_up_accel, f_accel, rounds)
+
+
+def _round(ev: PairEvaluator, v: _Live, out: _Outputs, last: bool) -> np.ndarray:
+    """One round for the brackets ``v`` (views, updated in place); the finished ones are written to ``out``.
+    Returns which finished."""
+    cross, top, tol = v.cross, v.top, v.tol
+    ca = v.c.copy()
+    k = ev.evaluate(v.sat, ca, grouped=True)
+    f = np.fmax(k.f, -180.0)  # NaN and -inf (SGP4 failed) count as -180
+    g = np.where(cross, f, np.where(top, k.s_rate, k.f_rate))
+    g1 = np.where(cross, k.f_rate, np.where(top, k.s_accel, k.f_accel))
+    better = f > v.best_f
+    v.best_f[:] = np.where(better, f, v.best_f)
+    v.best_t[:] = np.where(better, ca, v.best_t)
+    v.best_up[:] = np.where(better, k.up, v.best_up)
+    v.best_up_accel[:] = np.where(better, k.up_accel, v.best_up_accel)
+    same_as_a = (g > 0.0) == (v.ga > 0.0)
+    v.a[:] = np.where(same_as_a, ca, v.a)
+    v.b[:] = np.where(same_as_a, v.b, ca)
+    v.ga[:] = np.where(same_as_a, g, v.ga)
+    v.gb[:] = np.where(same_as_a, v.gb, g)
+    lo, hi = np.minimum(v.a, v.b), np.maximum(v.a, v.b)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        newton = ca - g / g1
+        # Crossings: the root of the second-order Taylor polynomial (Halley-like, cubic convergence).
+        disc = g1 * g1 - 2.0 * g * k.f_accel
+        quad = ca - 2.0 * g / (g1 + np.copysign(np.sqrt(np.maximum(disc, 0.0)), g1))
+        newton = np.where(cross & (disc > 0.0) & np.isfinite(quad), quad, newton)
+    del disc, quad
+    ok = np.isfinite(newton) & (newton > lo) & (newton < hi) & (cross | (g1 < 0.0))
+    step = np.abs(newton - ca)
+    prev_step = v.prev_step.copy()
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        # A maximum's Newton step leaves an error ~C step^2, C = step / previous step^2 as observed
+        # once two Newton steps were taken.
+        predicted = step / (prev_step * prev_step) * step * step
+        # A crossing's step solves the second-order Taylor polynomial of f: its error comes from
+        # the error of f' (SGP4's velocity), of f'' (the approximate acceleration) and from f'''
+        # (the change of f'' since the previous round, with a margin).  Before a second round,
+        # Newton's C = |f''/2f'| stands in for the last two.
+        jerk = _JERK_MARGIN * np.abs((k.f_accel - v.prev_accel) / (ca - v.prev_t))
+        curve = np.where(np.isfinite(jerk), (0.5 * k.f_accel_err + jerk * step / 6.0) * step,
+                         0.5 * np.abs(k.f_accel) * step)
+        cross_err = (k.f_rate_err + curve) * step / np.abs(k.f_rate)
+    del jerk, curve
+    v.prev_t[:], v.prev_accel[:] = ca, k.f_accel
+    close = ok & np.where(cross, (step < _QUADRATIC_S) & (cross_err < _CROSSING_SAFETY * tol),
+                          top & (step < _TOP_STEP_S) & (predicted < _SAFETY * tol) & (step < 0.25 * prev_step)
+                          & (k.s_rate_err * step < _TOP_S_TOL * np.cos(np.radians(k.el))))
+    done = (ok & (step < tol)) | close | (hi - lo < tol) | (g == 0.0) | ~np.isfinite(g)
+    values = [np.where(ok & done, newton, ca), k.el, k.az, f, k.el_rate]
+    if close.any():  # the values at the accepted root, carried over from ``ca`` by Taylor's formula
+        sel = np.flatnonzero(close)
+        dt = (newton - ca)[sel]
+        el0, cross_c = k.el[sel], cross[sel]
+        el_cross = el0 + (k.el_rate[sel] + 0.5 * k.el_accel[sel] * dt) * dt
+        s_top = np.sin(np.radians(el0)) + (k.s_rate[sel] + 0.5 * k.s_accel[sel] * dt) * dt
+        el_top = np.degrees(np.arcsin(np.clip(s_top, -1.0, 1.0)))
+        el_c = np.where(cross_c, el_cross, np.maximum(el_top, el0))
+        az_rate, az_accel = k.azimuth_rates(sel)
+        f_c = np.where(cross_c, 0.0, f[sel] + el_c - el0)
+        values = [values[0], *(x.copy() for x in values[1:])]
+        values[1][sel] = el_c
+        values[2][sel] = (k.az[sel] + (az_rate + 0.5 * az_accel * dt) * dt) % 360.0
+        values[3][sel] = f_c
+        values[4][sel] = k.el_rate[sel] + k.el_accel[sel] * dt
+        up = f_c > v.best_f[sel]
+        v.best_f[sel[up]] = f_c[up]
+        v.best_t[sel[up]] = newton[sel][up]
+    v.prev_step[:] = np.where(ok, step, np.inf)
+    if v.hidden.any():
         with np.errstate(invalid="ignore", divide="ignore"):
-            newton = ca - g / g1
-            # Crossings: the root of the second-order Taylor polynomial (Halley-like, cubic convergence).
-            disc = g1 * g1 - 2.0 * g * k.f_accel
-            quad = ca - 2.0 * g / (g1 + np.copysign(np.sqrt(np.maximum(disc, 0.0)), g1))
-            newton = np.where(cross & (disc > 0.0) & np.isfinite(quad), quad, newton)
-        ok = np.isfinite(newton) & (newton > lo) & (newton < hi) & (cross | (g1 < 0.0))
-        step = np.abs(newton - ca)
-        tl = tol[active]
-        ps = prev_step[active]
-        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            # A maximum's Newton step leaves an error ~C step^2, C = step / previous step^2 as observed
-            # once two Newton steps were taken.
-            predicted = step / (ps * ps) * step * step
-            # A crossing's step solves the second-order Taylor polynomial of f: its error comes from
-            # the error of f' (SGP4's velocity), of f'' (the approximate acceleration) and from f'''
-            # (the change of f'' since the previous round, with a margin).  Before a second round,
-            # Newton's C = |f''/2f'| stands in for the last two.
-            jerk = _JERK_MARGIN * np.abs((k.f_accel - prev_accel[active]) / (ca - prev_t[active]))
-            curve = np.where(np.isfinite(jerk), (0.5 * k.f_accel_err + jerk * step / 6.0) * step,
-                             0.5 * np.abs(k.f_accel) * step)
-            cross_err = (k.f_rate_err + curve) * step / np.abs(k.f_rate)
-        prev_t[active], prev_accel[active] = ca, k.f_accel
-        close = ok & np.where(cross, (step < _QUADRATIC_S) & (cross_err < _CROSSING_SAFETY * tl),
-                              top & (step < _TOP_STEP_S) & (predicted < _SAFETY * tl) & (step < 0.25 * ps)
-                              & (k.s_rate_err * step < _TOP_S_TOL * np.cos(np.radians(k.el))))
-        done = (ok & (step < tl)) | close | (hi - lo < tl) | (g == 0.0) | ~np.isfinite(g)
-        if close.any():  # the values at the accepted root, carried over from ``ca`` by Taylor's formula
-            sel = active[close]
-            dt = (newton - ca)[close]
-            el0, cross_c = k.el[close], cross[close]
-            el_cross = el0 + (k.el_rate[close] + 0.5 * k.el_accel[close] * dt) * dt
-            s_top = np.sin(np.radians(el0)) + (k.s_rate[close] + 0.5 * k.s_accel[close] * dt) * dt
-            el_top = np.degrees(np.arcsin(np.clip(s_top, -1.0, 1.0)))
-            el_out[sel] = el_c = np.where(cross_c, el_cross, np.maximum(el_top, el0))
-            az_out[sel] = (k.az[close] + (k.az_rate[close] + 0.5 * k.az_accel[close] * dt) * dt) % 360.0
-            f_out[sel] = f_c = np.where(cross_c, 0.0, f[close] + el_c - el0)
-            el_rate_out[sel] = k.el_rate[close] + k.el_accel[close] * dt
-            up = f_c > best_f[sel]
-            best_f[sel[up]] = f_c[up]
-            best_t[sel[up]] = newton[close][up]
-        prev_step[active] = np.where(ok, step, np.inf)
-        t_out[active] = np.where(ok & done, newton, ca)
-        hid = hidden[active]
-        if hid.any():
-            with np.errstate(invalid="ignore", divide="ignore"):
-                model = f + np.where(k.f_accel < 0.0, k.f_rate ** 2 / (-2.0 * k.f_accel), np.inf)
-            done |= hid & (best_f[active] <= 0.0) & ok & (step < 120.0) & (model < _HOPELESS_DEG)
-        c[active] = np.where(ok, newton, 0.5 * (lo + hi))
-        active = active[~done]
-    return Solution(t_out[undo], el_out[undo], az_out[undo], f_out[undo], el_rate_out[undo], best_f[undo],
-                    best_t[undo], best_up[undo], best_up_accel[undo], f_accel_out[undo], rounds)
+            model = f + np.where(k.f_accel < 0.0, k.f_rate ** 2 / (-2.0 * k.f_accel), np.inf)
+        done |= v.hidden & (v.best_f <= 0.0) & ok & (step < 120.0) & (model < _HOPELESS_DEG)
+    v.c[:] = np.where(ok, newton, 0.5 * (lo + hi))
+    if last:
+        done[:] = True
+    if done.any():
+        out.store(v.idx[done], (*values, v.best_f, v.best_t, v.best_up, v.best_up_accel, k.f_accel), done)
+    return done

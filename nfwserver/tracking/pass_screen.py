@@ -35,9 +35,10 @@ import numpy as np
 from sgp4.api import SatrecArray
 
 from nfwserver.tracking.constants import SECONDS_PER_DAY
-from nfwserver.tracking.frames import TopocentricFrame, teme_to_itrs
+from nfwserver.tracking.frames import TopocentricFrame
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.pass_kinematics import PairEvaluator
+from nfwserver.tracking.timescale import gmst1982
 
 #: Geocentric angular rate (rad/s) of a low satellite, for which the fine step is ``fine_step_s``.
 _LEO_RATE = 1.2e-3
@@ -139,43 +140,19 @@ def screen(satrecs: list, frame: TopocentricFrame, horizon: HorizonTable, jd0: f
     grid = np.linspace(0.0, n_steps * coarse_step_s, n_steps + 1)
     jd = np.full(grid.shape, jd0)
     fr = fr0 + grid / SECONDS_PER_DAY
-    obs = frame.origin
-    r_obs = float(np.linalg.norm(obs))
-    obs_unit = obs / r_obs
-    e_lo = math.radians(max(horizon.minimum - 1.0, -89.0))
-    k_lo = r_obs * math.cos(e_lo)
+    # The rotation of TEME into the Earth-fixed frame at each grid time (as frames.teme_to_itrs).
+    theta, theta_dot = gmst1982(jd, fr + ut1_utc / SECONDS_PER_DAY)
+    rotation = (np.cos(theta), np.sin(theta), theta_dot / SECONDS_PER_DAY)
     flat = horizon.is_flat
     parts: list[Brackets] = []
     chunk = max(1, _SCREEN_PAIRS // len(grid))
     for i0 in range(0, len(satrecs), chunk):
         part = satrecs[i0 : i0 + chunk]
         err, r, v = SatrecArray(part).sgp4(jd, fr)
-        pos, vel = teme_to_itrs(r, v, jd, fr, ut1_utc)
-        assert vel is not None  # velocities were given
+        pos, vel = _earth_fixed(r, v, rotation)
         del r, v
-        ok = err == 0
-        x, y, z = pos[..., 0], pos[..., 1], pos[..., 2]
-        vx, vy, vz = vel[..., 0], vel[..., 1], vel[..., 2]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            rad = np.sqrt(x * x + y * y + z * z)
-            psi = np.arccos(np.clip((x * obs_unit[0] + y * obs_unit[1] + z * obs_unit[2]) / rad, -1.0, 1.0))
-            ratio = np.clip(k_lo / rad, -1.0, 1.0)
-            margin = np.where(ok, psi - (np.arccos(ratio) - e_lo), np.inf)  # > 0: below the lowest point
-            # Angular rate of the satellite's direction plus the rate of change of the visibility limit.
-            cx, cy, cz = y * vz - z * vy, z * vx - x * vz, x * vy - y * vx
-            rdot = (x * vx + y * vy + z * vz) / rad
-            rate = (np.sqrt(cx * cx + cy * cy + cz * cz) + np.abs(k_lo * rdot) * rad / np.sqrt(
-                np.maximum(rad * rad - k_lo * k_lo, 1e-6 * rad * rad))) / (rad * rad)
-        # Sampled maxima miss the true one by little on near-circular orbits; eccentric orbits
-        # (fast perigee passages) get a wider safety factor.
         ecc = np.array([sr.ecco for sr in part])
-        bound = np.nanmax(np.where(ok, rate, np.nan), axis=1, initial=0.0) * (1.1 + 2.0 * ecc) + 1e-5
-        reach = bound[:, None] * coarse_step_s
-        kept = (margin[:, :-1] + margin[:, 1:] - reach) * 0.5 <= 0.0
-        # A failed propagation at one end hides nothing: keep the interval if the other end is close.
-        kept |= (np.isinf(margin[:, :-1]) & (margin[:, 1:] <= reach)) | (
-            np.isinf(margin[:, 1:]) & (margin[:, :-1] <= reach))
-        del margin, psi, ratio, rate, cx, cy, cz, rdot, rad
+        kept, bound = _visibility(frame, horizon, pos, vel, err == 0, ecc, coarse_step_s)
         # Sampling step: under a flat horizon f turns only where the elevation does, twice an orbit,
         # so a step under half the time between the turns (1200 s at a low orbit's rate) leaves at
         # most one turn per step; a sloping horizon adds turns at its own corners.
@@ -183,17 +160,13 @@ def screen(satrecs: list, frame: TopocentricFrame, horizon: HorizonTable, jd0: f
         wanted = base * np.clip(_LEO_RATE / np.maximum(bound, 1e-9), 1.0, max(coarse_step_s / base, 1.0))
         per_sat = np.maximum(1, np.round(coarse_step_s / wanted)).astype(np.intp)
         coarse_only = per_sat == 1
-        if coarse_only.any():
+        if coarse_only.all():
+            parts.append(_classify_grid(i0, grid, kept, *_coarse_kinematics(frame, horizon, pos, vel, err)))
+        elif coarse_only.any():
             sel = np.flatnonzero(coarse_only)
-            f, f_rate, el_rate, up, up_rate = _coarse_kinematics(frame, horizon, pos[sel], vel[sel], err[sel])
-            m = len(grid)
-            sat_ids = np.repeat(sel + i0, m)
-            link = np.ones((len(sel), m), dtype=bool)
-            link[:, -1] = False
-            kept_full = np.zeros((len(sel), m), dtype=bool)
-            kept_full[:, :-1] = kept[sel]
-            parts.append(_classify(sat_ids, np.tile(grid, len(sel)), f, f_rate, el_rate, link.ravel(),
-                                   kept_full.ravel(), up, up_rate))
+            coarse = _coarse_kinematics(frame, horizon, tuple(c[sel] for c in pos), tuple(c[sel] for c in vel),
+                                        err[sel])
+            parts.append(_classify_grid(sel + i0, grid, kept[sel], *coarse))
         fine = np.flatnonzero(~coarse_only)
         if len(fine):
             parts.append(_fine_samples(fine + i0, kept[fine], per_sat[fine], grid, coarse_step_s, evaluator))
@@ -205,33 +178,103 @@ def screen(satrecs: list, frame: TopocentricFrame, horizon: HorizonTable, jd0: f
                       for k in ("crossings", "peaks", "culminations")))
 
 
-def _coarse_kinematics(frame: TopocentricFrame, horizon: HorizonTable, pos: np.ndarray, vel: np.ndarray,
+def _earth_fixed(r: np.ndarray, v: np.ndarray, rotation: tuple[np.ndarray, np.ndarray, np.ndarray]
+                 ) -> tuple[tuple, tuple]:
+    """Earth-fixed position (km) and velocity (km/s) components, each (sats, times), of TEME states (sats,
+    times, 3) with the rotation's cosine, sine and rate (rad/s) at each time (as frames.teme_to_itrs)."""
+    c, s, w = rotation
+    ms = -s
+    rx, ry, vx, vy = r[..., 0], r[..., 1], v[..., 0], v[..., 1]
+    x = c * rx + s * ry
+    y = ms * rx + c * ry
+    return (x, y, r[..., 2]), (c * vx + s * vy + w * y, ms * vx + c * vy - w * x, v[..., 2])
+
+
+def _visibility(frame: TopocentricFrame, horizon: HorizonTable, pos: tuple, vel: tuple, ok: np.ndarray,
+                ecc: np.ndarray, coarse_step_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Which coarse intervals (sats, times - 1) may hold visibility, and each satellite's bound on how fast its
+    visibility margin can shrink (rad/s), from Earth-fixed positions and velocities at the grid times."""
+    obs = frame.origin
+    r_obs = float(np.linalg.norm(obs))
+    obs_unit = obs / r_obs
+    e_lo = math.radians(max(horizon.minimum - 1.0, -89.0))
+    k_lo = r_obs * math.cos(e_lo)
+    x, y, z = pos
+    vx, vy, vz = vel
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rad = np.sqrt(x * x + y * y + z * z)
+        psi = np.arccos(np.clip((x * obs_unit[0] + y * obs_unit[1] + z * obs_unit[2]) / rad, -1.0, 1.0))
+        ratio = np.clip(k_lo / rad, -1.0, 1.0)
+        margin = np.where(ok, psi - (np.arccos(ratio) - e_lo), np.inf)  # > 0: below the lowest point
+        del psi, ratio
+        # Angular rate of the satellite's direction plus the rate of change of the visibility limit.
+        cx, cy, cz = y * vz - z * vy, z * vx - x * vz, x * vy - y * vx
+        rdot = (x * vx + y * vy + z * vz) / rad
+        rate = (np.sqrt(cx * cx + cy * cy + cz * cz) + np.abs(k_lo * rdot) * rad / np.sqrt(
+            np.maximum(rad * rad - k_lo * k_lo, 1e-6 * rad * rad))) / (rad * rad)
+        del cx, cy, cz, rdot, rad
+    # Sampled maxima miss the true one by little on near-circular orbits; eccentric orbits
+    # (fast perigee passages) get a wider safety factor.
+    bound = np.nanmax(np.where(ok, rate, np.nan), axis=1, initial=0.0) * (1.1 + 2.0 * ecc) + 1e-5
+    reach = bound[:, None] * coarse_step_s
+    kept = (margin[:, :-1] + margin[:, 1:] - reach) * 0.5 <= 0.0
+    # A failed propagation at one end hides nothing: keep the interval if the other end is close.
+    kept |= (np.isinf(margin[:, :-1]) & (margin[:, 1:] <= reach)) | (
+        np.isinf(margin[:, 1:]) & (margin[:, :-1] <= reach))
+    return kept, bound
+
+
+def _coarse_kinematics(frame: TopocentricFrame, horizon: HorizonTable, pos: tuple, vel: tuple,
                        err: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None,
                                                  np.ndarray | None]:
-    """Flattened f, df/dt and d(elevation)/dt (deg, deg/s) at the coarse points of some satellites, and
-    under a flat horizon at 0 deg the height above the horizontal plane (km) and its rate (km/s)
-    (None otherwise)."""
-    d = pos - frame.origin
-    e, n, u = frame.components(d)
-    e1, n1, u1 = frame.components(vel)
+    """f, df/dt and d(elevation)/dt (deg, deg/s), each (sats, times), at the coarse points of some satellites
+    from their Earth-fixed position and velocity components; and under a flat horizon at 0 deg the height
+    above the horizontal plane (km) and its rate (km/s) (None otherwise)."""
+    (ex, ey, ez), (nx, ny, nz), (ux, uy, uz) = frame.axes
+    ox, oy, oz = frame.origin.tolist()
+    dx, dy, dz = pos[0] - ox, pos[1] - oy, pos[2] - oz
+    # As frames.TopocentricFrame.components (every term, a zero coefficient too).
+    e, n, u = dx * ex + dy * ey + dz * ez, dx * nx + dy * ny + dz * nz, dx * ux + dy * uy + dz * uz
+    del dx, dy, dz
+    vx, vy, vz = vel
+    e1, n1, u1 = vx * ex + vy * ey + vz * ez, vx * nx + vy * ny + vz * nz, vx * ux + vy * uy + vz * uz
     q = e * e + n * n
     rho2 = q + u * u
+    flat = horizon.is_flat
     with np.errstate(invalid="ignore", divide="ignore"):
         hz = np.sqrt(q)
         el = np.degrees(np.arctan2(u, hz))
         # d(el)/dt = (u' rho^2 - u rho rho') / (rho^2 hz) = (u' q - u (e e' + n n')) / (rho^2 hz)
         el_rate = np.degrees((u1 * q - u * (e * e1 + n * n1)) / (rho2 * hz))
-        az = np.degrees(np.arctan2(e, n)) % 360.0
-        f = el - horizon.min_elevation_array(np.nan_to_num(az))
-        f_rate = el_rate
-        if not horizon.is_flat:
+        if flat:  # the table's one minimum elevation everywhere (min_elevation_array gives copies of it)
+            f = el - horizon.minimum
+            f_rate = el_rate
+        else:
+            az = np.degrees(np.arctan2(e, n)) % 360.0
+            f = el - horizon.min_elevation_array(np.nan_to_num(az))
             f_rate = el_rate - horizon.slope_array(np.nan_to_num(az)) * np.degrees((n * e1 - e * n1) / q)
     bad = err != 0
     f[bad] = -np.inf
     el_rate[bad] = np.nan
-    if horizon.is_flat and horizon.minimum == 0.0:
-        return f.ravel(), f_rate.ravel(), el_rate.ravel(), u.ravel(), u1.ravel()
-    return f.ravel(), f_rate.ravel(), el_rate.ravel(), None, None
+    if flat and horizon.minimum == 0.0:
+        return f, f_rate, el_rate, u, u1
+    return f, f_rate, el_rate, None, None
+
+
+def _classify_grid(sats: int | np.ndarray, grid: np.ndarray, kept: np.ndarray, f: np.ndarray, f_rate: np.ndarray,
+                   el_rate: np.ndarray, up: np.ndarray | None, up_rate: np.ndarray | None) -> Brackets:
+    """Brackets between consecutive coarse points (arrays (sats, times)); ``sats``: the satellite index of
+    each row, or of the first row (the rows are then consecutive satellites)."""
+    rows, m = f.shape
+    sat_ids = np.repeat(np.arange(sats, sats + rows) if isinstance(sats, int) else sats, m)
+    kept_full = np.zeros((rows, m), dtype=bool)
+    kept_full[:, :-1] = kept
+    link = np.ones((rows, m), dtype=bool)
+    link[:, -1] = False
+    flat_up = None if up is None else up.ravel()
+    flat_up_rate = None if up_rate is None else up_rate.ravel()
+    return _classify(sat_ids, np.tile(grid, rows), f.ravel(), f_rate.ravel(), el_rate.ravel(), link.ravel(),
+                     kept_full.ravel(), flat_up, flat_up_rate)
 
 
 def _fine_samples(sats: np.ndarray, kept: np.ndarray, per_sat: np.ndarray, grid: np.ndarray,

@@ -16,7 +16,10 @@ The search runs in three stages, each batched over every satellite of the catalo
    middle of their pass; rises and sets are paired into passes and each pass gets its TCA.
 
 Satellites are searched in groups of similar orbits (low, geosynchronous-like, the rest), each
-with its own grid step and look-back.  Passes already in progress at ``start`` are reported with
+with its own grid step and look-back, a chunk of 200 at a time; the brackets of several chunks are
+refined together (:mod:`~nfwserver.tracking.pass_batch`), each satellite against its own chunk's
+reference instant, which gives the passes of refining every chunk alone, bit for bit, in fewer rounds.
+Passes already in progress at ``start`` are reported with
 their true AOS before ``start`` (``aos_before_start``), passes in progress at ``end`` with their
 LOS after it: the search looks back and ahead by up to one orbital period (at most a day; half a
 period for near-circular orbits shorter than three hours, whose passes last less than that).  A
@@ -39,6 +42,7 @@ from nfwserver.tracking.frames import TopocentricFrame
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer
 from nfwserver.tracking.pass_assemble import assemble
+from nfwserver.tracking.pass_batch import Batch, Chunk
 from nfwserver.tracking.pass_kinematics import PairEvaluator
 from nfwserver.tracking.pass_records import Pass, PassList
 from nfwserver.tracking.pass_screen import screen
@@ -53,8 +57,10 @@ _SHORT_PERIOD_S = 3.0 * 3600.0
 _SLOW_REV_PER_DAY = 1.5
 #: Coarse grid steps (s) of the three groups: low, geosynchronous-like, the rest.
 _LOW_STEP_S, _SLOW_STEP_S, _OTHER_STEP_S = 1200.0, 3600.0, 1200.0
-#: Satellites searched together (bounds the memory of one search).
+#: Satellites screened together (bounds the memory of one screen).
 _CHUNK = 200
+#: Brackets refined together (at least; a batch takes whole chunks): bounds the memory of one refinement.
+_BATCH_BRACKETS = 10000
 
 #: Fork-time hand-over of the work to worker processes (Satrec objects cannot be pickled); set only
 #: for the duration of one parallel :func:`find_passes` call.
@@ -63,8 +69,8 @@ _FORK_JOB: tuple | None = None
 
 def _fork_worker(indices: list[int]) -> PassList:
     assert _FORK_JOB is not None
-    satrecs, args = _FORK_JOB
-    return find_passes([satrecs[i] for i in indices], *args)
+    satellites, args = _FORK_JOB
+    return find_passes([satellites[i] for i in indices], *args)
 
 
 def find_passes(
@@ -77,7 +83,9 @@ def find_passes(
     fine_step_s: float = 60.0,
     workers: int = 1,
 ) -> PassList:
-    """Passes of ``satellites`` (``sgp4`` Satrecs, or objects with a ``.satrec``) between ``start`` and ``end``.
+    """Passes of ``satellites`` between ``start`` and ``end``: element sets (whose SGP4 models are made for the
+    search and dropped unless they exist), catalog satellites (their element sets), ``sgp4`` Satrecs or objects
+    with a ``.satrec``.
 
     Returns the passes overlapping the window, sorted by AOS (TCA when AOS is unknown), as a
     :class:`~nfwserver.tracking.pass_records.PassList` (a read-only sequence of :class:`Pass`).  See the
@@ -91,14 +99,14 @@ def find_passes(
     with one worker.
     """
     global _FORK_JOB
+    satellites = [getattr(s, "elements", s) for s in satellites]  # a catalog satellite's element set
     if workers > 1 and len(satellites) >= 200 * workers and _FORK_JOB is None and threading.active_count() == 1:
         import multiprocessing
 
         if "fork" in multiprocessing.get_all_start_methods():
-            satrecs_all = [getattr(s, "satrec", s) for s in satellites]
-            _FORK_JOB = (satrecs_all, (observer, start, end, horizon, ut1_utc, fine_step_s))
+            _FORK_JOB = (satellites, (observer, start, end, horizon, ut1_utc, fine_step_s))
             try:
-                chunks = [list(range(k, len(satrecs_all), workers)) for k in range(workers)]
+                chunks = [list(range(k, len(satellites), workers)) for k in range(workers)]
                 with multiprocessing.get_context("fork").Pool(workers) as pool:
                     worker_parts = pool.map(_fork_worker, chunks)
             finally:
@@ -120,6 +128,7 @@ def find_passes(
     other = ~short & ~slow
     look_back = np.where((ecc < 0.05) & short, 0.5, 1.0) * periods  # s
     parts: list[dict[str, np.ndarray]] = []
+    batch = Batch()
     # The rest is split by period so that each part looks back and ahead only as far as it needs.
     for group, step in ((short, _LOW_STEP_S), (slow, _SLOW_STEP_S), (other & (periods <= 8 * 3600.0), _OTHER_STEP_S),
                         (other & (periods > 8 * 3600.0) & (periods <= 13 * 3600.0), _OTHER_STEP_S),
@@ -131,8 +140,13 @@ def find_passes(
             idx = members[c0 : c0 + _CHUNK]
             extension = float(min(np.max(look_back[idx]), SECONDS_PER_DAY))
             models = [_model(satellites[i]) for i in idx]
-            parts.append(_search(models, catalog_numbers[idx], observer, start, end, horizon, ut1_utc, fine_step_s,
-                                 step, extension))
+            batch.add(_screen_chunk(models, catalog_numbers[idx], observer, start, end, horizon, ut1_utc,
+                                    fine_step_s, step, extension))
+            if batch.size >= _BATCH_BRACKETS:
+                parts.append(_refine(batch, observer, horizon, ut1_utc))
+                batch = Batch()
+    if batch.chunks:
+        parts.append(_refine(batch, observer, horizon, ut1_utc))
     return PassList.concat(start, window_s, parts)
 
 
@@ -155,10 +169,10 @@ def _model(satellite: object) -> object:
     return transient() if transient is not None else getattr(satellite, "satrec", satellite)
 
 
-def _search(satrecs: list, catalog_numbers: np.ndarray, observer: Observer, start: datetime, end: datetime,
-            horizon: HorizonTable, ut1_utc: float, fine_step_s: float, coarse_step_s: float,
-            extension: float) -> dict[str, np.ndarray]:
-    """Passes (PassList columns) of one group of satellites searched over ``[start - extension, end + extension]``."""
+def _screen_chunk(satrecs: list, catalog_numbers: np.ndarray, observer: Observer, start: datetime, end: datetime,
+                  horizon: HorizonTable, ut1_utc: float, fine_step_s: float, coarse_step_s: float,
+                  extension: float) -> Chunk:
+    """One chunk of satellites screened over ``[start - extension, end + extension]``."""
     t0 = start - timedelta(seconds=extension)
     window_s = (end - start).total_seconds()
     span = window_s + 2.0 * extension
@@ -166,4 +180,11 @@ def _search(satrecs: list, catalog_numbers: np.ndarray, observer: Observer, star
     ev = PairEvaluator(satrecs, observer, jd0, fr0, ut1_utc, horizon)
     brackets = screen(satrecs, TopocentricFrame(observer), horizon, jd0, fr0, span, coarse_step_s, fine_step_s,
                       ut1_utc, ev)
-    return assemble(ev, brackets, horizon.is_flat, catalog_numbers, span, extension, extension + window_s)
+    return Chunk(satrecs, catalog_numbers, jd0, fr0, span, extension, extension + window_s, brackets)
+
+
+def _refine(batch: Batch, observer: Observer, horizon: HorizonTable, ut1_utc: float) -> dict[str, np.ndarray]:
+    """Passes (PassList columns, times after the window start) from the brackets of a batch of chunks."""
+    models, jd0, fr0, layout, brackets = batch.merged()
+    ev = PairEvaluator(models, observer, jd0, fr0, ut1_utc, horizon)
+    return assemble(ev, brackets, horizon.is_flat, layout)

@@ -10,12 +10,14 @@ than ``max_age_days`` (30 by default) before ``at``; stale sets are still used, 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from datetime import datetime, timedelta
+from typing import Any, TypeVar
 
 import numpy as np
+import numpy.typing as npt
 
-from nfwserver.tracking.catalog import Satellite
 from nfwserver.tracking.look_angles import look_angles_array
 from nfwserver.tracking.observer import Observer
 from nfwserver.tracking.timescale import julian_date
@@ -25,33 +27,63 @@ MAX_PLAUSIBLE_RANGE_KM = 1.5e6
 #: Element sets older than this (days) before the time asked for are reported as stale.
 STALE_AFTER_DAYS = 30.0
 
+T = TypeVar("T")
+#: Satellites propagated at a time by :func:`usable_mask` (bounds the SGP4 models held at once).
+_BLOCK = 512
+
 
 @dataclass
 class Screened:
     """Satellites split by whether their positions at the screening instant are usable."""
 
-    usable: list[Satellite] = field(default_factory=list)
-    unusable: list[Satellite] = field(default_factory=list)
+    usable: list[Any] = field(default_factory=list)
+    unusable: list[Any] = field(default_factory=list)
 
 
-def screen_satellites(satellites: list[Satellite], observer: Observer, at: datetime, ut1_utc: float = 0.0,
+def screen_satellites(satellites: Sequence[Any], observer: Observer, at: datetime, ut1_utc: float = 0.0,
                       max_range_km: float = MAX_PLAUSIBLE_RANGE_KM) -> Screened:
-    """Split ``satellites`` (objects with ``.satrec``) into usable and unusable at ``at``."""
+    """Split ``satellites`` (objects with ``.satrec``, or element sets) into usable and unusable at ``at``."""
     result = Screened()
-    if not satellites:
-        return result
-    jd, fr = julian_date(at)
-    arr = look_angles_array([s.satrec for s in satellites], observer, np.array([jd]), np.array([fr]), ut1_utc)
-    rng = arr.range_km[:, 0]
-    with np.errstate(invalid="ignore"):
-        good = np.isfinite(rng) & (rng <= max_range_km) & np.isfinite(arr.elevation_deg[:, 0])
-    for sat, ok in zip(satellites, good):
+    for sat, ok in zip(satellites, usable_mask(satellites, observer, at, ut1_utc, max_range_km).tolist()):
         (result.usable if ok else result.unusable).append(sat)
     return result
 
 
-def stale_satellites(satellites: list[Satellite], at: datetime,
-                     max_age_days: float = STALE_AFTER_DAYS) -> list[Satellite]:
-    """The satellites whose element epoch is more than ``max_age_days`` before ``at``."""
+def usable_mask(satellites: Sequence[Any], observer: Observer, at: datetime, ut1_utc: float = 0.0,
+                max_range_km: float = MAX_PLAUSIBLE_RANGE_KM) -> npt.NDArray[np.bool_]:
+    """True for each of ``satellites`` whose position at ``at`` is usable (see the module docstring).
+
+    Element sets (objects with ``transient_satrec``, also inside a satellite's ``elements``) are propagated
+    with models made for this check and dropped, a block at a time, so a whole catalog is checked
+    without keeping a model for every set.
+    """
+    good = np.zeros(len(satellites), dtype=bool)
+    jd, fr = julian_date(at)
+    for b0 in range(0, len(satellites), _BLOCK):
+        models = [_model(s) for s in satellites[b0 : b0 + _BLOCK]]
+        arr = look_angles_array(models, observer, np.array([jd]), np.array([fr]), ut1_utc)
+        rng = arr.range_km[:, 0]
+        with np.errstate(invalid="ignore"):
+            good[b0 : b0 + len(models)] = np.isfinite(rng) & (rng <= max_range_km) & np.isfinite(
+                arr.elevation_deg[:, 0])
+    return good
+
+
+def _model(satellite: Any) -> Any:
+    """An SGP4 model of ``satellite``: its element set's transient one when it has an element set, else its
+    ``.satrec``."""
+    elements = getattr(satellite, "elements", satellite)
+    transient = getattr(elements, "transient_satrec", None)
+    return transient() if transient is not None else satellite.satrec
+
+
+def stale_satellites(satellites: Sequence[T], at: datetime, max_age_days: float = STALE_AFTER_DAYS) -> list[T]:
+    """The satellites (or element sets) whose element epoch is more than ``max_age_days`` before ``at``."""
     oldest = at - timedelta(days=max_age_days)
-    return [s for s in satellites if s.elements.epoch < oldest]
+    return [s for s in satellites if _epoch(s) < oldest]
+
+
+def _epoch(item: Any) -> datetime:
+    """The element epoch (UTC) of a satellite or of an element set."""
+    epoch: datetime = getattr(item, "elements", item).epoch
+    return epoch

@@ -84,3 +84,24 @@ def test_names_do_not_depend_on_load_order() -> None:
 def test_epoch_is_utc() -> None:
     assert all(s.epoch.tzinfo == timezone.utc for s in VISUAL)
     assert min(s.epoch for s in VISUAL) > datetime(2026, 4, 1, tzinfo=timezone.utc)
+
+
+def test_dde_names_are_assigned_when_first_needed(monkeypatch) -> None:
+    import nfwserver.tracking.catalog as catalog_module
+
+    calls = []
+    real = catalog_module.assign_dde_names
+    monkeypatch.setattr(catalog_module, "assign_dde_names", lambda *a: calls.append(1) or real(*a))
+    cat = Catalog(VISUAL, dde_names={25544: "SPACE-STN"})
+    sets = cat.element_sets()
+    assert [s.catalog_number for s in sets] == sorted(s.catalog_number for s in VISUAL)
+    assert len(cat) == len(VISUAL) and 25544 in cat
+    assert calls == []  # a catalog used for its element sets (a pass search) makes no DDE names
+    assert cat.get(25544).dde_name == "SPACE-STN" and cat.find("SPACE-STN").catalog_number == 25544
+    assert len(calls) == 1
+    cat.satellites()
+    assert len(calls) == 1  # made once
+    cat.update([_shifted(VISUAL[0], 1.0)])
+    assert len(calls) == 1  # an update makes them again only when they are read
+    assert cat.get(VISUAL[0].catalog_number).elements.epoch > VISUAL[0].epoch
+    assert len(calls) == 2

@@ -7,8 +7,9 @@ from datetime import datetime, timedelta, timezone
 import pytest
 from skyfield.api import load, wgs84
 
-from nfwserver.tracking.derived import mode_at, parse_schedule, path_loss_db, realtime_values
+from nfwserver.tracking.derived import mode_at, path_loss_db, realtime_values
 from nfwserver.tracking.elements import load_element_file
+from nfwserver.tracking.mode_schedule import parse_schedule
 from nfwserver.tracking.observer import Observer
 from tests.conftest import DATA
 from tests.tracking.skyfield_oracle import TS, skyfield_satellite

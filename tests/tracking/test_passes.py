@@ -194,3 +194,25 @@ def test_sgp4s_pure_python_model_finds_the_same_passes(monkeypatch) -> None:
         assert a.catalog_number == b.catalog_number
         assert abs((a.aos - b.aos).total_seconds()) < 1e-3 and abs((a.los - b.los).total_seconds()) < 1e-3
         assert abs(a.max_elevation_deg - b.max_elevation_deg) < 1e-6
+
+
+@pytest.mark.parametrize("horizon", [None, HorizonTable([(0, 4.0), (120, 11.0), (250, 1.5)])])
+def test_refining_several_chunks_together_changes_no_bit(monkeypatch, horizon) -> None:
+    """Chunks refined together, each satellite against its own chunk's reference instant, and rounds taken in
+    slices give bit for bit the passes of refining every chunk alone in one slice."""
+    import nfwserver.tracking.pass_refine as pass_refine
+    import nfwserver.tracking.passes as passes
+
+    sets = list(ACTIVE.values())[::25]  # ~600 objects of every kind: low, eccentric, geosynchronous
+    start = datetime(2026, 5, 8, 7, 13, 22, 123456, tzinfo=timezone.utc)
+    observer = Observer(47.3, -122.5, 120.0)
+    monkeypatch.setattr(passes, "_CHUNK", 40)
+    found = []
+    for batch, slice_size in ((1, 10**9), (10**9, 10**9), (3000, 257)):  # alone, all together, in slices
+        monkeypatch.setattr(passes, "_BATCH_BRACKETS", batch)
+        monkeypatch.setattr(pass_refine, "_SLICE", slice_size)
+        found.append(find_passes(sets, observer, start, start + timedelta(hours=30), horizon=horizon).columns)
+    assert len(found[0]["tca_s"]) > 1000
+    for other in found[1:]:
+        for name, column in found[0].items():
+            assert np.array_equal(column, other[name], equal_nan=True), name

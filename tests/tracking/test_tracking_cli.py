@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import re
 from datetime import datetime, timezone
 
@@ -147,3 +148,49 @@ def test_a_far_propagated_object_is_skipped_and_stale_sets_are_named(capsys) -> 
     assert main(["visible", *ELEMENTS, "--observer", "52.2,0.12", "--at", "2026-05-08T00:00Z"]) == 0
     err = capsys.readouterr().err
     assert "older than" not in err and "implausibly" not in err
+
+
+@pytest.mark.parametrize("command", [
+    ["passes", "--start", "2026-05-08T00:00Z", "--hours", "6"],
+    ["visible", "--at", "2026-05-08T03:00:00"],
+    ["ephemeris", "--sat", "25544", "--start", "2026-05-08", "--duration", "600", "--step", "60"],
+])
+def test_json_holds_the_csv_rows_as_typed_values(capsys, command) -> None:
+    common = [*command, *ELEMENTS, "--observer", "52.2,0.12", "--ut1-utc", "0"]
+    assert main([*common, "--format", "csv"]) == 0
+    rows = _csv(capsys)
+    assert main([*common, "--format", "json"]) == 0
+    out = capsys.readouterr().out
+    docs = json.loads(out)
+    assert len(docs) == len(rows) > 0 and out.count("\n") == len(rows) + 2  # "[", one object a line, "]"
+    for doc, row in zip(docs, rows):
+        assert list(doc) == list(row)
+        for key, text in row.items():
+            value = doc[key]
+            if text in ("Y", "N"):
+                assert value is (text == "Y")
+            elif text == "":
+                assert value is None
+            elif isinstance(value, str):
+                assert value == text
+            else:
+                assert value == (int(text) if key == "catalog_number" else float(text))
+
+
+def test_passes_table_csv_and_json_of_the_same_passes(capsys) -> None:
+    common = ["passes", *ELEMENTS, "--observer", "52.2,0.12", "--start", "2026-05-08T00:00Z", "--hours", "24"]
+    assert main([*common, "--format", "table"]) == 0
+    table = capsys.readouterr().out.splitlines()
+    assert main([*common, "--format", "csv"]) == 0
+    rows = _csv(capsys)
+    assert main([*common, "--format", "json"]) == 0
+    docs = json.loads(capsys.readouterr().out)
+    assert len(table) - 1 == len(rows) == len(docs) > 50
+    header = table[0].split()
+    starts = [table[0].index(name) for name in header]
+    for line, row in zip(table[1:], rows):
+        assert line == line.rstrip() and row["name"] in line
+        assert line[: starts[1]].strip() == row["catalog_number"]
+        if row["aos_utc"]:
+            assert row["aos_utc"] in line
+        assert f"{float(row['max_elevation_deg']):.1f}" in line.split()
