@@ -2,9 +2,12 @@
 
 :class:`ConfigWatcher` checks the file's size and modification time every ``interval_s`` seconds of
 the station's clock, waits until a change has stopped changing (a writer may be halfway through),
-then reads it.  A valid file is handed to ``apply`` (the station's live reload); an invalid one is
-refused with one message and the running configuration stays.  Only regular files are read, so a
-FIFO or device put in place of the file never blocks the watcher.
+then reads it.  Only a file that is whole is applied: it must parse and validate completely, hold at
+least one setting (an empty or comment-only file is what an editor leaves halfway through a save,
+never "reset everything to the defaults") and be unchanged between the start and the end of the read.
+A valid file is handed to ``apply`` (the station's live reload); anything else is handed to ``refused``
+with one sentence and the running configuration stays until a good file arrives.  Only regular files
+are read, so a FIFO or device put in place of the file never blocks the watcher.
 
 Owned by its own thread, ``nfw-config``; it waits on the injected clock, so tests drive it with a
 :class:`~nfwserver.clock.VirtualClock`.
@@ -16,6 +19,7 @@ import logging
 import os
 import stat
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 from nfwserver.clock import Clock
@@ -60,7 +64,7 @@ class ConfigWatcher(ServiceThread):
 
     def check(self) -> bool:
         """One look at the file (the thread's step; returns True when a change was handled)."""
-        from nfwserver.config import ConfigError, load_config
+        from nfwserver.config.loader import ConfigError, has_settings, parse_config, read_config_text
 
         now = file_signature(self.path)
         if now == self._seen:
@@ -73,12 +77,25 @@ class ConfigWatcher(ServiceThread):
             now = later
         if self._stop.is_set():
             return False
-        self._seen = now
         if now is None:
+            self._seen = now
             self.refused(f"{self.path} is missing or not a regular file; keeping the running configuration")
             return True
         try:
-            new = load_config(self.path)
+            text = read_config_text(self.path)
+        except ConfigError as exc:
+            self._seen = now
+            self.refused(f"configuration change refused, keeping the running one: {exc}")
+            return True
+        if file_signature(self.path) != now:
+            return False  # written to while being read: the next look reads it again once it settles
+        self._seen = now
+        if not has_settings(text):
+            self.refused(f"configuration change refused, keeping the running one: {self.path} has no settings "
+                         "(empty, or an editor is halfway through saving it)")
+            return True
+        try:
+            new = replace(parse_config(text, str(self.path), self.path.parent), path=str(self.path))
         except ConfigError as exc:
             self.refused(f"configuration change refused, keeping the running one: {exc}")
             return True

@@ -125,10 +125,13 @@ class Station:
         restart = self.apply_config(new)
         note = "configuration reloaded" + (f"; restart to apply {', '.join(restart)}" if restart else "")
         log.info(note)
+        self.core.health.link("config", paced=False).succeeded()
         self.core.events.add(self.clock.now(), Direction.INFO, "note", note, accepted=True)
 
     def _config_refused(self, message: str) -> None:
-        log.error(message)
+        """A changed file that cannot be applied: the ``config`` link shows it (STATUS, console) until a
+        good file is applied; the health link writes the log line (repeats rate-limited)."""
+        self.core.health.link("config", paced=False).failed(message)
         self.core.events.add(self.clock.now(), Direction.INFO, "note", message, accepted=False)
 
     def watch_config(self, path: str, interval_s: float = 2.0) -> None:

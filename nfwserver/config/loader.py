@@ -222,8 +222,23 @@ def load_config(path: str | Path | None = None) -> Config:
             return Config()
         path = default
     path = Path(path)
+    return replace(parse_config(read_config_text(path), str(path), path.parent), path=str(path))
+
+
+def has_settings(text: str) -> bool:
+    """True unless ``text`` is TOML holding no table and no key (empty, blank or comments only).
+
+    Text that is not TOML at all counts as having settings: :func:`parse_config` then names the problem."""
     try:
-        text = read_regular_file(path)
+        return bool(tomllib.loads(text.lstrip("\ufeff")))
+    except tomllib.TOMLDecodeError:
+        return True
+
+
+def read_config_text(path: Path) -> str:
+    """The text of the configuration file ``path``; raises :class:`ConfigError` naming why it cannot be read."""
+    try:
+        return read_regular_file(path)
     except FileNotFoundError:
         raise ConfigError(str(path), ["cannot read the file: it does not exist"]) from None
     except FileRefused as exc:
@@ -232,7 +247,6 @@ def load_config(path: str | Path | None = None) -> Config:
         raise ConfigError(str(path), ["cannot read the file: it is not UTF-8 text"]) from None
     except OSError as exc:
         raise ConfigError(str(path), [f"cannot read the file ({exc.strerror or exc})"]) from None
-    return replace(parse_config(text, str(path), path.parent), path=str(path))
 
 
 def observer_hint(config: Config) -> str:

@@ -132,6 +132,35 @@ def test_configuration_changed_while_running(tmp_path) -> None:
         station.stop()
 
 
+@pytest.mark.parametrize("half_saved", ["", "\n  \n", "# nfwserver configuration\n# [observer]\n", "\ufeff"])
+def test_an_empty_or_half_saved_file_is_refused_and_the_running_configuration_stays(tmp_path, half_saved) -> None:
+    """An editor mid-save leaves an empty or comment-only file: it never resets the station to defaults.
+    The refusal shows as the ``config`` fault until a whole file is applied, which clears it."""
+    path = tmp_path / "c.toml"
+    path.write_text('[observer]\nlocation = "QF56od"\n[server]\nrate_hz = 5\nstate_file = "none"\n')
+    from nfwserver.config import load_config
+
+    clock = VirtualClock(datetime(2026, 5, 8, tzinfo=timezone.utc))
+    station = Station(load_config(path), clock, transport=FakeDdeSystem().server_transport())
+    notes = []
+    station.core.events.subscribe(lambda e: notes.append(e) if e.direction is Direction.INFO else None)
+    station.start()
+    station.watch_config(str(path), interval_s=0.5)
+    state = station.core.state
+    try:
+        before = state.observer
+        path.write_text(half_saved, encoding="utf-8")
+        assert advance_until(clock, lambda: any("refused" in n.text for n in notes))
+        assert any("has no settings" in n.text for n in notes)
+        assert state.observer == before and state.observer.latitude_deg < 0 and state.rate_hz == 5
+        assert "has no settings" in station.core.health.faults()["config"]
+        path.write_text('[observer]\nlocation = "QF56od"\n[server]\nrate_hz = 10\nstate_file = "none"\n')
+        assert advance_until(clock, lambda: any("reloaded" in n.text for n in notes))
+        assert state.rate_hz == 10 and "config" not in station.core.health.faults()
+    finally:
+        station.stop()
+
+
 def test_a_slow_element_url_times_out_and_the_rest_loads(tmp_path) -> None:
     class Slow(http.server.BaseHTTPRequestHandler):
         def do_GET(self):
