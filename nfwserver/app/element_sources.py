@@ -78,7 +78,7 @@ def fetch_url(url: str, timeout_s: float = 20.0, progress: ProgressCallback | No
     try:
         with urllib.request.urlopen(request, timeout=timeout_s) as response:  # noqa: S310 - scheme checked above
             length = response.headers.get("Content-Length")
-            total = int(length) if length and length.isdigit() else None
+            total = int(length) if length and length.isascii() and length.isdigit() else None
             while size <= MAX_DOWNLOAD_BYTES:
                 chunk = response.read(_CHUNK)
                 if not chunk:

@@ -46,8 +46,8 @@ def command_word(argv: Iterable[str]) -> str | None:
 # A value that starts with '-' followed by a digit or '.', e.g. "-33.87,151.21,40" or "-0.3".
 _NEGATIVE_VALUE = re.compile(r"^-[0-9.]")
 # One relative-time term: "+2h", "-30m", "+90s", "+1d", "+1.5h"; terms may follow each other ("+1h30m").
-_RELATIVE = re.compile(r"^([+-])((?:\d+(?:\.\d*)?[smhd])+)$")
-_RELATIVE_TERM = re.compile(r"(\d+(?:\.\d*)?)([smhd])")
+_RELATIVE = re.compile(r"^([+-])((?:\d+(?:\.\d*)?[smhd])+)$", re.ASCII)
+_RELATIVE_TERM = re.compile(r"(\d+(?:\.\d*)?)([smhd])", re.ASCII)
 _UNIT_S = {"s": 1.0, "m": 60.0, "h": 3600.0, "d": 86400.0}
 #: Relative times reach at most this far (a larger value is almost certainly a typo).
 MAX_RELATIVE = timedelta(days=3660)

@@ -179,7 +179,7 @@ def _by_catalog_number(key: str, value: Any, form: str, convert: Callable[[str],
     problems = []
     for number, text in value.items():
         try:
-            if not number.isdigit() or not 0 < int(number) < 1_000_000_000:
+            if not (number.isascii() and number.isdigit()) or not 0 < int(number) < 1_000_000_000:
                 raise ValueError(f"{number!r} is not a catalog number")
             if not isinstance(text, str):
                 raise ValueError("must be a string")

@@ -66,7 +66,7 @@ def search(index: Sequence[Entry], query: str, first: Sequence[int] = (), limit:
     exact: list = []
     prefix: list = []
     other: list = []
-    digits = text.isdigit()
+    digits = text.isascii() and text.isdigit()
     for e in index:
         if digits and str(e.catalog_number).startswith(text):
             (exact if e.catalog_number == int(text) else prefix).append(e)

@@ -93,7 +93,7 @@ _ASSIGN = re.compile(r"^(SAT|ANTAZ|ANTEL)\s*=\s*(\S*)$", re.IGNORECASE)
 _KNOWN_WORD = re.compile(r"^(TUNE|TRACK|SAT|ANTAZ|ANTEL)\b", re.IGNORECASE)
 _USAGE = {"TUNE": "ON or OFF", "TRACK": "ON or OFF", "SAT": "=<catalog number>", "ANTAZ": "=<degrees>",
           "ANTEL": "=<degrees>"}
-_NUMBER = re.compile(r"^[+-]?(\d+(\.\d*)?|\.\d+)$")
+_NUMBER = re.compile(r"^[+-]?(\d+(\.\d*)?|\.\d+)$", re.ASCII)
 
 
 def clean_poke_text(text: str) -> str:
@@ -125,11 +125,11 @@ def parse_poke_line(line: str) -> Poke:
         raise PokeError("not a Nova command (TUNE ON|OFF, TRACK ON|OFF, SAT=n, ANTAZ=deg, ANTEL=deg)")
     kind, value = PokeKind(m.group(1).upper()), m.group(2)
     if kind is PokeKind.SAT:
-        if not value.isdigit() or not 1 <= len(value) <= 6:
-            raise PokeError(f"SAT needs a catalog number, got {escape_for_log(value, 20)!r}", bad_argument=True)
+        if not (value.isascii() and value.isdigit()) or not 1 <= len(value) <= 6:
+            raise PokeError(f"SAT needs a catalog number, got '{escape_for_log(value, 20)}'", bad_argument=True)
         return Poke(kind, int(value))
     if not _NUMBER.match(value):
-        raise PokeError(f"{kind.value} needs a number of degrees, got {escape_for_log(value, 20)!r}", bad_argument=True)
+        raise PokeError(f"{kind.value} needs a number of degrees, got '{escape_for_log(value, 20)}'", bad_argument=True)
     number = float(value)
     if not math.isfinite(number):
         raise PokeError(f"{kind.value} value is not finite", bad_argument=True)

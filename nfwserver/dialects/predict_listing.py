@@ -47,7 +47,7 @@ DAYNUM_OFFSET = 3651.0  #: PREDICT's day 0 is 31Dec79 00:00 UTC: daynum = unix /
 ONE_YEAR_S = 31557600  #: QuickFind/QuickPredict accept a start within this of now
 MAX_SPAN_S = 86400  #: longest list (PREDICT's limit for ``+`` starts; ours for every list)
 MAX_CALCULATIONS = 5000  #: positions one listing may compute before giving up
-_ATOL = re.compile(r"[ \t\n\v\f\r]*([+-]?\d+)")
+_ATOL = re.compile(r"[ \t\n\v\f\r]*([+-]?\d+)", re.ASCII)
 _DAYS = ("Mon", "Tue", "Wed", "Thu", "Fri", "Sat", "Sun")
 _MONTHS = ("Jan", "Feb", "Mar", "Apr", "May", "Jun", "Jul", "Aug", "Sep", "Oct", "Nov", "Dec")
 

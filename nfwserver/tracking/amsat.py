@@ -31,7 +31,7 @@ from datetime import datetime
 
 from nfwserver.tracking.tle import TleError, TleFields, check_ranges, epoch_from_tle
 
-_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?", re.ASCII)
 
 # (field, keywords): the first keyword contained in the lower-cased label decides the field.
 _KEYWORDS: tuple[tuple[str, tuple[str, ...]], ...] = (
@@ -83,10 +83,10 @@ def _field_of(label: str) -> str | None:
 
 def _epoch(text: str) -> datetime:
     parts = text.split()
-    if len(parts) >= 2 and parts[0].isdigit() and _NUMBER.fullmatch(parts[1]):
+    if len(parts) >= 2 and parts[0].isascii() and parts[0].isdigit() and _NUMBER.fullmatch(parts[1]):
         year, day = int(parts[0]), float(parts[1])
     else:
-        m = re.fullmatch(r"(\d{2}|\d{4})(\d{3}(?:\.\d*)?)", parts[0] if parts else "")
+        m = re.fullmatch(r"(\d{2}|\d{4})(\d{3}(?:\.\d*)?)", parts[0] if parts else "", re.ASCII)
         if not m:
             raise TleError(f"epoch {text!r} is not in the form YYDDD.DDDDDDDD")
         year, day = int(m.group(1)), float(m.group(2))
@@ -150,7 +150,7 @@ def parse_amsat_block(block: AmsatBlock) -> TleFields:
 
 def _designator(text: str) -> str:
     """``1983-058B`` -> ``83058B`` (the TLE's form); already-short forms pass through."""
-    m = re.fullmatch(r"(\d{2})?(\d{2})-?(\d{3})([A-Z]{0,3})", text.strip().upper())
+    m = re.fullmatch(r"(\d{2})?(\d{2})-?(\d{3})([A-Z]{0,3})", text.strip().upper(), re.ASCII)
     if not m:
         return ""
     return f"{m.group(2)}{m.group(3)}{m.group(4)}"
