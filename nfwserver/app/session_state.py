@@ -7,7 +7,9 @@ which ``[server] satellite`` was configured when the choice was made, so an edit
 wins over a choice saved before it (the station says so in its log).
 
 :class:`SessionSaver` follows the ticks on its own worker thread: saving (an fsync) never runs on
-the publisher.
+the publisher.  A file that cannot be written (read-only, full disk, a removed directory) is the
+``state-file`` link's fault: one warning, visible in STATUS while it lasts, retried with a bounded
+back-off (never once per tick), cleared by the first save that succeeds; the choice stays in memory.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from pathlib import Path
 
 from nfwserver.core.sample import TickSample
 from nfwserver.core.tick_worker import TickWorker
+from nfwserver.health import LinkHealth
 from nfwserver.storage import atomic_write_text, remove_stale_temporaries
 
 log = logging.getLogger(__name__)
@@ -59,26 +62,52 @@ class StateFile:
         self._last = state
         return state
 
+    def saved(self, state: SessionState) -> bool:
+        """True when ``state`` is what was last loaded or saved (nothing to write)."""
+        return state == self._last
+
     def save(self, state: SessionState) -> None:
-        """Write ``state`` if it differs from what was last loaded or saved."""
+        """Write ``state`` if it differs from what was last loaded or saved; raises :class:`OSError`."""
         if state == self._last:
             return
-        try:
-            atomic_write_text(self.path, json.dumps(asdict(state)) + "\n")
-            self._last = state
-        except OSError as exc:
-            log.error("cannot save the session state to %s: %s", self.path, exc)
+        atomic_write_text(self.path, json.dumps(asdict(state)) + "\n")
+        self._last = state
 
 
 class SessionSaver(TickWorker):
-    """Saves the AutoTracking satellite when it changes, on the worker thread ``nfw-session``."""
+    """Saves the AutoTracking satellite when it changes, on the worker thread ``nfw-session``.
+
+    ``health`` is the ``state-file`` link: failures back off on its schedule; the last unsaved state is
+    tried once more when the saver stops, whatever the back-off says."""
 
     thread_name = "nfw-session"
 
-    def __init__(self, state_file: StateFile, configured: int | None) -> None:
-        super().__init__()
+    def __init__(self, state_file: StateFile, configured: int | None, health: LinkHealth) -> None:
+        super().__init__(health.clock)
         self.state_file = state_file
         self.configured = configured
+        self.health = health
+        self._wanted: SessionState | None = None
 
     def process(self, sample: TickSample) -> None:
-        self.state_file.save(SessionState(sample.catalog_number, self.configured))
+        self._wanted = SessionState(sample.catalog_number, self.configured)
+        self._write(self._wanted, forced=False)
+
+    def stop(self) -> None:
+        super().stop()
+        if self._wanted is not None:
+            self._write(self._wanted, forced=True)
+
+    def _write(self, state: SessionState, forced: bool) -> None:
+        if self.state_file.saved(state):
+            self.health.succeeded()  # nothing left unsaved
+            return
+        if not (forced or self.health.may_try()):
+            return
+        try:
+            self.state_file.save(state)
+        except OSError as exc:
+            self.health.failed(f"cannot save the session state to {self.state_file.path} "
+                               f"({exc.strerror or exc}); keeping it in memory")
+        else:
+            self.health.succeeded()

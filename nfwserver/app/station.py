@@ -79,7 +79,9 @@ class Station:
             self.predict = PredictUdpServer(context, config.dialects.predict_host, config.dialects.predict_port)
         self.rotor: RotorCoupling | None = make_rotor(config.rotor, self.core, clock)
         self.radio: RadioCoupling | None = make_radio(config.radio, self.core, clock)
-        self.saver = SessionSaver(self.state_file, config.server.satellite) if self.state_file else None
+        self.saver = (SessionSaver(self.state_file, config.server.satellite,
+                                   self.core.health.link("state-file", Backoff(1.0, 60.0)))
+                      if self.state_file else None)
         self.easycomm: EasyCommOutput | None = (
             EasyCommOutput(config.easycomm, self.core.state, clock,
                            health=self.core.health.link("easycomm", Backoff(0.5, 2.0)))

@@ -54,6 +54,33 @@ def test_the_selected_satellite_survives_a_restart(tmp_path) -> None:
     third.stop()
 
 
+def test_an_unwritable_state_file_is_one_warning_retried_with_backoff_and_cleared_when_writable(tmp_path, caplog):
+    """A directory where the state file should be makes every save fail (also for root, unlike chmod)."""
+    import logging
+
+    state = tmp_path / "state.json"
+    state.mkdir()
+    clock = VirtualClock(datetime(2026, 5, 8, tzinfo=timezone.utc))
+    station = Station(parse_config(f'[server]\nstate_file = "{state}"\nrate_hz = 5\n'), clock,
+                      transport=FakeDdeSystem().server_transport())
+    caplog.set_level(logging.INFO)
+    station.start()
+    try:
+        assert station.core.command("SAT=27607").ok
+        assert advance_until(clock, lambda: "state-file" in station.core.health.faults())
+        advance_until(clock, lambda: False, limit_s=20.0)  # 20 s of ticks at 5 Hz with the file unwritable
+        lines = [r for r in caplog.records if "cannot save the session state" in r.getMessage()]
+        assert len(lines) == 1 and lines[0].levelno == logging.WARNING
+        assert "keeping it in memory" in station.core.health.faults()["state-file"]
+        assert station.core.snapshot().catalog_number == 27607  # the choice stays in memory
+        state.rmdir()
+        assert advance_until(clock, lambda: "state-file" not in station.core.health.faults(), limit_s=120)
+        assert json.loads(state.read_text())["satellite"] == 27607
+        assert any("state-file: recovered" in r.getMessage() for r in caplog.records)
+    finally:
+        station.stop()
+
+
 _SAVER = (
     "import itertools, sys\n"
     "from nfwserver.app.session_state import SessionState, StateFile\n"
