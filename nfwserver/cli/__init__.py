@@ -75,5 +75,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except CliError as exc:
         print(f"nfwserver: {exc}", file=sys.stderr)
         return 1
+    except OSError as exc:  # a file or device the command could not use: one line, the details with -v
+        where = f": {exc.filename}" if exc.filename else ""
+        print(f"nfwserver: {exc.strerror or exc}{where}", file=sys.stderr)
+        if args.verbose:
+            logging.getLogger("nfwserver").debug("details", exc_info=True)
+        return 1
     except KeyboardInterrupt:
         return 130

@@ -37,7 +37,11 @@ def run_init(args: argparse.Namespace) -> int:
     path = Path(args.config) if args.config else default_config_path()
     if path.exists() and not args.force:
         raise CliError(f"{path} already exists (use --force to overwrite)")
-    atomic_write_text(path, template())
+    try:
+        atomic_write_text(path, template())
+    except OSError as exc:
+        raise CliError(f"cannot write {path}: {exc.strerror or exc} "
+                       "(choose another place with --config FILE)") from None
     print(path)
     return 0
 

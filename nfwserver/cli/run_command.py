@@ -17,10 +17,13 @@ import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from nfwserver.cli.station_runner import run_console, serve_headless, start_report
 from nfwserver.clock import Clock, SystemClock
+
+if TYPE_CHECKING:
+    from nfwserver.cli.log_file import StationLogFile
 
 log = logging.getLogger("nfwserver")
 
@@ -38,12 +41,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def _log_to_file(path: Path) -> logging.Handler:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handler = logging.handlers.RotatingFileHandler(path, maxBytes=5 * 2**20, backupCount=5, encoding="utf-8")
-    handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+def _log_to_file(path: Path, clock: Clock) -> StationLogFile:
+    """Send the log to the rotating file ``path`` (see :mod:`nfwserver.cli.log_file`); the terminal keeps
+    showing warnings and errors only."""
+    from nfwserver.cli.log_file import StationLogFile
+
+    handler = StationLogFile(path, clock)
     root = logging.getLogger()
-    for existing in root.handlers:  # the terminal keeps showing warnings and errors only
+    for existing in root.handlers:
         if isinstance(existing, logging.StreamHandler) and not isinstance(existing, logging.FileHandler):
             existing.setLevel(max(existing.level, logging.WARNING))
     root.addHandler(handler)
@@ -128,13 +133,16 @@ def serve(config: Any, plan: RunPlan, watch: str | None = None) -> int:
     """Start the station from ``config``, run it as ``plan`` says, stop it; the exit code."""
     from nfwserver.app.station import Station
     from nfwserver.cli import CliError
+    from nfwserver.cli.log_file import LOG_BACKOFF
 
     clock = plan.clock or SystemClock()
     file_handler = None
     if not plan.console:
-        file_handler = _log_to_file(plan.log_file)
+        file_handler = _log_to_file(plan.log_file, clock)
         print(f"nfwserver: logging to {plan.log_file}", file=sys.stderr)
     station = Station(config, clock, transport=plan.transport)
+    if file_handler is not None:
+        file_handler.attach(station.core.health.link("log-file", LOG_BACKOFF))
     try:
         station.start()
     except OSError as exc:
@@ -158,7 +166,8 @@ def serve(config: Any, plan: RunPlan, watch: str | None = None) -> int:
                 timer.cancel()
             if failure is None:
                 return 0
-            file_handler = _log_to_file(plan.log_file)
+            file_handler = _log_to_file(plan.log_file, clock)
+            file_handler.attach(station.core.health.link("log-file", LOG_BACKOFF))
             log.error("the console stopped: %s: %s", type(failure).__name__, failure, exc_info=failure)
             print(f"nfwserver: the console failed ({type(failure).__name__}: {failure}); the station keeps "
                   f"serving without it, logging to {plan.log_file}; stop it with Ctrl+C.", file=sys.stderr)
