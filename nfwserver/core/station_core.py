@@ -22,8 +22,10 @@ from dataclasses import dataclass
 from datetime import datetime
 
 from nfwserver.clock import Clock
+from nfwserver.commands.parsing import parse_poke
+from nfwserver.commands.table import CommandError as PokeError
+from nfwserver.commands.table import Face, Poke, PokeKind, escape_for_log
 from nfwserver.core.events import Direction, EventLog
-from nfwserver.core.nova_protocol import Poke, PokeError, PokeKind, escape_for_log, parse_poke
 from nfwserver.core.sample import TickSample
 from nfwserver.core.state import DEFAULT_RATE_HZ, StateSnapshot, StationState
 from nfwserver.core.status import INTERFACE_VERSION, StatusBit
@@ -31,7 +33,7 @@ from nfwserver.core.tracker import TickListener, Tracker
 from nfwserver.health.board import HealthBoard
 from nfwserver.radio.transponder import Channel
 from nfwserver.ratelimited_log import RateLimitedLog
-from nfwserver.tracking.catalog import Catalog
+from nfwserver.tracking.catalog import Catalog, Satellite
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer
 
@@ -169,22 +171,53 @@ class StationCore:
         """Record where the antennas point (sky degrees; a rotor read-back, or ANTAZ/ANTEL)."""
         self.state.report_antenna(azimuth_deg, elevation_deg, source, self.clock.now())
 
-    def apply(self, pokes: Iterable[Poke], source: str) -> tuple[str | None, str | None]:
-        """Apply parsed commands in order; returns (refusal reason, note on an ignored command)."""
-        note = None
+    def _satellite_for(self, value: int | str) -> tuple[Satellite | None, str | None]:
+        """The satellite ``SAT=value`` names (a catalog number, or a name matching one satellite only),
+        or None and why not."""
+        catalog = self.state.catalog
+        if isinstance(value, int):
+            sat = catalog.get(value)
+            return (sat, None) if sat is not None else (None, f"satellite {value} is not in the catalog")
+        key = value.upper()
+        found = [s for s in catalog if key in (s.dde_name.upper(), s.name.upper())]
+        if len(found) == 1:
+            return found[0], None
+        shown = escape_for_log(value, 40)
+        if not found:
+            return None, f"no satellite is named {shown!r}"
+        names = ", ".join(f"{s.catalog_number} {s.name}" for s in found[:5])
+        return None, f"{len(found)} satellites are named {shown!r} ({names}); use the catalog number"
+
+    def check(self, pokes: Iterable[Poke]) -> tuple[list[Poke], str | None]:
+        """Validate commands as a whole before any takes effect: each ``SAT=`` resolved to a catalog number
+        of a satellite that can be computed now; returns the resolved commands, or the refusal reason."""
+        resolved = []
         for poke in pokes:
+            if poke.kind is PokeKind.SAT:
+                sat, why = self._satellite_for(poke.value if isinstance(poke.value, str) else int(poke.value))
+                if sat is None:
+                    return [], f"{why}; keeping the current one"
+                problem = self.tracker.why_not_computable(sat)
+                if problem is not None:
+                    return [], (f"satellite {sat.catalog_number} {sat.dde_name} cannot be computed now ({problem}); "
+                                "keeping the current one")
+                poke = Poke(PokeKind.SAT, sat.catalog_number)
+            resolved.append(poke)
+        return resolved, None
+
+    def apply(self, pokes: Iterable[Poke], source: str) -> tuple[str | None, str | None]:
+        """Apply commands atomically: all are checked (:meth:`check`) before the first takes effect, so a
+        refused command changes nothing.  Returns (refusal reason, note on an accepted command)."""
+        resolved, reason = self.check(pokes)
+        if reason is not None:
+            return reason, None
+        note = None
+        for poke in resolved:
             if poke.kind is PokeKind.TUNE:
                 self.set_tune(bool(poke.value), source)
             elif poke.kind is PokeKind.TRACK:
                 note = self.set_track(bool(poke.value), source) or note
             elif poke.kind is PokeKind.SAT:
-                sat = self.state.catalog.get(int(poke.value))
-                if sat is None:
-                    return f"satellite {poke.value} is not in the catalog; keeping the current one", note
-                why = self.tracker.why_not_computable(sat)
-                if why is not None:
-                    return (f"satellite {poke.value} {sat.dde_name} cannot be computed now ({why}); "
-                            "keeping the current one"), note
                 self.select_satellite(int(poke.value), source)
             elif poke.kind is PokeKind.ANTAZ:
                 self.report_antenna_position(float(poke.value), None, source)
@@ -192,11 +225,12 @@ class StationCore:
                 self.report_antenna_position(None, float(poke.value), source)
         return None, note
 
-    def command(self, text: str, source: str = "console", conversation: int | None = None) -> CommandResult:
-        """Handle one command string (a poke, a TCP line, the console's command line)."""
+    def command(self, text: str, source: str = "console", conversation: int | None = None,
+                face: Face = Face.DDE) -> CommandResult:
+        """Handle one command string (a poke, a TCP line, the console's command line) sent by ``face``."""
         bits = 0
         try:
-            reason, note = self.apply(parse_poke(text), source)
+            reason, note = self.apply(parse_poke(text, face), source)
             if reason is not None:
                 bits = StatusBit.BAD_SUBFUNCTION
         except PokeError as exc:

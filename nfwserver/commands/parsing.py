@@ -1,0 +1,84 @@
+"""Parsing command text through the table (:mod:`nfwserver.commands.table`), for every face.
+
+:func:`parse_line` reads one command as a given face may send it; :func:`parse_poke` reads Nova's
+station commands from a DDE poke or execute, which may hold several, one per line: every line must
+parse before any is returned, so a half-understood poke changes nothing.  Surrounding NULs, CR/LF and
+blanks are stripped, keywords are matched in any case.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from nfwserver.commands.table import (
+    MAX_COMMAND_LENGTH,
+    Command,
+    CommandError,
+    Face,
+    Poke,
+    PokeKind,
+    Target,
+    commands_for,
+)
+
+__all__ = ["Parsed", "clean_command_text", "parse_line", "parse_poke", "parse_poke_line"]
+
+
+@dataclass(frozen=True)
+class Parsed:
+    """One command as parsed: its table entry and its checked argument (None when it takes none)."""
+
+    command: Command
+    value: object
+
+    def poke(self) -> Poke:
+        """The station command (only for entries whose target is the station)."""
+        return Poke(PokeKind(self.command.word), self.value)  # type: ignore[arg-type]
+
+
+def clean_command_text(text: str) -> str:
+    """Strip the NULs, CR/LF and blanks that clients leave around a command."""
+    return text.strip("\x00\r\n\t ")
+
+
+def _unknown(face: Face) -> str:
+    station = ", ".join(c.short for c in commands_for(face, Target.STATION))
+    return f"not a Nova command ({station})"
+
+
+def parse_line(text: str, face: Face, target: Target | None = None) -> Parsed:
+    """One command from ``face`` (only commands acting on ``target`` when given); raises :class:`CommandError`."""
+    text = clean_command_text(text)
+    if not text:
+        raise CommandError("empty poke")
+    if len(text) > MAX_COMMAND_LENGTH:
+        raise CommandError(f"poke of {len(text)} characters is too long")
+    known = commands_for(face, target)
+    for entry in known:
+        match = entry.match(text)
+        if match:
+            try:
+                return Parsed(entry, entry.convert(match, face))
+            except CommandError as exc:
+                raise CommandError(str(exc), exc.bad_argument, entry) from None
+    word = re.match(r"\w+", text, re.ASCII)
+    for entry in known:
+        if word and word.group(0).upper() == entry.word:
+            raise CommandError(f"{entry.word} needs {entry.needs}", bad_argument=True, command=entry)
+    raise CommandError(_unknown(face))
+
+
+def parse_poke_line(line: str, face: Face = Face.DDE) -> Poke:
+    """One of Nova's station commands; raises :class:`CommandError`."""
+    return parse_line(line, face, Target.STATION).poke()
+
+
+def parse_poke(text: str, face: Face = Face.DDE) -> list[Poke]:
+    """Nova's station commands in ``text``, one per line; raises :class:`CommandError` unless all parse."""
+    if len(text) > 4 * MAX_COMMAND_LENGTH:
+        raise CommandError(f"poke of {len(text)} characters is too long")
+    lines = [p for p in re.split(r"[\r\n\x00]+", text) if clean_command_text(p)]
+    if not lines:
+        raise CommandError("empty poke")
+    return [parse_poke_line(line, face) for line in lines]
