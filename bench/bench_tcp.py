@@ -27,7 +27,7 @@ ROOT = Path(__file__).resolve().parent.parent
 CATALOG = Catalog(load_element_file(ROOT / "tests" / "data" / "visual.txt").sets)
 OBS = Observer(52.2, 0.12, 20.0)
 START = datetime(2026, 5, 8, tzinfo=timezone.utc)
-CONFIG = TcpConfig(enabled=True, host="127.0.0.1", port=0, allow=("127.0.0.1/32",))
+CONFIG = TcpConfig(enabled=True, host="127.0.0.1", port=0, allow=("127.0.0.1/32",), max_per_address=4096)
 
 
 def watcher_process(host: str, port: int, n: int) -> None:

@@ -48,6 +48,8 @@ class ElementRefresher(ServiceThread):
         self.fetches += 1
         try:
             self.refresh()
+        except OSError as exc:  # out of descriptors, a full disk: one line, the next request tries again
+            log.warning("element refresh failed: %s", exc.strerror or exc)
         except Exception:  # never let a refresh take the station down
             log.exception("element refresh failed")
 

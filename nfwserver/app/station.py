@@ -78,6 +78,7 @@ class Station:
                                      callsign=config.dialects.callsign, on_reload=self.refresher.request)
             self.predict = PredictUdpServer(context, config.dialects.predict_host, config.dialects.predict_port)
         self.rotor: RotorCoupling | None = make_rotor(config.rotor, self.core, clock)
+        self.core.rotor_configured = self.rotor is not None
         self.radio: RadioCoupling | None = make_radio(config.radio, self.core, clock)
         self.saver = (SessionSaver(self.state_file, config.server.satellite,
                                    self.core.health.link("state-file", Backoff(1.0, 60.0)))

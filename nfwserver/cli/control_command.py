@@ -22,10 +22,12 @@ def _common(p: argparse.ArgumentParser) -> None:
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    from nfwserver.commands.help_text import poke_epilog
+
     p = subparsers.add_parser(
-        "poke", help="send a Nova command to the running station (TCP)",
-        description="Send one command to the running station over its TCP port: TUNE ON|OFF, TRACK ON|OFF, "
-        "SAT=<catalog number>, ANTAZ=<deg>, ANTEL=<deg> (or SUMMARY).")
+        "poke", help="send a command to the running station (TCP)",
+        description="Send one command to the running station over its TCP port and print the reply.",
+        epilog=poke_epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("text", help='the command, e.g. "TRACK ON"')
     _common(p)
     p.set_defaults(func=poke)
@@ -35,7 +37,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     s.set_defaults(func=status)
 
 
-def _ask(args: argparse.Namespace, line: str) -> str:
+def _ask(args: argparse.Namespace, line: str, until: str | None = None) -> str:
     from nfwserver.cli import CliError
     from nfwserver.config import ConfigError, load_config
     from nfwserver.tcp.client import StationUnreachable, ask, connect_host
@@ -47,7 +49,7 @@ def _ask(args: argparse.Namespace, line: str) -> str:
     host = args.host or connect_host(config.tcp.host)
     port = int(args.port or config.tcp.port)
     try:
-        return ask(host, port, line, args.timeout)
+        return ask(host, port, line, args.timeout, until)
     except StationUnreachable as exc:
         raise CliError(str(exc)) from None
 
@@ -62,7 +64,12 @@ def poke(args: argparse.Namespace) -> int:
         print("nfwserver poke: the command must be one line of printable ASCII (at most 256 characters)",
               file=sys.stderr)
         return 2
-    reply = _ask(args, text)
+    word = text.split()[0].upper()
+    if word == "WATCH":
+        print("nfwserver poke: WATCH streams until stopped; connect a TCP client to the port (e.g. nc 127.0.0.1 8090)",
+              file=sys.stderr)
+        return 2
+    reply = _ask(args, text, until="OK" if word == "HELP" else None)
     if reply.startswith("ERROR"):
         raise CliError(f"the station refused {text!r}: {reply[5:].strip()}")
     print(reply)

@@ -120,8 +120,9 @@ def _satellite(match: re.Match[str], face: Face) -> int | str:
         raise CommandError("SAT needs =<catalog number>", bad_argument=True)
     if value.isascii() and value.isdigit() and 1 <= len(value) <= 6:
         return int(value)
-    if face is not Face.DDE and value and not value[:1].isdigit() and value.isprintable():
-        return value  # a name: the station resolves it when it is unique
+    if face is not Face.DDE and value.isascii() and value.isprintable() and any(ch.isalpha() for ch in value) \
+            and not value[:1].isdigit():
+        return value  # a name (ASCII, with a letter): the station resolves it when it is unique
     raise CommandError(f"SAT needs a catalog number, got '{escape_for_log(value, 20)}'", bad_argument=True)
 
 
@@ -158,7 +159,7 @@ COMMANDS: tuple[Command, ...] = (
     Command("TRACK", r"TRACK\s+(ON|OFF)", "TRACK ON|OFF", "TRACK ON|OFF", "ON or OFF",
             "switch rotor tracking on or off (TRACK ON needs a station and a satellite; without a rotor it is "
             "accepted with a warning)",
-            _STATION_REPLY + "; TCP: OK warning: <why nothing turns> when no rotor is configured",
+            _STATION_REPLY + " (OK warning: <why nothing turns> when the station has no rotor)",
             Face.ALL, Target.STATION, _on),
     Command("SAT", r"SAT\s*=\s*(.*?)", "SAT=<catalog number>", "SAT=n", "=<catalog number>",
             "select the satellite to track by catalog number; on TCP and the console also by a name that "
@@ -178,9 +179,10 @@ COMMANDS: tuple[Command, ...] = (
             "devices", "one line", Face.TCP, Target.SESSION),
     Command("WATCH", r"WATCH", "WATCH", "WATCH", "nothing after it",
             "stream every published Nova string until the client sends a line (that line ends the stream "
-            "and is not executed)", "OK, then one line per published string", Face.TCP, Target.SESSION),
+            "and is not executed)", "OK, then one line per published string; OK again for the line that ends it",
+            Face.TCP, Target.SESSION),
     Command("HELP", r"HELP", "HELP", "HELP", "nothing after it",
-            "list the commands this face takes", "one line per command, then OK", Face.TCP | Face.CONSOLE,
+            "list the commands this face takes", "one line per command (TCP: then OK)", Face.TCP | Face.CONSOLE,
             Target.SESSION),
     Command("QUIT", r"QUIT", "QUIT", "QUIT", "nothing after it", "close the connection", "OK, then the server closes",
             Face.TCP, Target.SESSION),

@@ -84,6 +84,20 @@ class TcpConfig:
     port: int = default("tcp", "port")
     #: networks allowed to connect, normalised by :mod:`ipaddress` ("127.0.0.1/32", "10.0.0.0/8", "::1/128")
     allow: tuple[str, ...] = default("tcp", "allow")
+    max_clients: int = default("tcp", "max_clients")  #: connections at once
+    max_per_address: int = default("tcp", "max_per_address")  #: connections from one address at once
+    idle_timeout_s: float = default("tcp", "idle_timeout_s")  #: seconds without a complete line (not WATCH)
+
+    @staticmethod
+    def peer_key(address: str) -> str:
+        """The peer's address as one key per host: IPv4-mapped IPv6 as IPv4, no zone, canonical form."""
+        try:
+            ip = ipaddress.ip_address(address.split("%", 1)[0])
+        except ValueError:
+            return address
+        if isinstance(ip, ipaddress.IPv6Address) and ip.ipv4_mapped is not None:
+            return str(ip.ipv4_mapped)
+        return str(ip)
 
     def allows(self, address: str) -> bool:
         """True when the peer ``address`` (an IP address string) lies in one of the ``allow`` networks."""

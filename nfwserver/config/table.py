@@ -140,6 +140,12 @@ SETTINGS: tuple[Setting, ...] = (
     _S("tcp", "port", "int", 8090, "TCP port (Nova's default 8090; 0 = any free port)", "tcp.port", 0, 65535),
     _S("tcp", "allow", "networks", ["127.0.0.1", "::1"], "addresses or networks allowed to connect "
        "(\"192.168.1.20\", \"10.0.0.0/8\", \"::1\"); others are refused", "tcp.allow"),
+    _S("tcp", "max_clients", "int", 256, "connections served at once; the next gets a refusal line",
+       "tcp.max_clients", 1, 4096),
+    _S("tcp", "max_per_address", "int", 32, "connections one address may hold, so that no address locks the "
+       "others out", "tcp.max_per_address", 1, 4096),
+    _S("tcp", "idle_timeout_s", "number", 300, "close a connection that completes no line for this long, "
+       "seconds (WATCH subscribers are never idle)", "tcp.idle_timeout_s", 5, 86400),
     # [easycomm]
     _S("easycomm", "enabled", "bool", False, "write EasyComm I lines to a serial port", "easycomm.enabled"),
     _S("easycomm", "device", "device", None, "serial device (required when enabled)", "easycomm.device",

@@ -33,6 +33,9 @@ from textual.containers import Horizontal, Vertical
 from textual.css.query import NoMatches
 from textual.widgets import Footer, Input, RichLog, Static
 
+from nfwserver.commands.help_text import help_lines
+from nfwserver.commands.parsing import parse_line
+from nfwserver.commands.table import CommandError, Face, Target
 from nfwserver.console.pass_view import PassSearch, next_pass_text, pass_table, search_passes
 from nfwserver.console.picker import SatellitePicker
 from nfwserver.console.reflow_log import ReflowLog
@@ -122,7 +125,7 @@ class NfwConsole(App):
             with Vertical(id="side"):
                 yield Static(id="passes")
                 yield Static(id="sky")
-        yield Input(placeholder="poke: TUNE ON | TRACK ON | SAT=25544 | Z (UTC/local) | FLIP AUTO|ON|OFF",
+        yield Input(placeholder="command: TUNE ON | TRACK ON | SAT=25544 or a name | Z (UTC/local) | HELP",
                     id="poke")
         yield Footer()
 
@@ -262,15 +265,33 @@ class NfwConsole(App):
         message.input.value = ""
         if not text:
             return
-        word = text.upper().split()
-        if word == ["Z"]:
-            self.action_toggle_zone()
-        elif word[0] == "FLIP":
-            self._set_flip(word[1].lower() if len(word) == 2 else "")
+        try:
+            parsed = parse_line(text, Face.CONSOLE)
+        except CommandError as exc:  # the core records and explains station commands' refusals
+            if exc.command is not None and exc.command.target is Target.ROTOR:
+                self._set_flip("")
+            elif exc.command is not None and exc.command.target is not Target.STATION:
+                self._note(str(exc), "red")
+            else:
+                self._station_command(text)
         else:
-            self.core.command(text, source="console")
+            target = parsed.command.target
+            if target is Target.DISPLAY:
+                self.action_toggle_zone()
+            elif target is Target.ROTOR:
+                self._set_flip(str(parsed.value))
+            elif target is Target.SESSION:  # HELP
+                for line in help_lines(Face.CONSOLE):
+                    self._note(line, "cyan")
+            else:
+                self._station_command(text)
         self._drain()
         self._refresh_state()
+
+    def _station_command(self, text: str) -> None:
+        result = self.core.command(text, source="console", face=Face.CONSOLE)
+        if result.warning and result.note:
+            self._note(f"warning: {result.note}")
 
     def action_pick_satellite(self) -> None:
         if isinstance(self.screen, SatellitePicker):

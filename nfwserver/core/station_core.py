@@ -45,12 +45,14 @@ class CommandResult:
     """The answer to one command string."""
 
     accepted: bool  #: understood and acknowledged (DDE_FACK); False: refused (DDE_FNOTPROCESSED)
-    note: str | None  #: why it was refused, or why an acknowledged command had no effect
+    note: str | None  #: why it was refused, why an acknowledged command had no effect, or a warning
     status: int  #: the status word after the command (with 0x4000/0x8000 for a bad function/subfunction)
+    #: the note is a warning on a command that took effect (``TRACK ON`` with no rotor configured)
+    warning: bool = False
 
     @property
     def ok(self) -> bool:
-        """Accepted and took effect."""
+        """Accepted and took effect, with nothing to add."""
         return self.accepted and self.note is None
 
 
@@ -91,6 +93,8 @@ class StationCore:
         #: Refused commands: one warning per client at once, then a counted summary at most once a minute
         #: (every refusal is still an event).
         self._refusals = RateLimitedLog(log, clock, 60.0)
+        #: whether the station drives a rotor itself (set by the station; None: not known, no warning)
+        self.rotor_configured: bool | None = None
         if satellite is not None and not self.select_satellite(satellite, source="startup"):
             log.warning("satellite %s is not in the catalog; no satellite selected", satellite)
 
@@ -184,9 +188,9 @@ class StationCore:
             return found[0], None
         shown = escape_for_log(value, 40)
         if not found:
-            return None, f"no satellite is named {shown!r}"
-        names = ", ".join(f"{s.catalog_number} {s.name}" for s in found[:5])
-        return None, f"{len(found)} satellites are named {shown!r} ({names}); use the catalog number"
+            return None, f"no satellite is named '{shown}'"
+        numbers = ", ".join(str(s.catalog_number) for s in found[:5]) + (", ..." if len(found) > 5 else "")
+        return None, f"{len(found)} satellites are named '{shown}' ({numbers}); use the catalog number"
 
     def check(self, pokes: Iterable[Poke]) -> tuple[list[Poke], str | None]:
         """Validate commands as a whole before any takes effect: each ``SAT=`` resolved to a catalog number
@@ -205,32 +209,41 @@ class StationCore:
             resolved.append(poke)
         return resolved, None
 
-    def apply(self, pokes: Iterable[Poke], source: str) -> tuple[str | None, str | None]:
+    def apply(self, pokes: Iterable[Poke], source: str) -> tuple[str | None, str | None, str | None]:
         """Apply commands atomically: all are checked (:meth:`check`) before the first takes effect, so a
-        refused command changes nothing.  Returns (refusal reason, note on an accepted command)."""
+        refused command changes nothing.  Returns (refusal reason, why an accepted command had no effect,
+        warning on a command that took effect)."""
         resolved, reason = self.check(pokes)
         if reason is not None:
-            return reason, None
-        note = None
+            return reason, None, None
+        note = warning = None
         for poke in resolved:
             if poke.kind is PokeKind.TUNE:
                 self.set_tune(bool(poke.value), source)
             elif poke.kind is PokeKind.TRACK:
-                note = self.set_track(bool(poke.value), source) or note
+                ignored = self.set_track(bool(poke.value), source)
+                note = ignored or note
+                if poke.value and ignored is None and self.rotor_configured is False:
+                    warning = ("TRACK ON with no rotor configured: nothing turns here ([rotor] backend); "
+                               "DDE clients that drive their own rotor still follow the feed")
             elif poke.kind is PokeKind.SAT:
                 self.select_satellite(int(poke.value), source)
             elif poke.kind is PokeKind.ANTAZ:
                 self.report_antenna_position(float(poke.value), None, source)
             elif poke.kind is PokeKind.ANTEL:
                 self.report_antenna_position(None, float(poke.value), source)
-        return None, note
+        return None, note, warning
 
     def command(self, text: str, source: str = "console", conversation: int | None = None,
-                face: Face = Face.DDE) -> CommandResult:
-        """Handle one command string (a poke, a TCP line, the console's command line) sent by ``face``."""
+                face: Face = Face.DDE, rate_key: str | None = None) -> CommandResult:
+        """Handle one command string (a poke, a TCP line, the console's command line) sent by ``face``.
+
+        A refusal is logged once a minute at most per ``rate_key`` (default: ``source``); a network face
+        passes the peer's address, so reconnecting does not start the count afresh."""
         bits = 0
+        warning = None
         try:
-            reason, note = self.apply(parse_poke(text, face), source)
+            reason, note, warning = self.apply(parse_poke(text, face), source)
             if reason is not None:
                 bits = StatusBit.BAD_SUBFUNCTION
         except PokeError as exc:
@@ -239,8 +252,10 @@ class StationCore:
         self.tracker.note_command(int(bits))
         accepted = reason is None
         self.events.add(self.clock.now(), Direction.IN, "poke", text, conversation=conversation, client=source,
-                        accepted=accepted, detail=reason or note or "")
+                        accepted=accepted, detail=reason or note or warning or "")
         if not accepted:
-            self._refusals.warning(f"refused:{source}", "refused command %s from %s: %s", escape_for_log(text),
-                                   escape_for_log(source), reason)
+            self._refusals.warning(f"refused:{rate_key or source}", "refused command %s from %s: %s",
+                                   escape_for_log(text), escape_for_log(source), reason)
+        if accepted and note is None and warning is not None:
+            return CommandResult(True, warning, self.tracker.status_word(), warning=True)
         return CommandResult(accepted, reason or note, self.tracker.status_word())

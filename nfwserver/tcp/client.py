@@ -32,8 +32,9 @@ def _read_line(stream, where: str) -> str:
     return raw.decode("ascii", errors="replace").rstrip("\r\n")
 
 
-def ask(host: str, port: int, line: str, timeout_s: float = 5.0) -> str:
-    """Send ``line`` to the station at ``host``:``port`` and return its one-line reply."""
+def ask(host: str, port: int, line: str, timeout_s: float = 5.0, until: str | None = None) -> str:
+    """Send ``line`` to the station at ``host``:``port`` and return its one-line reply (with ``until``:
+    every line up to and without the one equal to ``until``, joined by newlines; ``HELP`` ends with OK)."""
     where = f"{host} port {port}"
     try:
         with socket.create_connection((host, port), timeout=timeout_s) as sock, sock.makefile("rb") as stream:
@@ -41,7 +42,12 @@ def ask(host: str, port: int, line: str, timeout_s: float = 5.0) -> str:
             if greeting != GREETING:
                 raise StationUnreachable(f"{where} answered {greeting[:60]!r}, not Nova's greeting")
             sock.sendall(line.encode("ascii") + b"\r\n")
-            return _read_line(stream, where)
+            if until is None:
+                return _read_line(stream, where)
+            lines: list[str] = []
+            while (reply := _read_line(stream, where)) != until and not reply.startswith("ERROR"):
+                lines.append(reply)
+            return "\n".join(lines) if reply == until else reply
     except OSError as exc:
         reason = exc.strerror or str(exc) or type(exc).__name__
         raise StationUnreachable(f"no station answers on {where} ({reason}); is `nfwserver run` running "

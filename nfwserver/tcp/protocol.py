@@ -38,6 +38,9 @@ import enum
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
+from nfwserver.commands.help_text import help_lines
+from nfwserver.commands.parsing import clean_command_text, parse_line
+from nfwserver.commands.table import CommandError, Face, Target
 from nfwserver.core.events import Direction
 from nfwserver.core.nova_protocol import format_azimuth, format_elevation, format_range_rate
 from nfwserver.core.station_core import StationCore
@@ -86,38 +89,56 @@ class NovaTcpProtocol:
         self.core.events.add(self.core.clock.now(), Direction.IN, "request", text, client=peer, accepted=True,
                              detail=detail)
 
-    def handle(self, line: str, peer: str) -> Reply | None:
-        """The reply to ``line`` (without its terminator) from ``peer``; None for an empty line."""
-        word = line.strip(" \t").upper()
-        if not word:
+    def handle(self, line: str, peer: str, rate_key: str | None = None) -> Reply | None:
+        """The reply to ``line`` (without its terminator) from ``peer``; None for a blank line.
+
+        ``rate_key`` groups the refusal log lines of one client across its connections (its address)."""
+        if not line.strip():  # blank, including lines of only VT, FF or the 0x1C-0x1F separators
             return None
+        try:
+            parsed = parse_line(line, Face.TCP)
+        except CommandError as exc:
+            if exc.command is not None and exc.command.target is Target.ROTOR and self.set_flip is None:
+                self._record(peer, clean_command_text(line))
+                return Reply(("ERROR no rotor is configured",))
+            if exc.command is not None and exc.command.target is not Target.STATION:
+                self._record(peer, clean_command_text(line), str(exc))
+                return Reply((f"ERROR {_one_line(str(exc))}",))
+            return self._station(line, peer, rate_key)  # the core records and rate-limits the refusal
+        entry = parsed.command
+        if entry.target is Target.STATION:
+            return self._station(line, peer, rate_key)
+        if entry.target is Target.ROTOR:
+            self._record(peer, clean_command_text(line))
+            if self.set_flip is None:
+                return Reply(("ERROR no rotor is configured",))
+            self.set_flip(str(parsed.value))
+            return Reply(("OK",))
+        return self._session(entry.word, peer)
+
+    def _station(self, line: str, peer: str, rate_key: str | None) -> Reply:
+        result = self.core.command(line, source=peer, face=Face.TCP, rate_key=rate_key)
+        if result.ok:
+            return Reply(("OK",))
+        if result.accepted and result.warning:
+            return Reply((f"OK warning: {_one_line(result.note or '')}",))
+        return Reply((f"ERROR {_one_line(result.note or 'refused')}",))
+
+    def _session(self, word: str, peer: str) -> Reply:
         if word == "SUMMARY":
             text = self.core.current_text()
             self._record(peer, "SUMMARY", text)
             return Reply((text,))
+        self._record(peer, word)
         if word == "STATUS":
-            self._record(peer, "STATUS")
             return Reply((self.status_line(),))
         if word == "WATCH":
-            self._record(peer, "WATCH")
             return Reply(("OK",), Action.WATCH)
         if word == "QUIT":
-            self._record(peer, "QUIT")
             return Reply(("OK",), Action.QUIT)
-        if word.split()[0] == "FLIP":
-            return self._flip(word, peer)
-        result = self.core.command(line, source=peer)
-        return Reply(("OK",) if result.ok else (f"ERROR {_one_line(result.note or 'refused')}",))
-
-    def _flip(self, word: str, peer: str) -> Reply:
-        parts = word.split()
-        self._record(peer, word)
-        if self.set_flip is None:
-            return Reply(("ERROR no rotor is configured",))
-        if len(parts) != 2 or parts[1] not in ("AUTO", "ON", "OFF"):
-            return Reply(("ERROR FLIP needs AUTO, ON or OFF",))
-        self.set_flip(parts[1].lower())
-        return Reply(("OK",))
+        if word == "HELP":
+            return Reply(help_lines(Face.TCP) + ("OK",))
+        raise AssertionError(f"the TCP face has no handler for {word}")  # a table entry without one
 
     @staticmethod
     def too_long(limit: int) -> Reply:

@@ -1,16 +1,23 @@
 """Nova's TCP server (Setup/TCP in Nova for Windows) as an adapter on the station core.
 
 One thread, ``nfw-tcp``, owns the listening socket and every connection: a :mod:`selectors` loop,
-so many clients cost no thread each.  The loop blocks in ``select`` without a timeout (nothing in
-it is scheduled in time); :meth:`NovaTcpServer.stop` and new published strings wake it through a
-socket pair.
+so many clients cost no thread each.  The loop waits in ``select`` until the next idle deadline;
+:meth:`NovaTcpServer.stop` and new published strings wake it through a socket pair.
 
 - Construction is pure; :meth:`NovaTcpServer.start` binds (raising :class:`OSError` when it cannot)
   and :meth:`NovaTcpServer.stop` closes everything.  Port 0 binds any free port (see ``address``).
 - A peer whose address is not in ``[tcp] allow`` is closed at once, before the greeting, and
-  logged (once a minute per address at most) and recorded in the event stream.
-- Lines and replies: :mod:`nfwserver.tcp.protocol`, split by :mod:`nfwserver.tcp.line_splitter`
-  (CR, LF, CR LF or NUL; at most 1 KiB kept per client; longer lines refused).
+  logged (once a minute per address at most) and recorded in the event stream.  IPv4-mapped IPv6
+  peers count as their IPv4 address everywhere (allow list, caps, rate limits).
+- Caps, so that one address never locks the others out: ``[tcp] max_per_address`` per address and
+  ``max_clients`` in all (the connection over a cap gets one ``ERROR`` line, then is closed); a
+  connection that completes no line for ``idle_timeout_s`` is closed (a ``WATCH`` subscriber never is).
+- Out of file descriptors (EMFILE and kin), the listener rests for a back-off (0.1 s doubling to 5 s)
+  instead of spinning: the ``tcp-accept`` link shows it in STATUS; the first good accept clears it.
+- Refused commands are logged once a minute per peer *address* (reconnecting does not reset it).
+- Lines: :mod:`nfwserver.tcp.protocol`, split by :mod:`nfwserver.tcp.line_splitter` (CR, LF, CR LF
+  or NUL; at most 1 KiB kept; longer lines refused).  The line ending a ``WATCH`` gets ``OK`` and is
+  not executed (a client stopping the stream with ``QUIT`` meant "stop").
 - The publisher thread only runs :meth:`NovaTcpServer.on_tick`: it appends the published string to
   a bounded queue and wakes the loop, at a cost that does not depend on the number of clients.
   The loop then copies the string to each ``WATCH`` client's output buffer.
@@ -23,20 +30,22 @@ socket pair.
 
 from __future__ import annotations
 
+import errno
 import logging
 import selectors
 import socket
 import threading
-from collections import deque
+from collections import Counter, deque
 from collections.abc import Callable
-from dataclasses import dataclass
 
 from nfwserver.config.schema import TcpConfig
 from nfwserver.core.events import Direction
 from nfwserver.core.sample import TickSample
 from nfwserver.core.station_core import StationCore
+from nfwserver.health.link_health import Backoff
 from nfwserver.ratelimited_log import RateLimitedLog
-from nfwserver.tcp.line_splitter import MAX_LINE_BYTES, LineSplitter
+from nfwserver.tcp.connection import Connection, TcpStats, admission_refusal, bind_listener, peer_label
+from nfwserver.tcp.line_splitter import MAX_LINE_BYTES
 from nfwserver.tcp.protocol import GREETING, Action, NovaTcpProtocol, Reply, StatusFields
 
 log = logging.getLogger(__name__)
@@ -44,40 +53,12 @@ log = logging.getLogger(__name__)
 DEFAULT_OUTPUT_LIMIT = 64 * 1024  #: bytes waiting for one client before a watching client is dropped
 COMMAND_HIGH_WATER = 16 * 1024  #: replies waiting before a client's further lines are left unread
 MAX_CLIENTS = 256
+#: accept() failures that mean "no descriptors or memory now": the listener rests instead of spinning
+_RESOURCE_ERRNOS = frozenset({errno.EMFILE, errno.ENFILE, errno.ENOBUFS, errno.ENOMEM})
+ACCEPT_BACKOFF = Backoff(0.1, 5.0)
 RECV_BYTES = 4096
 PUBLISHED_BACKLOG = 256  #: published strings waiting for the loop (it normally takes them at once)
 CRLF = b"\r\n"
-
-
-@dataclass
-class TcpStats:
-    accepted: int = 0
-    refused: int = 0  #: peers not allowed, or over the client limit
-    dropped: int = 0  #: watching clients dropped for not reading
-    lost: int = 0  #: published strings lost because the loop fell PUBLISHED_BACKLOG behind
-    delivered: int = 0  #: published strings handed to the watchers
-    max_buffered: int = 0  #: the most bytes ever waiting for one client
-
-
-class _Client:
-    """One connection; owned by the ``nfw-tcp`` thread."""
-
-    def __init__(self, sock: socket.socket, peer: str) -> None:
-        self.sock = sock
-        self.peer = peer
-        self.splitter = LineSplitter(MAX_LINE_BYTES)
-        self.inbox: deque[bytes | None] = deque()  # received lines not handled yet (one read's worth)
-        self.out = bytearray()
-        self.mask = selectors.EVENT_READ
-        self.watching = False
-        self.closing = False  # QUIT: close once the output is sent
-        self.eof = False  # the client shut its side: answer what it sent, then close (unless watching)
-        self.closed = False
-
-
-def _label(address: tuple) -> str:
-    host, port = address[0], address[1]
-    return f"tcp [{host}]:{port}" if ":" in host else f"tcp {host}:{port}"
 
 
 class NovaTcpServer:
@@ -86,17 +67,20 @@ class NovaTcpServer:
 
     def __init__(self, core: StationCore, config: TcpConfig, extra: StatusFields | None = None, *,
                  output_limit: int = DEFAULT_OUTPUT_LIMIT, send_buffer_bytes: int | None = None,
-                 max_clients: int = MAX_CLIENTS, set_flip: Callable[[str], None] | None = None) -> None:
+                 max_clients: int | None = None, set_flip: Callable[[str], None] | None = None) -> None:
         self.core = core
         self.config = config
         self.protocol = NovaTcpProtocol(core, extra, set_flip)
         self.output_limit = output_limit
         self.send_buffer_bytes = send_buffer_bytes
-        self.max_clients = max_clients
+        self.max_clients = max_clients if max_clients is not None else config.max_clients
+        self._per_address: Counter[str] = Counter()
+        self._accept_health = core.health.link("tcp-accept", ACCEPT_BACKOFF)
+        self._accept_resting = False
         self.stats = TcpStats()
         self.address: tuple[str, int] | None = None
-        self._clients: set[_Client] = set()
-        self._watching: set[_Client] = set()
+        self._clients: set[Connection] = set()
+        self._watching: set[Connection] = set()
         self._published: deque[str] = deque(maxlen=PUBLISHED_BACKLOG)
         self._wake_pending = False
         self._stop = threading.Event()
@@ -116,22 +100,17 @@ class NovaTcpServer:
     def watcher_count(self) -> int:
         return len(self._watching)
 
+    def wake(self) -> None:
+        """Let the loop look at the clock now (idle connections, the accept back-off): for a clock that
+        does not run by itself."""
+        self._wake()
+
     # -- life cycle --------------------------------------------------------------------------------
     def start(self) -> None:
         """Bind ``[tcp] host``/``port`` and serve on thread ``nfw-tcp``; OSError when it cannot bind."""
         if self._thread is not None:
             return
-        family, _, _, _, sockaddr = socket.getaddrinfo(self.config.host, self.config.port, type=socket.SOCK_STREAM,
-                                                       flags=socket.AI_PASSIVE)[0]
-        listener = socket.socket(family, socket.SOCK_STREAM)
-        try:
-            listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-            listener.bind(sockaddr)
-            listener.listen(64)
-            listener.setblocking(False)
-        except OSError:
-            listener.close()
-            raise
+        listener = bind_listener(self.config.host, self.config.port)
         self._listener = listener
         self.address = listener.getsockname()[:2]
         self._wake_r, self._wake_w = socket.socketpair()
@@ -190,7 +169,8 @@ class NovaTcpServer:
         assert self._selector is not None
         while not self._stop.is_set():
             try:
-                ready = self._selector.select()
+                ready = self._selector.select(self._next_timeout())
+                self._check_clock()
                 for key, mask in ready:
                     if key.data == "listen":
                         self._accept()
@@ -201,6 +181,37 @@ class NovaTcpServer:
                 self._deliver()
             except Exception:  # keep serving whatever one connection did
                 log.exception("TCP server loop failed; carrying on")
+
+    def _next_timeout(self) -> float | None:
+        """Real seconds until something on the clock is due (an idle deadline, the end of the accept
+        back-off), at least 50 ms; None when nothing is."""
+        now = self.core.clock.monotonic()
+        due = [c.last_line + self.config.idle_timeout_s for c in self._clients if not c.watching]
+        fault = self._accept_health.fault
+        if self._accept_resting and fault is not None:
+            due.append(fault.retry_at)
+        if not due:
+            return None
+        return min(max(min(due) - now, 0.05), 60.0)
+
+    def _check_clock(self) -> None:
+        """Close idle connections; put the listener back when its back-off has run out."""
+        now = self.core.clock.monotonic()
+        for client in [c for c in self._clients if not c.watching]:
+            if now - client.last_line >= self.config.idle_timeout_s:
+                self.stats.idle_closed += 1
+                self._close(client, f"idle for {self.config.idle_timeout_s:g} s without a complete line")
+        if self._accept_resting and self._accept_health.may_try() and self._listener is not None \
+                and self._selector is not None:
+            self._selector.register(self._listener, selectors.EVENT_READ, "listen")
+            self._accept_resting = False
+
+    def _rest_listener(self, exc: OSError) -> None:
+        """accept() is out of descriptors or memory: stop listening until the back-off has run out."""
+        self._accept_health.failed(f"cannot accept connections: {exc.strerror or exc}")
+        if not self._accept_resting and self._selector is not None and self._listener is not None:
+            self._selector.unregister(self._listener)
+            self._accept_resting = True
 
     def _drain_wake(self) -> None:
         # Drain first, then clear the flag: a tick that sets the flag and sends its byte during the drain
@@ -219,18 +230,27 @@ class NovaTcpServer:
                 sock, address = self._listener.accept()
             except (BlockingIOError, InterruptedError):
                 return
-            except OSError as exc:  # e.g. out of file descriptors: try again on the next event
-                self._refusals.warning("accept", "TCP accept failed: %s", exc)
+            except OSError as exc:
+                if exc.errno in _RESOURCE_ERRNOS:
+                    self._rest_listener(exc)
+                else:  # the peer gave up between connect and accept (ECONNABORTED ...): the next one
+                    self._refusals.warning("accept", "TCP accept failed: %s", exc)
                 return
-            peer = _label(address)
-            reason = None
-            if not self.config.allows(address[0]):
-                reason = "not in [tcp] allow"
-            elif len(self._clients) >= self.max_clients:
-                reason = f"already {self.max_clients} clients"
-            if reason is not None:
+            self._accept_health.succeeded()
+            peer = peer_label(address)
+            key = TcpConfig.peer_key(address[0])
+            refusal = admission_refusal(self.config, self._per_address[key], len(self._clients),
+                                        self.max_clients, address[0])
+            if refusal is not None:
+                reason, line = refusal
+                if line is not None:
+                    try:
+                        sock.setblocking(False)
+                        sock.send(line.encode("ascii") + CRLF)
+                    except OSError:
+                        pass
                 sock.close()
-                self._refusals.warning(address[0], "TCP connection from %s refused: %s", peer, reason)
+                self._refusals.warning(key, "TCP connection from %s refused: %s", peer, reason)
                 self.core.events.add(self.core.clock.now(), Direction.INFO, "note", f"connection refused: {reason}",
                                      client=peer, accepted=False)
                 self.stats.refused += 1  # counted once it is on record (log and event stream)
@@ -239,8 +259,9 @@ class NovaTcpServer:
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             if self.send_buffer_bytes:
                 sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, self.send_buffer_bytes)
-            client = _Client(sock, peer)
+            client = Connection(sock, peer, key, self.core.clock.monotonic())
             self._clients.add(client)
+            self._per_address[key] += 1
             self._selector.register(sock, client.mask, client)
             self.stats.accepted += 1
             log.info("TCP client %s connected", peer)
@@ -248,7 +269,7 @@ class NovaTcpServer:
             self._queue(client, GREETING.encode("ascii") + CRLF)
             self._pump(client)
 
-    def _service(self, client: _Client, mask: int) -> None:
+    def _service(self, client: Connection, mask: int) -> None:
         if mask & selectors.EVENT_READ and not client.inbox and not client.eof:
             try:
                 data = client.sock.recv(RECV_BYTES)
@@ -263,18 +284,21 @@ class NovaTcpServer:
                 client.inbox.extend(client.splitter.feed(data))
         self._pump(client)
 
-    def _handle_lines(self, client: _Client) -> None:
+    def _handle_lines(self, client: Connection) -> None:
         while client.inbox and len(client.out) < COMMAND_HIGH_WATER and not client.closing:
             item = client.inbox.popleft()
-            if client.watching:  # any line ends WATCH
+            client.last_line = self.core.clock.monotonic()
+            reply: Reply | None
+            if client.watching:  # any line ends WATCH, and is not executed
                 client.watching = False
                 self._watching.discard(client)
-            reply: Reply | None
-            if item is None:
+                reply = Reply(("OK",))
+            elif item is None:
                 reply = self.protocol.too_long(MAX_LINE_BYTES)
             else:
                 try:
-                    reply = self.protocol.handle(item.decode("ascii", errors="replace"), client.peer)
+                    reply = self.protocol.handle(item.decode("ascii", errors="replace"), client.peer,
+                                                 rate_key=f"tcp {client.address}")
                 except Exception:
                     log.exception("TCP command from %s failed", client.peer)
                     reply = Reply(("ERROR internal error",))
@@ -288,12 +312,12 @@ class NovaTcpServer:
                 client.closing = True
                 client.inbox.clear()
 
-    def _queue(self, client: _Client, data: bytes) -> None:
+    def _queue(self, client: Connection, data: bytes) -> None:
         client.out += data
         if len(client.out) > self.stats.max_buffered:
             self.stats.max_buffered = len(client.out)
 
-    def _send(self, client: _Client) -> bool:
+    def _send(self, client: Connection) -> bool:
         """Send what the socket takes now; False when the connection was closed."""
         while client.out:
             try:
@@ -306,7 +330,7 @@ class NovaTcpServer:
             del client.out[:sent]
         return True
 
-    def _pump(self, client: _Client) -> None:
+    def _pump(self, client: Connection) -> None:
         """Send what waits, handle received lines while there is room, then choose what to wait for."""
         while not client.closed:
             if not self._send(client):
@@ -348,11 +372,15 @@ class NovaTcpServer:
                 self._pump(client)
             self.stats.delivered += 1
 
-    def _close(self, client: _Client, reason: str, accepted: bool | None = None) -> None:
+    def _close(self, client: Connection, reason: str, accepted: bool | None = None) -> None:
         if client.closed:
             return
         client.closed = True
-        self._clients.discard(client)
+        if client in self._clients:
+            self._clients.discard(client)
+            self._per_address[client.address] -= 1
+            if self._per_address[client.address] <= 0:
+                del self._per_address[client.address]
         self._watching.discard(client)
         if self._selector is not None:
             try:

@@ -79,7 +79,7 @@ def test_table_entries_are_complete() -> None:
             assert entry.lo is not None and entry.hi is not None, entry.name
         if entry.kind in ("choice", "choices"):
             assert entry.choices, entry.name
-    assert keys_of("tcp") == ("enabled", "host", "port", "allow")
+    assert keys_of("tcp") == ("enabled", "host", "port", "allow", "max_clients", "max_per_address", "idle_timeout_s")
     assert keys_of("easycomm") == ("enabled", "device", "baud", "rate_hz", "uplink")
 
 

@@ -122,7 +122,8 @@ def test_watch_streams_every_published_string_until_a_line_arrives(tcp_station, 
     assert wait_for(lambda: server.watcher_count() == 1)
     station.run(2.0)  # 11 ticks at 5 Hz
     assert [client.text() for _ in published] == published and len(published) == 11
-    client.send(b"\r\n")  # any line, even an empty one, ends WATCH
+    client.send(b"\r\n")  # any line, even an empty one, ends WATCH: answered OK, not executed
+    assert client.text() == "OK"
     assert wait_for(lambda: server.watcher_count() == 0)
     station.run(1.0)
     assert client.ask("QUIT") == "OK"

@@ -1,0 +1,79 @@
+"""One connection of Nova's TCP server and the server's counters (owned by the ``nfw-tcp`` thread)."""
+
+from __future__ import annotations
+
+import selectors
+import socket
+from collections import deque
+from dataclasses import dataclass
+
+from nfwserver.config.schema import TcpConfig
+from nfwserver.tcp.line_splitter import MAX_LINE_BYTES, LineSplitter
+
+__all__ = ["Connection", "TcpStats", "admission_refusal", "bind_listener", "peer_label"]
+
+
+@dataclass
+class TcpStats:
+    accepted: int = 0
+    refused: int = 0  #: peers not allowed, or over a connection cap
+    idle_closed: int = 0  #: connections closed for completing no line within the idle timeout
+    dropped: int = 0  #: watching clients dropped for not reading
+    lost: int = 0  #: published strings lost because the loop fell PUBLISHED_BACKLOG behind
+    delivered: int = 0  #: published strings handed to the watchers
+    max_buffered: int = 0  #: the most bytes ever waiting for one client
+
+
+class Connection:
+    """One connection; owned by the ``nfw-tcp`` thread."""
+
+    def __init__(self, sock: socket.socket, peer: str, address: str, now: float) -> None:
+        self.sock = sock
+        self.peer = peer
+        self.address = address  #: the peer's address, one key per host (TcpConfig.peer_key)
+        self.last_line = now  #: clock monotonic seconds of the last complete line (or of the connect)
+        self.splitter = LineSplitter(MAX_LINE_BYTES)
+        self.inbox: deque[bytes | None] = deque()  # received lines not handled yet (one read's worth)
+        self.out = bytearray()
+        self.mask = selectors.EVENT_READ
+        self.watching = False
+        self.closing = False  # QUIT: close once the output is sent
+        self.eof = False  # the client shut its side: answer what it sent, then close (unless watching)
+        self.closed = False
+
+
+def peer_label(address: tuple) -> str:
+    host, port = address[0], address[1]
+    return f"tcp [{host}]:{port}" if ":" in host else f"tcp {host}:{port}"
+
+
+
+def admission_refusal(config: TcpConfig, from_address: int, connected: int, max_clients: int,
+                      address: str) -> tuple[str, str | None] | None:
+    """Why a new connection from ``address`` (already holding ``from_address`` of the ``connected``
+    ones) is refused, as (log reason, line sent to the peer or None to close without a word); None to serve it."""
+    key = TcpConfig.peer_key(address)
+    if not config.allows(address):
+        return "not in [tcp] allow", None
+    if from_address >= config.max_per_address:
+        return (f"already {from_address} connections from {key}",
+                f"ERROR too many connections from {key} (at most {config.max_per_address})")
+    if connected >= max_clients:
+        return (f"already {max_clients} clients",
+                f"ERROR the station serves {max_clients} connections at most; try again later")
+    return None
+
+
+def bind_listener(host: str, port: int) -> socket.socket:
+    """A non-blocking listening socket on ``host``:``port`` (0: any free port); OSError when it cannot bind."""
+    family, _, _, _, sockaddr = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)[0]
+    listener = socket.socket(family, socket.SOCK_STREAM)
+    try:
+        listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        listener.bind(sockaddr)
+        listener.listen(64)
+        listener.setblocking(False)
+    except OSError:
+        listener.close()
+        raise
+    return listener

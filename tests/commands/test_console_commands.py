@@ -1,0 +1,33 @@
+"""The console's input line goes through the command table too (issue 24): HELP lists what it takes,
+FLIP without a rotor says so, SAT= by a unique name works, TRACK ON without a rotor warns."""
+
+from __future__ import annotations
+
+import asyncio
+
+from nfwserver.commands.help_text import help_lines
+from nfwserver.commands.table import Face
+from nfwserver.console.app import NfwConsole
+from tests.app.console_helpers import log_text, settle
+from tests.dde.conftest import ISS, make_station
+
+
+def test_console_help_flip_name_and_track_warning() -> None:
+    station = make_station()
+    station.core.rotor_configured = False
+
+    async def scenario() -> None:
+        app = NfwConsole(station.core, favourites=(ISS,))
+        async with app.run_test(size=(120, 40)) as pilot:
+            await settle(app, pilot)
+            for text in ("help", "flip on", "SAT=oao 2", "TRACK ON"):
+                await pilot.press(*text, "enter")
+                await pilot.pause(0.1)
+            shown = " ".join(log_text(app, "incoming").split())
+            for line in help_lines(Face.CONSOLE):
+                assert " ".join(line.split()) in shown
+            assert "no rotor is configured" in shown
+            assert "warning: TRACK ON with no rotor configured" in shown
+            assert station.core.state.catalog_number == 3597
+
+    asyncio.run(scenario())
