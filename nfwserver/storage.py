@@ -49,7 +49,7 @@ def _create_like(tmp: Path, target: Path) -> int:
     return fd
 
 
-def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> None:
+def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
     """Replace ``path`` with ``data`` atomically, keeping its permissions."""
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
@@ -74,7 +74,7 @@ def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> None:
                 os.close(dir_fd)
 
 
-def atomic_write_text(path: str | os.PathLike, text: str) -> None:
+def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
     atomic_write_bytes(path, text.encode("utf-8"))
 
 
@@ -91,7 +91,7 @@ def _pid_running(pid: int) -> bool | None:
     return True
 
 
-def remove_stale_temporaries(path: str | os.PathLike, now: float | None = None) -> list[Path]:
+def remove_stale_temporaries(path: str | os.PathLike[str], now: float | None = None) -> list[Path]:
     """Remove temporaries of ``path`` left by writers that are gone; returns what was removed.
 
     ``now`` (POSIX seconds, for the age rule) defaults to the file system's idea of the present.

@@ -17,6 +17,7 @@ threads.  :meth:`start` and :meth:`stop` are idempotent.
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 
 from nfwserver.app.config_watcher import ConfigWatcher
 from nfwserver.app.devices import make_radio, make_rotor
@@ -92,7 +93,7 @@ class Station:
                           set_flip=self.rotor.set_flip_mode if self.rotor is not None else None)
             if config.tcp.enabled else None)
         self.watcher: ConfigWatcher | None = None
-        self._unsubscribe: list = []
+        self._unsubscribe: list[Callable[[], None]] = []
         self._started = False
 
     # -- convenience views -------------------------------------------------------------------------

@@ -48,8 +48,8 @@ def _text_of(pieces: list[np.ndarray]) -> str:
     block = np.concatenate(pieces, axis=1)
     codes = block[block != 0]
     if codes.dtype == np.uint8:
-        return codes.tobytes().decode("ascii")
-    return codes.astype("<u4").tobytes().decode("utf-32-le")
+        return str(codes.tobytes().decode("ascii"))
+    return str(codes.astype("<u4").tobytes().decode("utf-32-le"))
 
 
 def _column(text: str, rows: int) -> np.ndarray:

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = subparsers.add_parser("config", help="configuration file: path, init, show",
                               description="Manage the configuration file.")
     sub = p.add_subparsers(dest="config_action", metavar="ACTION", required=True)

@@ -21,7 +21,7 @@ def _common(p: argparse.ArgumentParser) -> None:
                    help="give up after this long (default 5)")
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     from nfwserver.commands.help_text import poke_epilog
 
     p = subparsers.add_parser(

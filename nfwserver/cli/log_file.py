@@ -47,7 +47,7 @@ class StationLogFile(logging.handlers.RotatingFileHandler):
         try:
             super().close()
         except OSError:  # the last buffered records could not be written either
-            self.stream = None  # type: ignore[assignment]
+            self.stream = None
 
     def _open(self) -> io.TextIOWrapper:
         Path(self.baseFilename).parent.mkdir(parents=True, exist_ok=True)
@@ -73,7 +73,7 @@ class StationLogFile(logging.handlers.RotatingFileHandler):
         self.dropped += 1
         error = sys.exc_info()[1]
         reason = getattr(error, "strerror", None) or str(error) or type(error).__name__
-        stream, self.stream = self.stream, None  # type: ignore[assignment]
+        stream, self.stream = self.stream, None
         if stream is not None:  # reopened on the next try; buffered bytes are part of what was lost
             try:
                 stream.close()

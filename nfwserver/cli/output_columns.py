@@ -51,7 +51,8 @@ def codes_of(texts: Sequence[str]) -> np.ndarray:
     width = max(1, *map(len, texts)) if texts else 1
     joined = "".join(text.ljust(width, "\0") for text in texts)
     if joined.isascii():
-        return np.frombuffer(joined.encode("ascii"), dtype=np.uint8).reshape(len(texts), width).copy()
+        codes: np.ndarray = np.frombuffer(joined.encode("ascii"), dtype=np.uint8).reshape(len(texts), width)
+        return np.array(codes)
     return np.frombuffer(joined.encode("utf-32-le"), dtype="<u4").reshape(len(texts), width).astype(np.uint32)
 
 
@@ -208,7 +209,8 @@ class Duration(Number):
         return len(self.empty)
 
     def _values(self, rows: slice) -> np.ndarray:
-        return (self.later.epoch_us(rows) - self.earlier.epoch_us(rows)) / 1e6
+        seconds: np.ndarray = (self.later.epoch_us(rows) - self.earlier.epoch_us(rows)) / 1e6
+        return seconds
 
 
 class Flag(Column):
@@ -240,7 +242,8 @@ def epoch_us_after(start: datetime, seconds: np.ndarray) -> np.ndarray:
     tie = np.abs(sub) == 0.5
     step = np.where(np.abs(sub) >= 0.5, np.sign(sub), 0.0).astype(np.int64)
     step = np.where(tie & (total % 2 == 0), 0, step)
-    return (start - _EPOCH) // timedelta(microseconds=1) + total + step
+    micros: np.ndarray = (start - _EPOCH) // timedelta(microseconds=1) + total + step
+    return micros
 
 
 def _fill(cells: Cells, where: np.ndarray, text: str) -> None:

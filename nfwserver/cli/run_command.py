@@ -28,7 +28,7 @@ if TYPE_CHECKING:
 log = logging.getLogger("nfwserver")
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = subparsers.add_parser(
         "run", help="run the server (console on a terminal, or --headless)",
         description="Run the Nova-compatible DDE server with the configuration file (see `nfwserver config path`), "
@@ -72,7 +72,7 @@ class RunPlan:
     clock: Clock | None = None
     transport: Any = None  #: a DDE server transport (default: the platform's)
     make_console: Callable[..., Any] | None = None  #: builds the console app (default: NfwConsole)
-    console_options: dict | None = None  #: passed to the app's run() (tests: headless=True)
+    console_options: dict[str, Any] | None = None  #: passed to the app's run() (tests: headless=True)
     stop: threading.Event | None = None  #: set to stop (default: set by SIGINT/SIGTERM)
 
 

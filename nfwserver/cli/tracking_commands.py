@@ -14,12 +14,16 @@ from __future__ import annotations
 import argparse
 import sys
 from datetime import datetime, timedelta
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from nfwserver.cli.arguments import number_in, satellite_value, time_value
 from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs, warn
 
 if TYPE_CHECKING:
+    from collections.abc import Iterable
+
+    from nfwserver.tracking.catalog import Catalog, Satellite
+    from nfwserver.tracking.observer import Observer
     from nfwserver.tracking.pass_records import PassList
 
 EPHEMERIS_COLUMNS = ["time_utc", "azimuth_deg", "elevation_deg", "range_km", "range_rate_km_s", "above_horizon"]
@@ -30,7 +34,7 @@ TIME_HELP = "'now' (default), relative (+2h, -30m, +90s, +1d) or ISO-8601 (UTC w
 MAX_DURATION_S = 366 * 86400.0
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = subparsers.add_parser("ephemeris", help="position table of one satellite",
                               description="Look angles of one satellite at regular steps (InstantTrack's table). "
                               "Defaults: the configured observer, horizon, catalog and satellite, from now.")
@@ -61,7 +65,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run_visible)
 
 
-def _pick(catalog, text: str):
+def _pick(catalog: Catalog, text: str) -> Satellite:
     """The satellite ``text`` names (catalog number, DDE or element name); CliError when absent."""
     from nfwserver.cli import CliError
 
@@ -71,7 +75,7 @@ def _pick(catalog, text: str):
     return sat
 
 
-def _screen(sats: list, catalog, observer, ut1_utc: float, at: datetime) -> list:
+def _screen(sats: list[Any], catalog: Catalog, observer: Observer, ut1_utc: float, at: datetime) -> list[Any]:
     """The satellites (or element sets) whose positions at ``at`` are usable; the rest and stale sets are
     reported (by DDE name)."""
     from nfwserver.tracking.screening import STALE_AFTER_DAYS, stale_satellites, usable_mask
@@ -91,15 +95,20 @@ def _screen(sats: list, catalog, observer, ut1_utc: float, at: datetime) -> list
     return sats
 
 
-def _dde_names(sats: list, catalog) -> str:
+def _dde_names(sats: list[Any], catalog: Catalog) -> str:
     """The DDE names of satellites or element sets (those of the catalog's satellites), comma-separated."""
-    return ", ".join(s.dde_name if hasattr(s, "dde_name") else catalog.get(s.catalog_number).dde_name for s in sats)
+    return ", ".join(s.dde_name if hasattr(s, "dde_name") else _dde_name(catalog, s.catalog_number) for s in sats)
 
 
-def _display_names(numbers, sets: list, catalog) -> list[str]:
+def _dde_name(catalog: Catalog, catalog_number: int) -> str:
+    sat = catalog.get(catalog_number)
+    return sat.dde_name if sat is not None else str(catalog_number)
+
+
+def _display_names(numbers: Iterable[int], sets: list[Any], catalog: Catalog) -> list[str]:
     """The name shown for each catalog number: the element set's name, else the satellite's DDE name."""
     by_number = {es.catalog_number: es for es in sets}
-    return [by_number[n].name or catalog.get(n).dde_name for n in numbers]
+    return [by_number[n].name or _dde_name(catalog, n) for n in numbers]
 
 
 def run_ephemeris(args: argparse.Namespace) -> int:

@@ -152,7 +152,7 @@ def warn(message: str) -> None:
     print(f"nfwserver: {message}", file=sys.stderr)
 
 
-def config_file(config) -> str:
+def config_file(config: Config) -> str:
     """The configuration file ``config`` came from, or the file the user would create."""
     if not config.source.startswith("<"):
         return config.source
@@ -161,7 +161,7 @@ def config_file(config) -> str:
     return str(default_config_path())
 
 
-def _load_config(args: argparse.Namespace):
+def _load_config(args: argparse.Namespace) -> Config:
     from nfwserver.cli import CliError
     from nfwserver.config import ConfigError, load_config
 
@@ -188,7 +188,7 @@ def _catalog_from_files(paths: list[str], inputs: TrackingInputs) -> Catalog:
     return Catalog(sets, dde_names=inputs.config().dde_names)
 
 
-def _station_catalog(config) -> Catalog:
+def _station_catalog(config: Config) -> Catalog:
     from nfwserver.app.station_catalog import configured_store, load_station_catalog
     from nfwserver.cli import CliError
 

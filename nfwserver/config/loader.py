@@ -86,7 +86,7 @@ def _exposure(host: str) -> str | None:
 class _Reading:
     """One pass over a parsed TOML document: converted values by (section, key) and the problems."""
 
-    def __init__(self, doc: dict, base: Path) -> None:
+    def __init__(self, doc: dict[str, Any], base: Path) -> None:
         self.base = base
         self.problems: list[str] = []
         self.values: dict[tuple[str, str], Any] = {}
@@ -131,7 +131,8 @@ class _Reading:
         if ("observer", "location") in self.present:
             if coords:
                 self.problems.append(f"[observer]: give location or {', '.join(coords)}, not both")
-            return self.get("observer", "location")
+            location: Observer | None = self.get("observer", "location")
+            return location
         if not coords or "observer" in self.dirty or any(not self.given("observer", k) for k in coords):
             return None
         missing = [k for k in ("latitude_deg", "longitude_deg") if not self.given("observer", k)]

@@ -15,7 +15,8 @@ from typing import Any
 
 from nfwserver.config.kinds import CHANNEL_KEYS
 from nfwserver.config.schema import Config
-from nfwserver.config.table import SECTIONS, SETTINGS, Setting
+from nfwserver.config.setting import Setting
+from nfwserver.config.table import SECTIONS, SETTINGS
 from nfwserver.radio.transponder import Channel
 from nfwserver.tracking.horizon import HorizonTable
 

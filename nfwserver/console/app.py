@@ -25,6 +25,7 @@ import threading
 from collections.abc import Callable, Mapping
 from datetime import datetime, tzinfo
 from functools import partial
+from typing import Any
 
 from rich.text import Text
 from textual.app import App, ComposeResult
@@ -64,7 +65,7 @@ NARROW_COLUMNS = 110
 SHORT_LINES = 34
 
 
-class NfwConsole(App):
+class NfwConsole(App[None]):
     """The console; give it the running station's core and adapters."""
 
     TITLE = "nfwserver"
@@ -111,7 +112,7 @@ class NfwConsole(App):
         self._lock = threading.Lock()
         self._unsubscribe: Callable[[], None] | None = None
         self._search: PassSearch | None = None
-        self._search_key: tuple | None = None
+        self._search_key: tuple[Any, ...] | None = None
         self._shown_log = "incoming"
 
     # -- layout -------------------------------------------------------------------------------
@@ -243,7 +244,7 @@ class NfwConsole(App):
         self.run_worker(partial(self._search_thread, *args), thread=True, group="passes", exclusive=True,
                         exit_on_error=False)
 
-    def _search_thread(self, *args) -> None:  # worker thread
+    def _search_thread(self, *args: Any) -> None:  # worker thread
         try:
             result = search_passes(*args)
         except Exception:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from rich.text import Text
 from textual.app import ComposeResult
@@ -63,9 +64,9 @@ def search(index: Sequence[Entry], query: str, first: Sequence[int] = (), limit:
                 break
             shown.append(entry)
         return shown, len(index)
-    exact: list = []
-    prefix: list = []
-    other: list = []
+    exact: list[Any] = []
+    prefix: list[Any] = []
+    other: list[Any] = []
     digits = text.isascii() and text.isdigit()
     for e in index:
         if digits and str(e.catalog_number).startswith(text):

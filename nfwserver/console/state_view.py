@@ -19,6 +19,7 @@ from datetime import datetime
 
 from rich.text import Text
 
+from nfwserver.console.time_display import TimeDisplay
 from nfwserver.core.station_core import CoreSnapshot, StationCore
 from nfwserver.core.status import describe
 from nfwserver.radio.coupling import RadioCoupling
@@ -164,6 +165,6 @@ def outputs_line(tcp: object | None, easycomm: object | None) -> Text | None:
     return parts if parts else None
 
 
-def status_line(snap: CoreSnapshot, times, now: datetime) -> Text:
+def status_line(snap: CoreSnapshot, times: TimeDisplay, now: datetime) -> Text:
     status = ", ".join(describe(snap.status)) or "ok"
     return Text(f"Status 0x{snap.status:04X}: {status}  {snap.state.rate_hz:g} Hz  {times.stamp(now)}")

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import ctypes
 import sys
+from typing import Any
 
 # Transaction classes and flags.
 XCLASS_BOOL = 0x1000
@@ -97,7 +98,7 @@ class ConvInfo(ctypes.Structure):  # pragma: no cover - layout of ddeml.h's CONV
                 ("ConvCtxt", ctypes.c_uint32 * 9), ("hwnd", ctypes.c_void_p), ("hwndPartner", ctypes.c_void_p)]
 
 
-def load_user32():  # pragma: no cover - Windows only
+def load_user32() -> Any:  # pragma: no cover - Windows only
     """user32 with the DDEML prototypes set; raises OSError off Windows."""
     if sys.platform != "win32":
         raise OSError("DDEML exists only on Windows")

@@ -15,6 +15,7 @@ import logging
 import queue
 import socket
 import threading
+from typing import Any
 
 from nfwserver.dialects.predict_protocol import END_OF_LISTING, PredictContext, PredictProtocol
 
@@ -36,7 +37,7 @@ class PredictUdpServer:
         self.sock: socket.socket | None = None
         self.address: tuple[str, int] = (host, port)
         self._stop = threading.Event()
-        self._listings: queue.Queue = queue.Queue(maxsize=LISTING_QUEUE)
+        self._listings: queue.Queue[Any] = queue.Queue(maxsize=LISTING_QUEUE)
         self._thread = threading.Thread(target=self._run, name="nfw-predict", daemon=True)
         self._lister = threading.Thread(target=self._run_listings, name="nfw-predict-list", daemon=True)
 

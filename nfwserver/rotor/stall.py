@@ -18,6 +18,7 @@ Times are ``clock.monotonic()`` seconds; angles are the rotor frame, degrees.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Protocol, runtime_checkable
 
@@ -110,7 +111,7 @@ class StallWatch:
         self.progressed = all(self._moved[:axes])
         return self._declare(newly)
 
-    def _declare(self, axes) -> list[int]:
+    def _declare(self, axes: Iterable[int]) -> list[int]:
         newly = [i for i in axes if not self.stalled[i]]
         for i in newly:
             self.stalled[i] = True

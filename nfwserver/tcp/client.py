@@ -7,6 +7,7 @@ socket code (README).  Timeouts are real seconds: this runs in a separate, short
 from __future__ import annotations
 
 import socket
+from typing import BinaryIO
 
 from nfwserver.tcp.greeting import GREETING
 
@@ -24,8 +25,8 @@ def connect_host(listen_host: str) -> str:
     return listen_host
 
 
-def _read_line(stream, where: str) -> str:
-    raw = stream.readline(4096)
+def _read_line(stream: BinaryIO, where: str) -> str:
+    raw: bytes = stream.readline(4096)
     if not raw:
         raise StationUnreachable(f"the station at {where} closed the connection "
                                  "(is this machine's address in its [tcp] allow list?)")

@@ -6,6 +6,7 @@ import selectors
 import socket
 from collections import deque
 from dataclasses import dataclass
+from typing import Any
 
 from nfwserver.config.schema import TcpConfig
 from nfwserver.tcp.line_splitter import MAX_LINE_BYTES, LineSplitter
@@ -42,7 +43,7 @@ class Connection:
         self.closed = False
 
 
-def peer_label(address: tuple) -> str:
+def peer_label(address: tuple[Any, ...]) -> str:
     host, port = address[0], address[1]
     return f"tcp [{host}]:{port}" if ":" in host else f"tcp {host}:{port}"
 

@@ -24,6 +24,7 @@ import os
 from collections.abc import Callable
 from datetime import datetime, timedelta
 from pathlib import Path
+from typing import Any
 
 from nfwserver.tracking import amsat, omm
 from nfwserver.tracking.element_names import MAX_NAME_LENGTH, sanitize_element_name
@@ -107,7 +108,7 @@ def _load_three_line_file(lines: list[str], source: str, result: LoadResult) -> 
     if (":" in all_names and any([amsat.is_satellite_line(x) for x in names])) or (
             "NORAD_CAT_ID" in all_names and any([is_csv_header(x) for x in names])):
         return False
-    pending: list = [(sanitize_element_name(_clean_name(name)), 3 * k + 1, one, two.rstrip())
+    pending: list[Any] = [(sanitize_element_name(_clean_name(name)), 3 * k + 1, one, two.rstrip())
                      for k, (name, one, two) in enumerate(zip(names, ones, twos))]
     _build_tles(pending, source, result)
     return True
@@ -116,7 +117,7 @@ def _load_three_line_file(lines: list[str], source: str, result: LoadResult) -> 
 def _load_lines(lines: list[str], source: str, result: LoadResult) -> None:
     i = 0
     n = len(lines)
-    pending: list = []  # TLE pairs (and their structural rejections) not yet built, in file order
+    pending: list[Any] = []  # TLE pairs (and their structural rejections) not yet built, in file order
     while i < n:
         line = lines[i].rstrip()
         if TLE_LIKE.match(line):
@@ -148,7 +149,7 @@ def _accept(result: LoadResult, source: str, line: int, prefix: str, build: Call
         result.rejected.append(Rejection(source, line, f"{prefix}these elements cannot be used ({exc})"))
 
 
-def _take_tle(lines: list[str], i: int, source: str, pending: list) -> int:
+def _take_tle(lines: list[str], i: int, source: str, pending: list[Any]) -> int:
     """Queue the TLE pair at ``lines[i]`` (with its name line) or its structural rejection."""
     line1 = lines[i].rstrip()
     name = ""
@@ -166,7 +167,7 @@ def _take_tle(lines: list[str], i: int, source: str, pending: list) -> int:
     return i + 2
 
 
-def _build_tles(pending: list, source: str, result: LoadResult) -> None:
+def _build_tles(pending: list[Any], source: str, result: LoadResult) -> None:
     """Build the queued TLE sets: canonical ones checked and read in bulk (:mod:`~nfwserver.tracking.tle_bulk`),
     the rest one by one by :func:`~nfwserver.tracking.tle.parse_tle`, which names what is wrong.  1024 at a
     time: the temporary values of a block are freed before the next (a catalog's would take ~8 MiB)."""
@@ -176,7 +177,7 @@ def _build_tles(pending: list, source: str, result: LoadResult) -> None:
     pending.clear()
 
 
-def _build_block(pending: list, source: str, result: LoadResult, years: dict[int, datetime]) -> None:
+def _build_block(pending: list[Any], source: str, result: LoadResult, years: dict[int, datetime]) -> None:
     pairs = [p for p in pending if not isinstance(p, Rejection)]
     good, values = read_canonical([p[2] for p in pairs], [p[3] for p in pairs])
     rows = zip(*(values[c].tolist() for c in _BULK_COLUMNS)) if values else iter(())
@@ -280,7 +281,7 @@ def _load_json(text: str, source: str, result: LoadResult) -> Rejection | None:
     return None
 
 
-def _add_omm(record: dict, source: str, line: int, result: LoadResult, what: str = "") -> None:
+def _add_omm(record: dict[str, Any], source: str, line: int, result: LoadResult, what: str = "") -> None:
     def build() -> ElementSet:
         name, fields = omm.omm_fields(record)
         return ElementSet.from_fields(name, fields, source, line)
@@ -288,7 +289,7 @@ def _add_omm(record: dict, source: str, line: int, result: LoadResult, what: str
     _accept(result, source, line, f"{what}: " if what else "", build)
 
 
-def load_element_file(path: str | os.PathLike) -> LoadResult:
+def load_element_file(path: str | os.PathLike[str]) -> LoadResult:
     """Load a file; an unreadable file gives one :class:`Rejection` (line 0), never an exception."""
     try:
         data = Path(path).read_bytes()

@@ -18,6 +18,8 @@ Times are seconds after the start of the search span; :func:`assemble` hands bac
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from nfwserver.tracking.pass_batch import Layout
@@ -29,7 +31,7 @@ from nfwserver.tracking.pass_screen import Brackets, Intervals
 _SHORT_PASS_S = 1800.0
 
 
-def _events(ev: PairEvaluator, br: Brackets, flat: bool, layout: Layout):
+def _events(ev: PairEvaluator, br: Brackets, flat: bool, layout: Layout) -> tuple[Any, ...]:
     """Refined crossings (sat, t, rising, az, el, el rate), the maxima of the hidden peaks that rose,
     and the refined culminations (t, el)."""
     cr, pk, cu = br.crossings, br.peaks, br.culminations
@@ -208,7 +210,8 @@ def _owner(p_sat: np.ndarray, lo: np.ndarray, hi: np.ndarray, sat: np.ndarray, a
     return np.where(ok, i, -1)
 
 
-def _records(p_sat, p_rise, p_set, t, az, tca_t, tca_el, catalog_numbers: np.ndarray, win_lo: np.ndarray
+def _records(p_sat: np.ndarray, p_rise: np.ndarray, p_set: np.ndarray, t: np.ndarray, az: np.ndarray,
+             tca_t: np.ndarray, tca_el: np.ndarray, catalog_numbers: np.ndarray, win_lo: np.ndarray
              ) -> dict[str, np.ndarray]:
     """PassList columns (times in s after the window start, ``win_lo`` after the search start)."""
     rise, fall = p_rise >= 0, p_set >= 0

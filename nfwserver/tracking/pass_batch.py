@@ -14,6 +14,7 @@ Times are seconds after each satellite's own reference instant (the start of its
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -38,7 +39,8 @@ class Layout:
         """``sat * KEY_SPACING + t`` with each satellite's index within its chunk: sortable (sat, t) keys of
         one chunk, rounded exactly as a search of that chunk alone rounds them."""
         first = self.chunk_starts[np.searchsorted(self.chunk_starts, sat, side="right") - 1]
-        return (sat - first) * KEY_SPACING + t
+        keys: np.ndarray = (sat - first) * KEY_SPACING + t
+        return keys
 
     def search(self, key_sat: np.ndarray, keys: np.ndarray, q_sat: np.ndarray, q_keys: np.ndarray,
                side: str) -> np.ndarray:
@@ -59,7 +61,7 @@ class Chunk:
     """One chunk's satellites (SGP4 models, catalog numbers), its reference instant (split UTC Julian date),
     span and window (s after the reference instant), and the brackets its screen found (chunk indices)."""
 
-    models: list
+    models: list[Any]
     catalog_numbers: np.ndarray
     jd0: float
     fr0: float
@@ -81,7 +83,7 @@ class Batch:
         br = chunk.brackets
         self.size += len(br.crossings) + len(br.peaks) + len(br.culminations)
 
-    def merged(self) -> tuple[list, np.ndarray, np.ndarray, Layout, Brackets]:
+    def merged(self) -> tuple[list[Any], np.ndarray, np.ndarray, Layout, Brackets]:
         """The batch's models, per-satellite reference instants (jd0, fr0), layout, and the brackets of
         every chunk with batch satellite indices."""
         counts = [len(c.models) for c in self.chunks]

@@ -17,6 +17,7 @@ when a step is final.  Times are seconds after a reference UTC instant.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -60,7 +61,7 @@ class Kinematics:
     up_accel: np.ndarray  #: its second derivative (km/s^2)
     f_accel_err: np.ndarray  #: bound on the error of ``f_accel`` from the approximate acceleration (deg/s^2)
     #: (e, n, e', n', e'', n'', e^2 + n^2, e e' + n n', SGP4 failed) for the azimuth's derivatives
-    plane: tuple = field(default=(), repr=False)
+    plane: tuple[Any, ...] = field(default=(), repr=False)
     _az_rates: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
 
     @classmethod
@@ -117,7 +118,7 @@ class PairEvaluator:
     array holding each satellite's own (searches of several groups refined together); ``ut1_utc`` seconds.
     """
 
-    def __init__(self, satrecs: list, observer: Observer, jd0: float | np.ndarray, fr0: float | np.ndarray,
+    def __init__(self, satrecs: list[Any], observer: Observer, jd0: float | np.ndarray, fr0: float | np.ndarray,
                  ut1_utc: float, horizon: HorizonTable) -> None:
         self.satrecs = satrecs
         self.frame = TopocentricFrame(observer)
@@ -198,14 +199,14 @@ class PairEvaluator:
         return topocentric_derivatives(self.frame, self.horizon, (x, y, r[:, 2]), vel, err)
 
 
-def _project(axes: tuple, x: np.ndarray, y: np.ndarray, z: np.ndarray
+def _project(axes: tuple[Any, ...], x: np.ndarray, y: np.ndarray, z: np.ndarray
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(east, north, up) components of the vectors (x, y, z) on the frame's ``axes``; a zero
     coefficient (the east axis has no z) is skipped."""
     return tuple(x * ax + y * ay + z * az if az else x * ax + y * ay for ax, ay, az in axes)
 
 
-def topocentric_derivatives(frame: TopocentricFrame, horizon: HorizonTable, pos: tuple, vel: tuple,
+def topocentric_derivatives(frame: TopocentricFrame, horizon: HorizonTable, pos: tuple[Any, ...], vel: tuple[Any, ...],
                             err: np.ndarray) -> Kinematics:
     """Angles and derivatives from Earth-fixed position (km) and velocity (km/s), each given as its
     (x, y, z) component arrays."""

@@ -26,6 +26,7 @@ Times are seconds after the search start; angles degrees.
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
+from typing import Any
 
 import numpy as np
 
@@ -82,7 +83,7 @@ class _Outputs:
                         np.full(n, np.nan), np.full(n, -np.inf), first.copy(), np.full(n, np.nan),
                         np.full(n, np.nan), np.full(n, np.nan)]
 
-    def store(self, where: np.ndarray, values: tuple, picked: np.ndarray) -> None:
+    def store(self, where: np.ndarray, values: tuple[Any, ...], picked: np.ndarray) -> None:
         """Write ``values[j][picked]`` (one array per column, in the order of :attr:`columns`) at ``where``."""
         for column, value in zip(self.columns, values):
             column[where] = value[picked]
@@ -239,4 +240,5 @@ def _round(ev: PairEvaluator, v: _Live, out: _Outputs, last: bool) -> np.ndarray
         done[:] = True
     if done.any():
         out.store(v.idx[done], (*values, v.best_f, v.best_t, v.best_up, v.best_up_accel, k.f_accel), done)
-    return done
+    finished: np.ndarray = done
+    return finished

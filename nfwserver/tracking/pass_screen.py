@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from sgp4.api import SatrecArray
@@ -132,7 +133,7 @@ def _hermite_root(a: np.ndarray, b: np.ndarray, ya: np.ndarray, yb: np.ndarray, 
     return np.where(np.isfinite(x), a + x * h, np.nan)
 
 
-def screen(satrecs: list, frame: TopocentricFrame, horizon: HorizonTable, jd0: float, fr0: float,
+def screen(satrecs: list[Any], frame: TopocentricFrame, horizon: HorizonTable, jd0: float, fr0: float,
            span_s: float, coarse_step_s: float, fine_step_s: float, ut1_utc: float,
            evaluator: PairEvaluator) -> Brackets:
     """Brackets of every event of ``satrecs`` within ``[0, span_s]`` seconds after ``jd0 + fr0``."""
@@ -179,7 +180,7 @@ def screen(satrecs: list, frame: TopocentricFrame, horizon: HorizonTable, jd0: f
 
 
 def _earth_fixed(r: np.ndarray, v: np.ndarray, rotation: tuple[np.ndarray, np.ndarray, np.ndarray]
-                 ) -> tuple[tuple, tuple]:
+                 ) -> tuple[tuple[Any, ...], tuple[Any, ...]]:
     """Earth-fixed position (km) and velocity (km/s) components, each (sats, times), of TEME states (sats,
     times, 3) with the rotation's cosine, sine and rate (rad/s) at each time (as frames.teme_to_itrs)."""
     c, s, w = rotation
@@ -190,8 +191,8 @@ def _earth_fixed(r: np.ndarray, v: np.ndarray, rotation: tuple[np.ndarray, np.nd
     return (x, y, r[..., 2]), (c * vx + s * vy + w * y, ms * vx + c * vy - w * x, v[..., 2])
 
 
-def _visibility(frame: TopocentricFrame, horizon: HorizonTable, pos: tuple, vel: tuple, ok: np.ndarray,
-                ecc: np.ndarray, coarse_step_s: float) -> tuple[np.ndarray, np.ndarray]:
+def _visibility(frame: TopocentricFrame, horizon: HorizonTable, pos: tuple[Any, ...], vel: tuple[Any, ...],
+                ok: np.ndarray, ecc: np.ndarray, coarse_step_s: float) -> tuple[np.ndarray, np.ndarray]:
     """Which coarse intervals (sats, times - 1) may hold visibility, and each satellite's bound on how fast its
     visibility margin can shrink (rad/s), from Earth-fixed positions and velocities at the grid times."""
     obs = frame.origin
@@ -224,7 +225,7 @@ def _visibility(frame: TopocentricFrame, horizon: HorizonTable, pos: tuple, vel:
     return kept, bound
 
 
-def _coarse_kinematics(frame: TopocentricFrame, horizon: HorizonTable, pos: tuple, vel: tuple,
+def _coarse_kinematics(frame: TopocentricFrame, horizon: HorizonTable, pos: tuple[Any, ...], vel: tuple[Any, ...],
                        err: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None,
                                                  np.ndarray | None]:
     """f, df/dt and d(elevation)/dt (deg, deg/s), each (sats, times), at the coarse points of some satellites

@@ -34,6 +34,7 @@ import math
 import threading
 from collections.abc import Sequence
 from datetime import datetime, timedelta, timezone
+from typing import Any
 
 import numpy as np
 
@@ -64,7 +65,7 @@ _BATCH_BRACKETS = 10000
 
 #: Fork-time hand-over of the work to worker processes (Satrec objects cannot be pickled); set only
 #: for the duration of one parallel :func:`find_passes` call.
-_FORK_JOB: tuple | None = None
+_FORK_JOB: tuple[Any, ...] | None = None
 
 
 def _fork_worker(indices: list[int]) -> PassList:
@@ -74,7 +75,7 @@ def _fork_worker(indices: list[int]) -> PassList:
 
 
 def find_passes(
-    satellites: Sequence,
+    satellites: Sequence[Any],
     observer: Observer,
     start: datetime,
     end: datetime,
@@ -150,7 +151,7 @@ def find_passes(
     return PassList.concat(start, window_s, parts)
 
 
-def _orbits(satellites: Sequence) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _orbits(satellites: Sequence[Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Mean motion (rad/min, SGP4's ``no_kozai``), eccentricity and catalog number of every satellite, read
     from an :class:`~nfwserver.tracking.elements.ElementSet`'s fields without making its SGP4 model."""
     if all(hasattr(s, "mean_motion_rev_per_day") for s in satellites):
@@ -169,7 +170,7 @@ def _model(satellite: object) -> object:
     return transient() if transient is not None else getattr(satellite, "satrec", satellite)
 
 
-def _screen_chunk(satrecs: list, catalog_numbers: np.ndarray, observer: Observer, start: datetime, end: datetime,
+def _screen_chunk(satrecs: list[Any], catalog_numbers: np.ndarray, observer: Observer, start: datetime, end: datetime,
                   horizon: HorizonTable, ut1_utc: float, fine_step_s: float, coarse_step_s: float,
                   extension: float) -> Chunk:
     """One chunk of satellites screened over ``[start - extension, end + extension]``."""

@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import sgp4.api
 
@@ -76,7 +77,7 @@ def _warn(message: str) -> None:
     logging.getLogger(__name__).warning("%s", message)
 
 
-def python_parsed_twoline2rv(cls: type, line1: str, line2: str, whichconst: int = sgp4.api.WGS72):
+def python_parsed_twoline2rv(cls: type, line1: str, line2: str, whichconst: int = sgp4.api.WGS72) -> Any:
     """A ``cls`` (compiled ``Satrec``) initialised with ``sgp4init`` from the pure-Python TLE reader."""
     from sgp4 import model as python_model
 
