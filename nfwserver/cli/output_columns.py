@@ -186,7 +186,7 @@ class Time(Column):
 
     def cells(self, rows: slice, style: str) -> Cells:
         empty = self.empty[rows]
-        codes = _iso_codes(self.epoch_us(rows) // 1000, quoted=style == "json")
+        codes = iso_codes(self.epoch_us(rows) // 1000, quoted=style == "json")
         codes[empty] = 0
         cells = Cells(codes, np.where(empty, 0, codes.shape[1]), ~empty)
         if style == "json":
@@ -308,7 +308,7 @@ def _put(cells: Cells, row: int, text: str) -> None:
     cells.right[row] = text[:1].isdigit() or text[:1] == "-"
 
 
-def _iso_codes(ms: np.ndarray, quoted: bool = False) -> np.ndarray:
+def iso_codes(ms: np.ndarray, quoted: bool = False) -> np.ndarray:
     """``YYYY-MM-DDTHH:MM:SS.mmmZ`` of milliseconds since 1970 (proleptic Gregorian, years 1..9999), in double
     quotes if ``quoted``."""
     days, ms_of_day = ms // 86_400_000, ms % 86_400_000

@@ -22,6 +22,7 @@ from nfwserver.cli.tracking_options import add_tracking_options, format_time, lo
 if TYPE_CHECKING:
     from collections.abc import Iterable
 
+    from nfwserver.cli.tracking_options import TrackingInputs
     from nfwserver.tracking.catalog import Catalog, Satellite
     from nfwserver.tracking.observer import Observer
     from nfwserver.tracking.pass_records import PassList
@@ -46,14 +47,35 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
                    metavar="SECONDS")
     p.set_defaults(func=run_ephemeris, usage_error=p.error)
 
-    p = subparsers.add_parser("passes", help="AOS/TCA/LOS of satellites over a window",
-                              description="Passes over the horizon table; all satellites when no --sat is given. "
-                              "A pass already in progress at the start is marked (in_progress Y).")
+    p = subparsers.add_parser(
+        "passes", help="AOS/TCA/LOS of satellites over a window (what can I work today?)",
+        description="Passes over the horizon table in the next --hours, in AOS order.  Which satellites: "
+        "--sat, --group and --favourites (any mix); without them your [satellites] favourites when the "
+        "configuration lists some, else every satellite of the catalog (--all forces that).  The table fits "
+        "80 columns (--wide: every column, as CSV and JSON give); a pass already in progress at the start "
+        "has its AOS before the start.",
+        epilog="table columns: sat, name, aos (month-day time), tca, los, max (highest elevation, deg), "
+        "rise/set (azimuth at AOS/LOS, deg), min (length, minutes)")
     add_tracking_options(p)
     p.add_argument("--sat", type=satellite_value, action="append", default=[],
                    help="catalog number or name; repeatable")
+    p.add_argument("--group", action="append", default=[], metavar="PATTERN",
+                   help="satellites whose name matches a shell-style pattern, e.g. 'NOAA*' or 'SO-*'; repeatable")
+    p.add_argument("--favourites", action="store_true",
+                   help="the configuration's [satellites] favourites (the default when it lists some)")
+    p.add_argument("--all", action="store_true", help="every satellite of the catalog, even with favourites set")
+    p.add_argument("--min-el", type=number_in(-90, 90, unit="deg"), default=0.0, metavar="DEG",
+                   help="only passes whose highest elevation reaches this many degrees (default 0: every pass "
+                   "over the horizon table; 10 is a common choice for passes worth working)")
     p.add_argument("--start", type=time_value, default="now", help=TIME_HELP)
-    p.add_argument("--hours", type=number_in(0, 744, low_open=True, unit="h"), default=24.0)
+    p.add_argument("--hours", type=number_in(0, 744, low_open=True, unit="h"), default=24.0,
+                   help="length of the window from --start, hours (default 24)")
+    p.add_argument("--local", action="store_true",
+                   help="table times in this computer's zone, named in the header (default UTC; CSV and JSON "
+                   "always give UTC)")
+    p.add_argument("--wide", action="store_true",
+                   help="a table with every column (catalog number, full name, ISO times with milliseconds, "
+                   "azimuths, duration in seconds, in_progress)")
     p.add_argument("--workers", type=number_in(1, 64, integer=True), default=1, metavar="N",
                    help="worker processes for large catalogs (POSIX; default 1)")
     p.set_defaults(func=run_passes)
@@ -156,12 +178,29 @@ def run_passes(args: argparse.Namespace) -> int:
 
     from nfwserver.cli.bulk_output import write_rows
     from nfwserver.cli.output_columns import Duration, Flag, Integer, Number, Text, Time
+    from nfwserver.cli.pass_table import compact_columns
 
     start = args.start
-    passes, names = _find_passes(args)  # the catalog is gone: its memory serves the output
+    passes, names, short_names = _find_passes(args)  # the catalog is gone: its memory serves the output
     cols = passes.columns
+    if args.min_el > 0.0 or args.min_el < 0.0:
+        keep = cols["max_elevation_deg"] >= args.min_el
+        cols = {key: value[keep] for key, value in cols.items()}
     numbers = np.array(sorted(names), dtype=np.int64)
     which = np.searchsorted(numbers, cols["catalog_number"])
+    if args.format == "table" and not args.wide:
+        if not len(cols["catalog_number"]):
+            reach = f" reaching {args.min_el:g} deg" if args.min_el else ""
+            warn(f"no passes{reach} of the {len(names) or 'chosen'} satellite(s) in the {args.hours:g} h from "
+                 f"{format_time(start)}")
+        write_rows(compact_columns(start, cols, [short_names[n] for n in numbers.tolist()], which, args.local),
+                   "table", sys.stdout)
+        return 0
+    if args.local and args.format == "table":
+        from nfwserver.cli.pass_table import zone_label
+
+        print(f"times in UTC: --local shortens the table's times only ({zone_label(True, start)} here); "
+              "drop --wide to see them", file=sys.stderr)
     aos_unknown, los_unknown = np.isnan(cols["aos_s"]), np.isnan(cols["los_s"])
     aos, los = Time("aos_utc", start, cols["aos_s"], aos_unknown), Time("los_utc", start, cols["los_s"], los_unknown)
     write_rows([Integer("catalog_number", cols["catalog_number"]), Text("name", [names[n] for n in numbers.tolist()],
@@ -174,9 +213,9 @@ def run_passes(args: argparse.Namespace) -> int:
     return 0
 
 
-def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str]]:
-    """The passes the options ask for, and the name to show for each satellite that has one (by catalog
-    number)."""
+def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str], dict[int, str]]:
+    """The passes the options ask for, and the name and the DDE name (at most 12 characters) to show for each
+    satellite that has one (by catalog number)."""
     import numpy as np
 
     from nfwserver.cli.tracking_options import TrackingInputs
@@ -185,12 +224,43 @@ def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str]]:
     start = args.start
     inputs = TrackingInputs(args)  # the configuration only if an option leaves a value to it
     horizon, observer, ut1_utc, catalog = inputs.horizon, inputs.observer, inputs.ut1_utc, inputs.catalog
-    sets = [_pick(catalog, text).elements for text in args.sat] if args.sat else catalog.element_sets()
+    sets = _chosen_sets(args, inputs, catalog)
     sets = _screen(sets, catalog, observer, ut1_utc, start)
     passes = find_passes(sets, observer, start, start + timedelta(hours=args.hours), horizon=horizon,
                          ut1_utc=ut1_utc, workers=args.workers)
     numbers = np.unique(passes.columns["catalog_number"]).tolist()
-    return passes, dict(zip(numbers, _display_names(numbers, sets, catalog)))
+    return (passes, dict(zip(numbers, _display_names(numbers, sets, catalog))),
+            {n: _dde_name(catalog, n) for n in numbers})
+
+
+def _chosen_sets(args: argparse.Namespace, inputs: TrackingInputs, catalog: Catalog) -> list[Any]:
+    """The element sets ``passes`` searches: --sat, --group, --favourites; else the configured favourites
+    (when there are some and no --elements file or --all was given); else the whole catalog."""
+    from nfwserver.cli import CliError
+    from nfwserver.cli.pass_table import matching_names
+
+    chosen: dict[int, Any] = {}
+    for text in args.sat:
+        sat = _pick(catalog, text)
+        chosen[sat.catalog_number] = sat
+    if args.group:
+        found = matching_names(args.group, ((s.catalog_number, s.dde_name, s.name) for s in catalog))
+        if not found:
+            raise CliError(f"no satellite's name matches {', '.join(args.group)}")
+        chosen.update((n, catalog.get(n)) for n in found)
+    default_favourites = not (args.sat or args.group or args.all or args.favourites or getattr(args, "elements", None))
+    if args.favourites or default_favourites:
+        favourites = inputs.config().favourites
+        if args.favourites and not favourites:
+            raise CliError("no favourites configured: list catalog numbers in [satellites] favourites")
+        present = [n for n in favourites if catalog.get(n) is not None]
+        if default_favourites and present:
+            warn(f"passes of your {len(present)} favourite(s) ([satellites] favourites); --all for every "
+                 "satellite")
+        chosen.update((n, catalog.get(n)) for n in present)
+    if not chosen and not (args.sat or args.group or args.favourites):
+        return catalog.element_sets()
+    return [sat.elements for sat in chosen.values() if sat is not None]
 
 
 def run_visible(args: argparse.Namespace) -> int:

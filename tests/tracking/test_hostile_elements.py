@@ -186,10 +186,12 @@ def test_passes_never_prints_a_control_character_from_an_element_file(tmp_path, 
     path.write_text("ISS\x1b[2J\x1b]0;owned\x07 (ZARYA)\n"
                     "1 25544U 98067A   24001.50000000  .00016717  00000-0  30328-3 0  9993\n"
                     "2 25544  51.6416 247.4627 0006703 130.5360 325.0288 15.49815330431950\n")
-    assert main(["passes", "--elements", str(path), "--observer", "52.2,0.12", "--start", "2024-01-01T12:00Z",
-                 "--hours", "24"]) == 0
-    out = capsys.readouterr().out
-    assert "ISS [2J ]0;owned (ZARYA)" in out and "\x1b" not in out and "\x07" not in out
+    for short in ([], ["--wide"]):
+        assert main(["passes", "--elements", str(path), "--observer", "52.2,0.12", "--start", "2024-01-01T12:00Z",
+                     "--hours", "24", *short]) == 0
+        out = capsys.readouterr().out
+        assert "\x1b" not in out and "\x07" not in out
+    assert "ISS [2J ]0;owned (ZARYA)" in out
 
 
 @pytest.mark.parametrize("epoch", ["2056-12-31T23:59:59", "2026-05-07T12:00:00.123456", "2024-02-29T00:00:00.000432"])

@@ -148,6 +148,6 @@ def test_after_config_init_and_a_location_the_commands_need_no_arguments(capsys)
     for argv in (["passes"], ["visible"], ["ephemeris", "--sat", "ISS", "--duration", "120"]):
         assert main(argv) == 0, argv
         out, err = capsys.readouterr()
-        assert out.splitlines()[0].startswith(("catalog_number", "time_utc")) and "no observer" not in err
+        assert out.splitlines()[0].startswith(("catalog_number", "time_utc", "sat ")) and "no observer" not in err
     assert main(["ephemeris", "--sat", "AO-91", "--duration", "0", "--format", "csv"]) == 0
     assert len(_rows(capsys)) == 1

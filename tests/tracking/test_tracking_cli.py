@@ -74,7 +74,8 @@ def test_passes_csv_and_horizon(capsys, tmp_path) -> None:
 
 
 def test_passes_of_all_satellites_and_visible(capsys) -> None:
-    assert main(["passes", *ELEMENTS, "--observer", "52.2,0.12", "--start", "2026-05-08T00:00Z", "--hours", "1"]) == 0
+    assert main(["passes", *ELEMENTS, "--observer", "52.2,0.12", "--start", "2026-05-08T00:00Z", "--hours", "1",
+                 "--wide"]) == 0
     table = capsys.readouterr().out.splitlines()
     assert table[0].startswith("catalog_number") and len(table) > 10
     at = ["--at", "2026-05-08T03:00:00", "--format", "csv"]
@@ -179,7 +180,7 @@ def test_json_holds_the_csv_rows_as_typed_values(capsys, command) -> None:
 
 def test_passes_table_csv_and_json_of_the_same_passes(capsys) -> None:
     common = ["passes", *ELEMENTS, "--observer", "52.2,0.12", "--start", "2026-05-08T00:00Z", "--hours", "24"]
-    assert main([*common, "--format", "table"]) == 0
+    assert main([*common, "--format", "table", "--wide"]) == 0
     table = capsys.readouterr().out.splitlines()
     assert main([*common, "--format", "csv"]) == 0
     rows = _csv(capsys)
