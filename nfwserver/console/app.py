@@ -77,16 +77,20 @@ class NfwConsole(App[None]):
     #side { width: 38; border: round $primary; padding: 0 1; }
     #poke { border: none; height: 1; padding: 0 1; }
     """
+    ENABLE_COMMAND_PALETTE = False  # every action has a key in the footer; ^p would cost its width
+    #: footer labels kept short so that every key shows on an 80-column terminal
     BINDINGS = [
-        Binding("f2", "pick_satellite", "Satellites", priority=True),
-        Binding("ctrl+d", "toggle_doppler", "Doppler", priority=True),
-        Binding("f4", "toggle_zone", "UTC/local", priority=True),
         Binding("f1", "show_outgoing", "Out", priority=True),
+        Binding("f2", "pick_satellite", "Sats", priority=True),
         Binding("f3", "show_incoming", "In", priority=True),
+        Binding("f4", "toggle_zone", "Zone", priority=True),
         Binding("ctrl+t", "toggle_tune", "Tune", priority=True),
+        Binding("ctrl+d", "toggle_doppler", "Doppler", priority=True),
         Binding("ctrl+f", "cycle_flip", "Flip", priority=True),
-        Binding("z", "toggle_zone", "UTC/local", show=False),
         Binding("ctrl+q", "quit", "Quit", priority=True),
+        Binding("pageup", "scroll_log(-1)", "Page up", show=False, priority=True),
+        Binding("pagedown", "scroll_log(1)", "Page down", show=False, priority=True),
+        Binding("z", "toggle_zone", "UTC/local", show=False),
     ]
 
     def __init__(self, core: StationCore, transport_note: str = "", hint: str = "",
@@ -120,7 +124,7 @@ class NfwConsole(App[None]):
         yield Static(id="state")
         with Horizontal(id="logs"):
             with Vertical(id="outgoing-pane", classes="pane"):
-                yield RichLog(id="outgoing", max_lines=500, wrap=False, markup=False)
+                yield ReflowLog(id="outgoing", max_lines=500)
             with Vertical(id="incoming-pane", classes="pane"):
                 yield ReflowLog(id="incoming", max_lines=500)
             with Vertical(id="side"):
@@ -178,13 +182,13 @@ class NfwConsole(App[None]):
         with self._lock:
             events = list(self._queue)
             self._queue.clear()
-        outgoing = self.query_one("#outgoing", RichLog)
+        outgoing = self.query_one("#outgoing", ReflowLog)
         incoming = self.query_one("#incoming", ReflowLog)
         for e in events:
             stamp = self.times.clock(e.time)
             if e.direction is Direction.OUT:
                 who = f" -> {e.client}" if e.client else ""
-                outgoing.write(Text(f"{stamp} {e.text}{who}"))
+                outgoing.add(Text(f"{stamp} {e.text}{who}"))
             else:
                 mark = "" if e.accepted is None else (" ok" if e.accepted else " REFUSED")
                 detail = f" ({e.detail})" if e.detail and not e.accepted else ""
@@ -308,9 +312,19 @@ class NfwConsole(App[None]):
         self._refresh_state()
 
     def _show_log(self, which: str) -> None:
+        """Show (on a narrow terminal) the ``which`` log; Page Up/Down scroll it.  The command line keeps
+        the focus, so typing goes on where it was."""
         self._shown_log = which
         self._layout()
-        self.query_one(f"#{which}", RichLog).focus()
+        if not isinstance(self.screen, SatellitePicker):
+            self.query_one("#poke", Input).focus()
+
+    def action_scroll_log(self, pages: int) -> None:
+        log_pane = self.query_one(f"#{self._shown_log}", RichLog)
+        if pages < 0:
+            log_pane.scroll_page_up(animate=False)
+        else:
+            log_pane.scroll_page_down(animate=False)
 
     def action_show_outgoing(self) -> None:
         self._show_log("outgoing")

@@ -23,8 +23,8 @@ def test_pokes_outgoing_strings_and_state_changes_show() -> None:
             assert "TUNE ON" in static_text(app, "state")
             station.run(2.0)  # 11 ticks at 5 Hz of virtual time
             await pilot.pause(0.3)
-            outgoing = log_text(app, "outgoing").splitlines()
-            assert len(outgoing) == 11 and all(" ISS AZ:" in line for line in outgoing)
+            outgoing = [line for line in log_text(app, "outgoing").splitlines() if " ISS AZ:" in line]
+            assert len(outgoing) == 11  # one per tick (each may wrap onto a second line in the pane)
             assert "AZ " in static_text(app, "state") and "ISS (25544)" in static_text(app, "state")
             await pilot.press(*"SAT=99999", "enter")
             await pilot.pause()
@@ -34,7 +34,7 @@ def test_pokes_outgoing_strings_and_state_changes_show() -> None:
             assert "TUNE OFF" in static_text(app, "state")
             station.run(1.0)
             await pilot.pause(0.3)
-            assert len(log_text(app, "outgoing").splitlines()) == 11  # nothing new after TUNE OFF
+            assert sum(" ISS AZ:" in line for line in log_text(app, "outgoing").splitlines()) == 11  # none new
             client = station.system.connect("NFW32", "NFW_DATA")
             client.poke("NFW_SERVER", "TRACK ON")
             await settle(app, pilot)

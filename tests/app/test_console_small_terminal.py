@@ -1,0 +1,98 @@
+"""The console on an 80x24 terminal, resized, keyboard only (issue 25 item 5)."""
+
+from __future__ import annotations
+
+import asyncio
+
+from textual.widgets import Input
+
+from nfwserver.console.app import NfwConsole
+from tests.app.console_helpers import log_text, screen_text, settle
+from tests.dde.conftest import ISS, make_station
+
+
+def _run(scenario) -> None:
+    station = make_station()
+    station.core.set_tune(True)
+    station.run(1.0)
+
+    async def body() -> None:
+        app = NfwConsole(station.core, favourites=(ISS,))
+        async with app.run_test(size=(80, 24)) as pilot:
+            await settle(app, pilot)
+            await scenario(app, pilot, station)
+
+    asyncio.run(body())
+
+
+def test_typed_commands_still_reach_the_station_after_f1_and_f3() -> None:
+    async def scenario(app, pilot, station) -> None:
+        await pilot.press("f1")
+        await pilot.press(*"TUNE OFF", "enter")
+        await pilot.pause(0.1)
+        assert not station.core.state.snapshot().dde_output
+        await pilot.press("f3")
+        await pilot.press(*"TUNE ON", "enter")
+        await pilot.pause(0.1)
+        assert station.core.state.snapshot().dde_output
+        assert isinstance(app.focused, Input)
+
+    _run(scenario)
+
+
+def test_the_outgoing_pane_wraps_whole_nova_strings() -> None:
+    async def scenario(app, pilot, station) -> None:
+        station.run(1.0)
+        await pilot.press("f1")
+        await settle(app, pilot)
+        shown = screen_text(app)
+        assert "AH:" in shown  # wrapped onto a second line, not cut off at the pane's edge
+        assert all(len(line) <= 80 for line in shown.splitlines())
+        assert "AH:" in log_text(app, "outgoing")
+
+    _run(scenario)
+
+
+def test_page_keys_scroll_the_shown_log_while_typing_stays_possible() -> None:
+    async def scenario(app, pilot, station) -> None:
+        for k in range(60):
+            station.core.command(f"ANTAZ={k}", source="test")
+        await pilot.press("f3")
+        await settle(app, pilot)
+        incoming = app.query_one("#incoming")
+        bottom = incoming.scroll_y
+        assert bottom > 0
+        await pilot.press("pageup")
+        await pilot.pause(0.2)
+        assert incoming.scroll_y < bottom
+        await pilot.press("pagedown", "pagedown")
+        await pilot.pause(0.2)
+        assert incoming.scroll_y == bottom
+        assert isinstance(app.focused, Input)
+
+    _run(scenario)
+
+
+def test_the_footer_shows_every_key_at_80_columns() -> None:
+    async def scenario(app, pilot, station) -> None:
+        footer = screen_text(app).splitlines()[-1]
+        for label in ("Out", "Sats", "In", "Zone", "Tune", "Doppler", "Flip", "Quit"):
+            assert label in footer, footer
+
+    _run(scenario)
+
+
+def test_the_header_rewraps_when_the_terminal_is_resized() -> None:
+    async def scenario(app, pilot, station) -> None:
+        narrow = screen_text(app)
+        await pilot.resize_terminal(140, 40)
+        await settle(app, pilot)
+        wide = screen_text(app).splitlines()
+        assert all(len(line) <= 140 for line in wide)
+        state = app.query_one("#state")
+        assert state.size.width > 100
+        lines_narrow = sum(1 for line in narrow.splitlines()[:12] if line.startswith("│"))
+        lines_wide = sum(1 for line in wide[:12] if line.startswith("│"))
+        assert lines_wide <= lines_narrow
+
+    _run(scenario)
