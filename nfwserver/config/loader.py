@@ -185,7 +185,7 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
     files they name must exist.
     """
     try:
-        doc = tomllib.loads(text)
+        doc = tomllib.loads(text.removeprefix("\ufeff"))  # Windows editors start UTF-8 files with a BOM
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(source, [f"not valid TOML ({exc})"]) from None
     reading = _Reading(doc, base_dir or Path("."))

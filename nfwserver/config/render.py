@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import textwrap
+from collections.abc import Mapping
 from operator import attrgetter
 from typing import Any
 
@@ -124,9 +125,12 @@ def _effective(config: Config, entry: Setting) -> Any:
     return value
 
 
-def show(config: Config, notes: dict[str, str] | None = None) -> str:
-    """Every key with its effective value; ``notes`` adds a comment to ``"section.key"`` lines."""
+def show(config: Config, notes: dict[str, str] | None = None, written: Mapping[str, Any] | None = None) -> str:
+    """Every key with its effective value; ``notes`` adds a comment to ``"section.key"`` lines.  A key
+    given in ``written`` (the file's TOML document) is shown as the user wrote it (``location =
+    "JO01ab"``, not the latitude it stands for); values derived from others are rounded for reading."""
     notes = dict(notes or {})
+    written = written or {}
     if not config.observer_configured:
         notes.setdefault("observer.location", f"not set: using {config.observer} (Greenwich)")
     if not config.horizon.points:
@@ -144,7 +148,15 @@ def show(config: Config, notes: dict[str, str] | None = None) -> str:
                 out.append(f"channels = {len(value)} channels" + (f"  # {note}" if note else ""))
                 out += [_channel_line(n, c) for n, c in sorted(value.items())]
                 continue
-            text = "(not set)" if value is None else toml_value(value)
+            given = written.get(entry.section, {})
+            if isinstance(given, Mapping) and entry.key in given:
+                text = toml_value(given[entry.key])
+            elif value is None:
+                text = "(not set)"
+            elif isinstance(value, float) and not isinstance(value, bool):
+                text = f"{value:.10g}"  # derived or default: rounded for reading
+            else:
+                text = toml_value(value)
             out.append(f"{entry.key} = {text}" + (f"  # {note}" if note else ""))
     return "\n".join(out) + "\n"
 

@@ -1,0 +1,77 @@
+"""``config set``, ``config init --locator``, a BOM, and ``config show`` as written (issue 25 item 6)."""
+
+from __future__ import annotations
+
+import os
+import stat
+
+import pytest
+
+from nfwserver.cli import main
+from nfwserver.config import load_config
+from nfwserver.tracking.observer import parse_observer
+
+
+@pytest.fixture
+def station_file(tmp_path):
+    path = tmp_path / "station.toml"
+    assert main(["config", "init", "--config", str(path), "--locator", "JO01ab"]) == 0
+    return path
+
+
+def test_init_with_a_locator_or_coordinates_configures_the_observer(tmp_path, station_file) -> None:
+    config = load_config(station_file)
+    expected = parse_observer("JO01ab")
+    assert config.observer_configured and config.observer == expected
+    other = tmp_path / "coords.toml"
+    assert main(["config", "init", "--config", str(other), "--lat", "-33.87", "--lon", "151.21", "--alt", "40"]) == 0
+    observer = load_config(other).observer
+    assert (observer.latitude_deg, observer.longitude_deg, observer.altitude_m) == (-33.87, 151.21, 40.0)
+    assert main(["config", "init", "--config", str(tmp_path / "x.toml"), "--lat", "10"]) == 1
+
+
+def test_set_keeps_comments_and_layout_and_validates_the_whole_file(station_file, capsys) -> None:
+    before = station_file.read_text()
+    comments = [line for line in before.splitlines() if line.startswith("#")]
+    assert main(["config", "set", "--config", str(station_file), "tcp.enabled", "true"]) == 0
+    after = station_file.read_text()
+    assert load_config(station_file).tcp.enabled
+    kept = [line for line in after.splitlines() if line.startswith("#")]
+    assert set(kept) <= set(comments) and len(comments) - len(kept) <= 1  # at most the commented example
+    assert after.count("\n") >= before.count("\n") - 1
+    assert main(["config", "set", "--config", str(station_file), "satellites.favourites", "[25544, 7530]"]) == 0
+    assert load_config(station_file).favourites == (25544, 7530)
+
+
+@pytest.mark.parametrize(("key", "value", "says"), [("tcp.port", "99999", "outside 0..65535"),
+                                                      ("tcp.enable", "true", "did you mean tcp.enabled"),
+                                                      ("rotor.backend", "telepathy", "rotor")])
+def test_a_refused_value_changes_nothing(station_file, capsys, key: str, value: str, says: str) -> None:
+    before = station_file.read_bytes()
+    assert main(["config", "set", "--config", str(station_file), key, value]) == 1
+    assert says in capsys.readouterr().err
+    assert station_file.read_bytes() == before
+
+
+def test_set_keeps_the_file_permissions(station_file) -> None:
+    os.chmod(station_file, 0o640)
+    assert main(["config", "set", "--config", str(station_file), "server.rate_hz", "2"]) == 0
+    assert stat.S_IMODE(station_file.stat().st_mode) == 0o640
+    assert load_config(station_file).server.rate_hz == 2
+
+
+def test_a_file_with_a_utf8_bom_is_read_and_edited(tmp_path) -> None:
+    path = tmp_path / "bom.toml"
+    path.write_bytes(b"\xef\xbb\xbf[observer]\nlocation = \"JO01ab\"\n")
+    assert load_config(path).observer_configured
+    assert main(["config", "set", "--config", str(path), "tcp.enabled", "true"]) == 0
+    assert load_config(path).tcp.enabled and load_config(path).observer_configured
+
+
+def test_show_prints_values_as_written(station_file, capsys) -> None:
+    capsys.readouterr()
+    assert main(["config", "show", "--config", str(station_file)]) == 0
+    out = capsys.readouterr().out
+    assert 'location = "JO01ab"' in out
+    assert "0.041666666666666664" not in out  # the locator's longitude is shown rounded, as derived
+    assert "longitude_deg = 0.04166666667  # from location" in out
