@@ -127,8 +127,9 @@ def _effective(config: Config, entry: Setting) -> Any:
 
 def show(config: Config, notes: dict[str, str] | None = None, written: Mapping[str, Any] | None = None) -> str:
     """Every key with its effective value; ``notes`` adds a comment to ``"section.key"`` lines.  A key
-    given in ``written`` (the file's TOML document) is shown as the user wrote it (``location =
-    "JO01ab"``, not the latitude it stands for); values derived from others are rounded for reading."""
+    given in ``written`` (the file's TOML document) as a number or a location is shown as the user wrote it
+    (``location = "JO01ab"``, not the latitude it stands for); values derived from others are rounded for
+    reading; paths are shown resolved."""
     notes = dict(notes or {})
     written = written or {}
     if not config.observer_configured:
@@ -149,8 +150,9 @@ def show(config: Config, notes: dict[str, str] | None = None, written: Mapping[s
                 out += [_channel_line(n, c) for n, c in sorted(value.items())]
                 continue
             given = written.get(entry.section, {})
-            if isinstance(given, Mapping) and entry.key in given:
-                text = toml_value(given[entry.key])
+            raw = given.get(entry.key) if isinstance(given, Mapping) else None
+            if isinstance(raw, int | float) or entry.key == "location" and raw is not None:
+                text = toml_value(raw)  # as written (paths and names stay resolved: more useful)
             elif value is None:
                 text = "(not set)"
             elif isinstance(value, float) and not isinstance(value, bool):

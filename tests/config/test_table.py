@@ -92,8 +92,8 @@ def test_show_prints_the_effective_values(tmp_path, capsys) -> None:
                     '[[satellites.channels]]\ncatalog_number = 99999\nname = "TEST"\ndownlink_hz = 435000000\n')
     assert main(["config", "show", "--config", str(path)]) == 0
     blocks = _by_section(capsys.readouterr().out)
-    assert 'location = "52.20000,0.12000,20"' in blocks["observer"]
-    assert "latitude_deg = 52.2\n" in blocks["observer"]
+    assert 'location = "52.2,0.12,20"' in blocks["observer"]
+    assert "latitude_deg = 52.2  # from location\n" in blocks["observer"]
     assert "points = [[0, 5], [180, 10]]" in blocks["horizon"]
     assert f'file = "{tmp_path / "h.txt"}"' in blocks["horizon"]
     assert f'store = "{tmp_path / "cat.txt"}"' in blocks["elements"]
