@@ -93,6 +93,7 @@ class Station:
                           set_flip=self.rotor.set_flip_mode if self.rotor is not None else None)
             if config.tcp.enabled else None)
         self.watcher: ConfigWatcher | None = None
+        self.selection_note = ""  #: which satellite the station started with, and why (set by start())
         self._unsubscribe: list[Callable[[], None]] = []
         self._started = False
 
@@ -181,14 +182,16 @@ class Station:
     def _restore_session(self) -> None:
         srv = self.config.server
         saved = self.state_file.load() if self.state_file is not None else SessionState()
-        choice = srv.satellite
+        choice, source = srv.satellite, "config"
         if saved.satellite is not None and saved.satellite in self.catalog and saved.configured == srv.satellite:
-            choice = saved.satellite  # chosen at run time, and the configuration has not changed since
-        elif saved.satellite is not None and saved.configured != srv.satellite:
-            log.info("[server] satellite changed to %s since the last run: it replaces the saved choice %s",
-                     srv.satellite, saved.satellite)
-        if choice is not None and not self.core.select_satellite(choice, source="config"):
-            log.warning("configured satellite %s is not in the loaded elements", choice)
+            choice, source = saved.satellite, "saved-state"  # chosen at run time; the configuration unchanged
+        self.selection_note = _selection_note(choice, source, srv.satellite, saved, self.state_file)
+        if choice is not None and not self.core.select_satellite(choice, source=source):
+            self.selection_note = f"configured satellite {choice} is not in the loaded elements"
+            log.warning("%s", self.selection_note)
+        else:
+            log.info("%s", self.selection_note)
+            self.core.selected_by = source
         if srv.tune:
             self.core.set_tune(True, source="config")
         if srv.track:
@@ -254,3 +257,18 @@ class Station:
                 self.transport.close()
             except Exception:
                 log.exception("closing the transport failed")
+
+
+def _selection_note(choice: int | None, source: str, configured: int | None, saved: SessionState,
+                    state_file: StateFile | None) -> str:
+    """Which satellite the station starts with, and why (the saved choice or the configuration)."""
+    if choice is None:
+        return "no satellite selected ([server] satellite is not set)"
+    if source == "saved-state":
+        where = state_file.path if state_file is not None else "the state file"
+        return (f"satellite {choice}: restored from {where} (chosen while running; [server] satellite "
+                f"{configured} unchanged since, so the saved choice wins; SAT= or F2 changes it)")
+    if saved.satellite is not None and saved.satellite != choice:
+        return (f"satellite {choice}: from [server] satellite, which changed since the last run, so it "
+                f"replaces the saved choice {saved.satellite}")
+    return f"satellite {choice}: from [server] satellite"

@@ -96,13 +96,14 @@ def _notes(station: Any, config: Any) -> tuple[list[str], str]:
     from nfwserver.config import observer_hint
 
     source = config.path or config.source
-    notes = [f"configuration: {source}", station.transport_note, f"{len(station.catalog)} satellites loaded"]
+    notes = [f"configuration: {source}", station.transport_note, f"{len(station.catalog)} satellites loaded",
+             station.selection_note]
     hints = [] if config.observer_configured else [observer_hint(config)]
     ages = [s.age_days(station.clock.now()) for s in station.catalog]
     if ages and min(ages) > 14:
         hints.append(f"the newest element set is {min(ages):.0f} days old: positions drift; add current elements "
                      "([elements] files or urls in the configuration)")
-    return notes + hints, " ".join(hints)
+    return [n for n in notes if n] + hints, " ".join(hints + [station.selection_note])
 
 
 def _make_console(station: Any, config: Any, hint: str) -> Any:

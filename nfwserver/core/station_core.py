@@ -95,6 +95,8 @@ class StationCore:
         self._refusals = RateLimitedLog(log, clock, 60.0)
         #: whether the station drives a rotor itself (set by the station; None: not known, no warning)
         self.rotor_configured: bool | None = None
+        #: who chose the selected satellite: "config", "saved-state", or the source of the command
+        self.selected_by = "config" if satellite is not None else ""
         if satellite is not None and not self.select_satellite(satellite, source="startup"):
             log.warning("satellite %s is not in the catalog; no satellite selected", satellite)
 
@@ -164,6 +166,7 @@ class StationCore:
         if self.state.select(catalog_number):
             self.tracker.selection_changed()
             self._note(f"satellite {catalog_number} {sat.dde_name} selected", source)
+            self.selected_by = source
         return True
 
     def clear_satellite(self) -> None:

@@ -17,7 +17,8 @@ Nova's commands    ``TUNE ON|OFF``, ``TRACK ON|OFF``, ``SAT=n``, ``ANTAZ=deg``, 
                    tracking needs to know it is not happening.  DDE clients still get an
                    acknowledgement for it; only this protocol reports it.
 ``STATUS``         one line of ``key=value`` pairs separated by single blanks (values never
-                   contain blanks): satellite, name, tune, track, radio_tuning, status (the
+                   contain blanks): satellite, name, satellite_from (who chose it: config,
+                   saved-state, or the client that sent SAT=), tune, track, radio_tuning, status (the
                    status word, hex), interface (version), az/el/rr/ah of the last tick when
                    there is a position, then the fields of the ``extra`` callable (rotor and
                    radio state, given by the station).
@@ -148,7 +149,8 @@ class NovaTcpProtocol:
         snap = self.core.snapshot()
         state = snap.state
         fields: dict[str, object] = {
-            "satellite": state.catalog_number, "name": snap.dde_name, "tune": state.dde_output,
+            "satellite": state.catalog_number, "name": snap.dde_name, "satellite_from": self.core.selected_by,
+            "tune": state.dde_output,
             "track": state.tracking, "radio_tuning": state.radio_tuning, "status": f"0x{snap.status:04X}",
             "interface": snap.interface_version,
         }

@@ -1,0 +1,64 @@
+"""Which satellite a station starts with, and why (issue 25 item 7): a choice saved while running wins over
+``[server] satellite`` only while that setting is unchanged, and the station says which won, at start and
+in STATUS (``satellite_from``)."""
+
+from __future__ import annotations
+
+import json
+import threading
+
+from nfwserver.app.station import Station
+from nfwserver.cli.run_command import RunPlan, serve
+from nfwserver.clock import VirtualClock
+from nfwserver.config import load_config
+from nfwserver.fake_dde import FakeDdeSystem
+from nfwserver.tcp.protocol import NovaTcpProtocol
+from tests.dde.conftest import ISS_PASS
+
+
+def _start(tmp_path, configured: int, saved: dict | None, capsys) -> tuple[str, dict[str, str]]:
+    """Run the station headless (printing its start-up notes), then read a station's STATUS line."""
+    state = tmp_path / "state.json"
+    path = tmp_path / "station.toml"
+    path.write_text(f'[observer]\nlocation = "JO02ae"\n[server]\nsatellite = {configured}\n'
+                    f'state_file = "{state}"\n')
+    config = load_config(str(path))
+    if saved is not None:
+        state.write_text(json.dumps(saved))
+    stop = threading.Event()
+    stop.set()
+    plan = RunPlan(console=False, log_file=tmp_path / "nfw.log", clock=VirtualClock(ISS_PASS.aos),
+                   transport=FakeDdeSystem().server_transport(), stop=stop)
+    assert serve(config, plan) == 0
+    err = capsys.readouterr().err
+    if saved is not None:
+        state.write_text(json.dumps(saved))  # as before the run (the run saved its own choice)
+    else:
+        state.unlink(missing_ok=True)
+    station = Station(config, VirtualClock(ISS_PASS.aos), transport=FakeDdeSystem().server_transport())
+    station.start()
+    try:
+        line = NovaTcpProtocol(station.core).status_line()
+        status = dict(pair.split("=", 1) for pair in line.split(" "))
+        status["hint"] = station.selection_note
+    finally:
+        station.stop()
+    assert f"nfwserver: {station.selection_note}" in err
+    return err, status
+
+
+def test_a_saved_choice_wins_while_the_configuration_is_unchanged_and_says_so(tmp_path, capsys) -> None:
+    err, status = _start(tmp_path, 25544, {"satellite": 7530, "configured": 25544}, capsys)
+    assert status["satellite"] == "7530" and status["satellite_from"] == "saved-state"
+    assert "satellite 7530: restored from" in status["hint"] and "saved choice wins" in status["hint"]
+
+
+def test_a_changed_configuration_beats_the_saved_choice_and_says_so(tmp_path, capsys) -> None:
+    err, status = _start(tmp_path, 25544, {"satellite": 7530, "configured": 43017}, capsys)
+    assert status["satellite"] == "25544" and status["satellite_from"] == "config"
+    assert "replaces the saved choice 7530" in status["hint"]
+
+
+def test_without_saved_state_the_configuration_is_named(tmp_path, capsys) -> None:
+    err, status = _start(tmp_path, 25544, None, capsys)
+    assert status["satellite_from"] == "config" and "satellite 25544: from [server] satellite" in status["hint"]
