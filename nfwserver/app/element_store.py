@@ -70,7 +70,7 @@ class ElementStore:
         catalog = Catalog(self.load())
         summary = catalog.update(sets)
         if summary.added or summary.updated or not self.path.exists():
-            text = "".join(sat.elements.tle_text() for sat in catalog)
+            text = "".join(es.tle_text() for es in catalog.element_sets())
             atomic_write_text(self.path, text)
         return catalog, summary
 
