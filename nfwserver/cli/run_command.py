@@ -99,9 +99,9 @@ def _notes(station: Any, config: Any) -> tuple[list[str], str]:
     notes = [f"configuration: {source}", station.transport_note, f"{len(station.catalog)} satellites loaded"]
     hints = [] if config.observer_configured else [observer_hint(config)]
     ages = [s.age_days(station.clock.now()) for s in station.catalog]
-    if ages and min(ages) > 14:
-        hints.append(f"the newest element set is {min(ages):.0f} days old: positions drift; add current elements "
-                     "([elements] files or urls in the configuration)")
+    if ages and min(ages) > config.elements.stale_days:
+        hints.append(f"the newest element set is {min(ages):.0f} days old: positions drift; "
+                     "`nfwserver elements update` fetches current ones")
     return notes + hints, " ".join(hints)
 
 
