@@ -36,9 +36,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     src.set_defaults(func=run_sources)
     pr = sub.add_parser("prune", help="remove decayed objects and old sets from the stored catalog",
                         description="InstantTrack's CRASH and OLD: remove objects that have decayed and sets whose "
-                        "epoch is more than --days before now; the store is rewritten atomically.")
+                        "epoch is more than --days before now; the store is rewritten atomically.  The selected "
+                        "satellite (saved state and [server] satellite) and [satellites] favourites are never "
+                        "removed; the store is never emptied without --all; removing more than half asks first "
+                        "on a terminal (--yes: do not ask; without a terminal --yes is required).")
     pr.add_argument("--days", type=number_in(0, 36600, low_open=True, unit="days"), default=30.0,
                     help="remove sets older than this many days (default 30)")
+    pr.add_argument("--dry-run", action="store_true", help="list what would be removed; change nothing")
+    pr.add_argument("--all", action="store_true", help="allow removing every set (the store may end up empty)")
+    pr.add_argument("--yes", action="store_true", help="remove more than half without asking")
     pr.set_defaults(func=run_prune)
     for action in (up, ls, pr, src):
         action.add_argument("--store", metavar="FILE", help="stored catalog file (default: [elements] store)")
@@ -197,6 +203,29 @@ def run_list(args: argparse.Namespace) -> int:
     return 0
 
 
+def _protected(config) -> dict[int, str]:
+    """Catalog numbers prune keeps, with why: the selected satellite (saved state, [server] satellite) and
+    the favourites."""
+    from nfwserver.app.session_state import StateFile
+
+    keep: dict[int, str] = {n: "a favourite" for n in config.favourites}
+    if config.server.satellite is not None:
+        keep[config.server.satellite] = "the configured satellite"
+    if config.state_file:
+        saved = StateFile(None if config.state_file == "default" else config.state_file).load().satellite
+        if saved is not None:
+            keep[saved] = "the selected satellite"
+    return keep
+
+
+def _confirm(question: str) -> bool:
+    print(f"{question} [y/N] ", end="", file=sys.stderr, flush=True)
+    try:
+        return sys.stdin.readline().strip().lower() in ("y", "yes")
+    except (OSError, KeyboardInterrupt):
+        return False
+
+
 def run_prune(args: argparse.Namespace) -> int:
     from nfwserver.cli import CliError
 
@@ -204,12 +233,35 @@ def run_prune(args: argparse.Namespace) -> int:
     store = _store(config)
     if not store.path.exists():
         raise CliError(f"the stored catalog {store.path} does not exist yet (`nfwserver elements update` creates it)")
+    keep = _protected(config)
+    plan = store.plan_prune(datetime.now(timezone.utc), args.days, frozenset(keep))
+    for es in plan.protected:
+        _say(f"kept {es.catalog_number} {es.name}: {keep[es.catalog_number]}")
+    removed = plan.removed
+    if args.dry_run:
+        for es in removed:
+            reason = "decayed" if es in plan.decayed else f"{(datetime.now(timezone.utc) - es.epoch).days} days old"
+            print(f"{es.catalog_number:>7}  {es.name}  ({reason})")
+        print(f"would remove {len(plan.decayed)} decayed and {len(plan.old)} older than {args.days:g} days; "
+              f"{plan.kept} of {plan.total} sets would remain in {store.path}")
+        return 0
+    if removed and not plan.kept and not args.all:
+        raise CliError(f"pruning would empty {store.path} (all {plan.total} sets are decayed or older than "
+                       f"{args.days:g} days); `nfwserver elements update` fetches current ones, --all removes them "
+                       "anyway, --dry-run lists them")
+    if 2 * len(removed) > plan.total and not args.yes:
+        what = f"{len(removed)} of the {plan.total} sets in {store.path}"
+        if not sys.stdin.isatty():
+            raise CliError(f"pruning would remove {what}; give --yes to confirm (--dry-run lists them)")
+        if not _confirm(f"remove {what}?"):
+            _say("nothing removed")
+            return 1
     try:
-        summary = store.prune(datetime.now(timezone.utc), args.days)
+        kept = store.apply_prune(plan)
     except OSError as exc:
         raise CliError(f"cannot write {store.path}: {exc.strerror or exc}") from None
-    for es in summary.decayed:
+    for es in plan.decayed:
         _say(f"removed {es.catalog_number} {es.name}: decayed")
-    print(f"removed {len(summary.decayed)} decayed and {len(summary.old)} older than {args.days:g} days; "
-          f"{summary.kept} sets remain in {store.path}")
+    print(f"removed {len(plan.decayed)} decayed and {len(plan.old)} older than {args.days:g} days; "
+          f"{kept} sets remain in {store.path}")
     return 0
