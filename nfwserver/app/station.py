@@ -25,7 +25,7 @@ from nfwserver.app.element_sources import FetchResult
 from nfwserver.app.long_lived import building_long_lived, release
 from nfwserver.app.session_state import SessionSaver, SessionState, StateFile
 from nfwserver.app.station_catalog import configured_store, configured_urls, fetch_configured, load_station_catalog
-from nfwserver.app.status_fields import device_status
+from nfwserver.app.status_fields import combined, device_status, elements_status
 from nfwserver.clock import Clock
 from nfwserver.config.live_reload import keep_running, restart_needed
 from nfwserver.config.schema import Config
@@ -88,7 +88,9 @@ class Station:
                            health=self.core.health.link("easycomm", Backoff(0.5, 2.0)))
             if config.easycomm.enabled else None)
         self.tcp: NovaTcpServer | None = (
-            NovaTcpServer(self.core, config.tcp, device_status(self.rotor, self.radio, self.easycomm),
+            NovaTcpServer(self.core, config.tcp,
+                          combined(device_status(self.rotor, self.radio, self.easycomm),
+                                   elements_status(self.core.state, clock, config.elements.stale_days)),
                           set_flip=self.rotor.set_flip_mode if self.rotor is not None else None)
             if config.tcp.enabled else None)
         self.watcher: ConfigWatcher | None = None
