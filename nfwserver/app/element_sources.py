@@ -1,25 +1,29 @@
 """Reading element sets from the bundled file, local files and URLs (InstantTrack UPDATE semantics).
 
-URLs are read with a timeout and a size limit; a source that fails is reported once, as one
-plain sentence (:class:`SourceError`), and the others still load, so a dead web site never stops
-the server.  A source that holds no element set at all (empty, binary or unrelated text) counts
-as failed: it is almost always the wrong file or an error page.
+URLs are read with a timeout.  Every file and URL is held to :class:`SourceLimits` (``[elements]
+max_source_mib`` and ``max_source_sets``): a file is measured before it is read and read with a
+bounded read, a download stops at the limit, and a source over either limit is refused whole with one
+sentence naming it and the limit.  A source that fails is reported once, as one plain sentence
+(:class:`SourceError`), and the others still load, so a dead web site never stops the server.  A
+source that holds no element set at all (empty, binary or unrelated text) counts as failed: it is
+almost always the wrong file or an error page.
 """
 
 from __future__ import annotations
 
+import contextlib
 import http.client
+import os
 import socket
 import urllib.error
 import urllib.request
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
 from importlib import resources
-from pathlib import Path
 
 from nfwserver.tracking.elements import ElementSet, LoadResult, Rejection, load_elements
 
-MAX_DOWNLOAD_BYTES = 50 * 1024 * 1024
 BUNDLED = "amateur.txt"
 BUNDLED_SOURCE = f"bundled {BUNDLED}"
 _CHUNK = 64 * 1024
@@ -30,6 +34,23 @@ ProgressCallback = Callable[[int, "int | None"], None]
 
 class SourceError(Exception):
     """A source that yielded nothing usable; ``str()`` is one sentence naming the source."""
+
+
+@dataclass(frozen=True)
+class SourceLimits:
+    """What one element source (a file or a URL) may hold; the defaults are the configuration's."""
+
+    max_bytes: int = 64 * 2**20  #: size of the file or download, bytes (``[elements] max_source_mib``)
+    max_sets: int = 100_000  #: element sets in it (``[elements] max_source_sets``)
+
+    def too_large(self, source: str) -> SourceError:
+        size = f"{self.max_bytes / 2**20:g} MiB" if self.max_bytes >= 2**20 else f"{self.max_bytes:,} bytes"
+        return SourceError(f"{source} is larger than {size}, the limit for one element source "
+                           "([elements] max_source_mib)")
+
+    def too_many(self, source: str) -> SourceError:
+        return SourceError(f"{source} holds more than {self.max_sets:,} element sets, the limit for one element "
+                           "source ([elements] max_source_sets)")
 
 
 @dataclass
@@ -67,8 +88,9 @@ def _network_reason(exc: BaseException, timeout_s: float) -> str:
     return repr(str(exc) or type(exc).__name__)[1:-1]  # one line, whatever the server sent
 
 
-def fetch_url(url: str, timeout_s: float = 20.0, progress: ProgressCallback | None = None) -> bytes:
-    """GET ``url`` (http/https only); raises :class:`SourceError` with one plain sentence."""
+def fetch_url(url: str, timeout_s: float = 20.0, progress: ProgressCallback | None = None,
+              limits: SourceLimits = SourceLimits()) -> bytes:
+    """GET ``url`` (http/https only), at most ``limits.max_bytes``; raises :class:`SourceError` (one sentence)."""
     scheme = url.partition("://")[0].lower()
     if scheme not in ("http", "https"):
         raise SourceError(f"{url}: unsupported scheme {scheme}:// (element sources are files or http(s) URLs)")
@@ -79,7 +101,9 @@ def fetch_url(url: str, timeout_s: float = 20.0, progress: ProgressCallback | No
         with urllib.request.urlopen(request, timeout=timeout_s) as response:  # noqa: S310 - scheme checked above
             length = response.headers.get("Content-Length")
             total = int(length) if length and length.isascii() and length.isdigit() else None
-            while size <= MAX_DOWNLOAD_BYTES:
+            if total is not None and total > limits.max_bytes:
+                raise limits.too_large(url)
+            while size <= limits.max_bytes:
                 chunk = response.read(_CHUNK)
                 if not chunk:
                     break
@@ -91,9 +115,24 @@ def fetch_url(url: str, timeout_s: float = 20.0, progress: ProgressCallback | No
                 raise OSError(f"the connection closed {total - size} bytes before the announced end")
     except (OSError, ValueError, urllib.error.URLError, http.client.HTTPException) as exc:
         raise SourceError(f"cannot fetch {url}: {_network_reason(exc, timeout_s)}") from None
-    if size > MAX_DOWNLOAD_BYTES:
-        raise SourceError(f"{url} is larger than {MAX_DOWNLOAD_BYTES // 2**20} MiB")
+    if size > limits.max_bytes:
+        raise limits.too_large(url)
     return b"".join(chunks)
+
+
+def read_file(path: str, limits: SourceLimits = SourceLimits()) -> bytes:
+    """The bytes of the file ``path``, refused unread when its size is over ``limits.max_bytes`` and read
+    with a bounded read (a file that grows, or is no regular file, is cut at the limit and refused)."""
+    try:
+        with open(path, "rb") as f:
+            if os.fstat(f.fileno()).st_size > limits.max_bytes:
+                raise limits.too_large(path)
+            data = f.read(limits.max_bytes + 1)
+    except OSError as exc:
+        raise SourceError(f"cannot read {path}: {(exc.strerror or str(exc)).lower()}") from None
+    if len(data) > limits.max_bytes:
+        raise limits.too_large(path)
+    return data
 
 
 def _looks_binary(data: bytes) -> bool:
@@ -106,13 +145,22 @@ def _looks_binary(data: bytes) -> bool:
     return odd > len(text) // 20
 
 
-def parse_source(data: bytes, source: str) -> LoadResult:
-    """The element sets in ``data``; raises :class:`SourceError` when there are none."""
+def _fewest_sets(data: bytes) -> int:
+    """A lower bound of the sets in ``data``, counted without parsing: TLE line 1s or OMM JSON objects."""
+    return max(data.count(b"\n1 ") + data.startswith(b"1 "), data.count(b'"NORAD_CAT_ID"'))
+
+
+def parse_source(data: bytes, source: str, limits: SourceLimits = SourceLimits()) -> LoadResult:
+    """The element sets in ``data``; raises :class:`SourceError` when there are none or too many."""
     if not data.strip():
         raise SourceError(f"{source} is empty")
     if _looks_binary(data):
         raise SourceError(f"{source} is not a text file of element sets (it holds binary data)")
+    if _fewest_sets(data) > limits.max_sets:
+        raise limits.too_many(source)
     loaded = load_elements(data, source=source)
+    if len(loaded.sets) > limits.max_sets:
+        raise limits.too_many(source)
     if not loaded.sets:
         why = f" (first problem: line {loaded.rejected[0].line_number}: {loaded.rejected[0].reason})" \
             if loaded.rejected else ""
@@ -120,29 +168,36 @@ def parse_source(data: bytes, source: str) -> LoadResult:
     return loaded
 
 
-def read_source(source: str, timeout_s: float = 20.0, progress: ProgressCallback | None = None) -> LoadResult:
-    """Element sets from a file or an http(s) URL; raises :class:`SourceError` (one sentence)."""
+def read_source(source: str, timeout_s: float = 20.0, progress: ProgressCallback | None = None,
+                limits: SourceLimits = SourceLimits(),
+                parsing: Callable[[], AbstractContextManager[object]] = contextlib.nullcontext) -> LoadResult:
+    """Element sets from a file or an http(s) URL; raises :class:`SourceError` (one sentence).
+
+    ``parsing()`` is entered around the parse (not the download): the station passes
+    :func:`~nfwserver.app.long_lived.building_long_lived`."""
     if is_url(source):
-        data = fetch_url(source, timeout_s, progress)
+        data = fetch_url(source, timeout_s, progress, limits)
     else:
-        try:
-            data = Path(source).read_bytes()
-        except OSError as exc:
-            raise SourceError(f"cannot read {source}: {(exc.strerror or str(exc)).lower()}") from None
+        data = read_file(source, limits)
         if progress is not None:
             progress(len(data), len(data))
-    return parse_source(data, source)
+    with parsing():
+        return parse_source(data, source, limits)
 
 
 def fetch_all(files: tuple[str, ...] = (), urls: tuple[str, ...] = (), use_bundled: bool = True,
-              timeout_s: float = 20.0) -> FetchResult:
-    """Element sets from every source, in order; never raises (failures are in ``failed``)."""
+              timeout_s: float = 20.0, limits: SourceLimits = SourceLimits(),
+              parsing: Callable[[], AbstractContextManager[object]] = contextlib.nullcontext,
+              labels: Mapping[str, str] | None = None) -> FetchResult:
+    """Element sets from every source, in order; never raises (failures are in ``failed``, each one line
+    opening with the source's label from ``labels`` when it has one, e.g. a preset's name)."""
     result = bundled_elements() if use_bundled else FetchResult()
     for source in (*files, *urls):
         try:
-            loaded = read_source(source, timeout_s)
+            loaded = read_source(source, timeout_s, limits=limits, parsing=parsing)
         except SourceError as exc:
-            result.failed.append(str(exc))
+            label = (labels or {}).get(source)
+            result.failed.append(f"{label}: {exc}" if label else str(exc))
             continue
         result.sets += loaded.sets
         result.rejected += loaded.rejected

@@ -32,11 +32,21 @@ def default_store_path() -> Path:
 
 @dataclass
 class PruneSummary:
-    """What :meth:`ElementStore.prune` removed and how many sets remain."""
+    """What :meth:`ElementStore.plan_prune` would remove (or :meth:`ElementStore.prune` removed) and what stays."""
 
     decayed: list[ElementSet] = field(default_factory=list)  #: InstantTrack's CRASH
     old: list[ElementSet] = field(default_factory=list)  #: InstantTrack's OLD
     kept: int = 0
+    protected: list[ElementSet] = field(default_factory=list)  #: old or decayed, kept because asked to
+
+    @property
+    def removed(self) -> list[ElementSet]:
+        return [*self.decayed, *self.old]
+
+    @property
+    def total(self) -> int:
+        """Sets in the store when planned."""
+        return self.kept + len(self.removed)
 
 
 def has_decayed(es: ElementSet, at: datetime) -> bool:
@@ -70,26 +80,38 @@ class ElementStore:
         catalog = Catalog(self.load())
         summary = catalog.update(sets)
         if summary.added or summary.updated or not self.path.exists():
-            text = "".join(sat.elements.tle_text() for sat in catalog)
+            text = "".join(es.tle_text() for es in catalog.element_sets())
             atomic_write_text(self.path, text)
         return catalog, summary
 
-    def prune(self, now: datetime, max_age_days: float) -> PruneSummary:
-        """Remove decayed objects and sets whose epoch is more than ``max_age_days`` before ``now``.
-
-        The file is rewritten atomically, and only when something was removed.
-        """
+    def plan_prune(self, now: datetime, max_age_days: float, keep: frozenset[int] = frozenset()) -> PruneSummary:
+        """What pruning would remove: decayed objects and sets whose epoch is more than ``max_age_days`` before
+        ``now``, except the catalog numbers in ``keep`` (the selected satellite, favourites).  Writes nothing."""
         summary = PruneSummary()
         oldest = now - timedelta(days=max_age_days)
-        kept: list[ElementSet] = []
         for es in self.load():
-            if has_decayed(es, now):
-                summary.decayed.append(es)
-            elif es.epoch < oldest:
-                summary.old.append(es)
+            doomed = summary.decayed if has_decayed(es, now) else summary.old if es.epoch < oldest else None
+            if doomed is None:
+                summary.kept += 1
+            elif es.catalog_number in keep:
+                summary.protected.append(es)
+                summary.kept += 1
             else:
-                kept.append(es)
-        summary.kept = len(kept)
-        if summary.decayed or summary.old:
+                doomed.append(es)
+        return summary
+
+    def apply_prune(self, planned: PruneSummary) -> int:
+        """Remove exactly the sets ``planned`` names (same catalog number and epoch; a set updated since
+        the plan stays) and rewrite the file atomically if anything went; returns how many sets remain."""
+        gone = {(es.catalog_number, es.epoch) for es in planned.removed}
+        sets = self.load()
+        kept = [es for es in sets if (es.catalog_number, es.epoch) not in gone]
+        if len(kept) != len(sets):
             atomic_write_text(self.path, "".join(es.tle_text() for es in kept))
+        return len(kept)
+
+    def prune(self, now: datetime, max_age_days: float, keep: frozenset[int] = frozenset()) -> PruneSummary:
+        """:meth:`plan_prune`, then :meth:`apply_prune` at once."""
+        summary = self.plan_prune(now, max_age_days, keep)
+        summary.kept = self.apply_prune(summary)
         return summary

@@ -22,10 +22,11 @@ from collections.abc import Callable
 from nfwserver.app.config_watcher import ConfigWatcher
 from nfwserver.app.devices import make_radio, make_rotor
 from nfwserver.app.element_refresher import ElementRefresher
-from nfwserver.app.element_sources import FetchResult, fetch_all
+from nfwserver.app.element_sources import FetchResult
+from nfwserver.app.long_lived import building_long_lived, release
 from nfwserver.app.session_state import SessionSaver, SessionState, StateFile
-from nfwserver.app.station_catalog import configured_store, load_station_catalog
-from nfwserver.app.status_fields import device_status
+from nfwserver.app.station_catalog import configured_store, configured_urls, fetch_configured, load_station_catalog
+from nfwserver.app.status_fields import combined, device_status, elements_status
 from nfwserver.clock import Clock
 from nfwserver.config.live_reload import keep_running, restart_needed
 from nfwserver.config.schema import Config
@@ -72,7 +73,7 @@ class Station:
         self.dialect_servers = [DialectServer(DDE_DIALECTS[name], self.core) for name in config.dialects.dde]
         self.publisher = Publisher(self.core, clock)
         self.refresher = ElementRefresher(self.refresh_elements, clock, config.elements.refresh_hours * 3600.0,
-                                          initial=bool(config.elements.urls))
+                                          initial=bool(configured_urls(config.elements)))
         self.predict: PredictUdpServer | None = None
         if config.dialects.predict_udp:
             context = PredictContext(self.core.state, clock, self._predict_list,
@@ -89,7 +90,9 @@ class Station:
                            health=self.core.health.link("easycomm", Backoff(0.5, 2.0)))
             if config.easycomm.enabled else None)
         self.tcp: NovaTcpServer | None = (
-            NovaTcpServer(self.core, config.tcp, device_status(self.rotor, self.radio, self.easycomm),
+            NovaTcpServer(self.core, config.tcp,
+                          combined(device_status(self.rotor, self.radio, self.easycomm),
+                                   elements_status(self.core.state, clock, config.elements.stale_days)),
                           set_flip=self.rotor.set_flip_mode if self.rotor is not None else None)
             if config.tcp.enabled else None)
         self.watcher: ConfigWatcher | None = None
@@ -155,26 +158,34 @@ class Station:
 
     def _load_catalog(self) -> None:
         """Stored catalog, element files and the bundled sets (no network: URLs come on the refresher)."""
-        loaded, fetched = load_station_catalog(self.config)
-        self._report(fetched)
-        catalog = self.core.state.catalog
-        catalog.update(sat.elements for sat in loaded)
+        with building_long_lived():
+            loaded, fetched = load_station_catalog(self.config)
+            self._report(fetched)
+            catalog = self.core.state.catalog
+            catalog.update(loaded.element_sets())
         self.core.state.catalog_changed()
         if not len(catalog):
             log.warning("no element sets loaded: nothing can be tracked until some are added")
 
     def refresh_elements(self) -> UpdateSummary:
-        """Read every element source again (refresher thread); newer epochs replace older ones."""
-        cfg = self.config.elements
-        fetched = fetch_all(cfg.files, cfg.urls, cfg.use_bundled)
+        """Read every element source again (refresher thread); newer epochs replace older ones.
+
+        Everything here runs on the calling thread: reading, parsing, merging and naming the new
+        catalog (:meth:`Catalog.update`), and saving the store.  The publish thread only ever sees the
+        swap of the catalog's contents, a reference change, and no garbage collection over the new
+        sets (:func:`~nfwserver.app.long_lived.building_long_lived`), so a refresh never delays a tick."""
+        fetched = fetch_configured(self.config.elements, fetch_urls=True, parsing=building_long_lived)
         self._report(fetched)
-        summary = self.core.state.catalog.update(fetched.sets)
-        self.core.state.catalog_changed()
-        if self.store is not None and (summary.added or summary.updated):
-            try:
-                self.store.update(fetched.sets)
-            except OSError as exc:
-                log.error("cannot save the element catalog to %s: %s", self.store.path, exc)
+        with building_long_lived():
+            summary = self.core.state.catalog.update(fetched.sets)
+            if summary.added or summary.updated:
+                self.core.state.catalog_changed()
+            if self.store is not None and (summary.added or summary.updated):
+                try:
+                    self.store.update(fetched.sets)
+                except OSError as exc:
+                    log.error("cannot save the element catalog to %s: %s", self.store.path, exc)
+            release(fetched.sets)  # the sets that were not newer
         log.info("elements refreshed: %d added, %d updated", len(summary.added), len(summary.updated))
         return summary
 
@@ -229,7 +240,7 @@ class Station:
                 worker.start()
         self.publisher.start()
         cfg = self.config.elements
-        if cfg.urls or (cfg.refresh_hours > 0 and cfg.files) or self.predict is not None:
+        if configured_urls(cfg) or (cfg.refresh_hours > 0 and cfg.files) or self.predict is not None:
             self.refresher.start()
 
     def stop(self) -> None:

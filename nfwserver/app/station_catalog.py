@@ -2,16 +2,20 @@
 
 Order (InstantTrack UPDATE semantics, a set replaces another only with a newer epoch): the stored
 catalog (``[elements] store``, kept by ``nfwserver elements update``) first, then the configured
-element files, the configured URLs (only when asked: the command-line tools do not touch the
+element files, the configured URLs and named sources (only when asked: the command-line tools do not touch the
 network unless told to), and the bundled set when ``[elements] use_bundled`` is on.  DDE names
 follow ``[satellites] names``.
 """
 
 from __future__ import annotations
 
-from nfwserver.app.element_sources import FetchResult, fetch_all
+from collections.abc import Callable
+from contextlib import AbstractContextManager, nullcontext
+
+from nfwserver.app.element_sources import FetchResult, SourceLimits, fetch_all
 from nfwserver.app.element_store import ElementStore
-from nfwserver.config.schema import Config
+from nfwserver.config.element_presets import preset_urls
+from nfwserver.config.schema import Config, ElementsConfig
 from nfwserver.tracking.catalog import Catalog
 
 
@@ -23,6 +27,25 @@ def configured_store(config: Config) -> ElementStore | None:
     return ElementStore(None if store == "default" else store)
 
 
+def source_limits(elements: ElementsConfig) -> SourceLimits:
+    """``[elements] max_source_mib`` and ``max_source_sets`` as :class:`SourceLimits`."""
+    return SourceLimits(int(elements.max_source_mib * 2**20), elements.max_source_sets)
+
+
+def configured_urls(elements: ElementsConfig) -> dict[str, str]:
+    """Every configured URL: ``[elements] urls`` (label ``""``) then the named sources' URLs (label: the
+    preset, e.g. ``amateur (CelesTrak, TLE)``)."""
+    return {**dict.fromkeys(elements.urls, ""), **preset_urls(elements.sources, elements.preset_mirror)}
+
+
+def fetch_configured(elements: ElementsConfig, *, fetch_urls: bool, timeout_s: float = 20.0,
+                     parsing: Callable[[], AbstractContextManager[object]] = nullcontext) -> FetchResult:
+    """The sets of every configured source (URLs and named sources only when ``fetch_urls``)."""
+    urls = configured_urls(elements) if fetch_urls else {}
+    return fetch_all(elements.files, tuple(urls), elements.use_bundled, timeout_s, source_limits(elements),
+                     parsing, labels=urls)
+
+
 def load_station_catalog(config: Config, *, fetch_urls: bool = False,
                          timeout_s: float = 20.0) -> tuple[Catalog, FetchResult]:
     """The catalog ``nfwserver run`` tracks, and what reading the sources found.
@@ -31,10 +54,9 @@ def load_station_catalog(config: Config, *, fetch_urls: bool = False,
     stored ones); ``failed`` one sentence per source that could not be used.  Never raises for
     bad sources.
     """
-    elements = config.elements
     store = configured_store(config)
     stored = store.load() if store is not None else []
-    fetched = fetch_all(elements.files, elements.urls if fetch_urls else (), elements.use_bundled, timeout_s)
+    fetched = fetch_configured(config.elements, fetch_urls=fetch_urls, timeout_s=timeout_s)
     catalog = Catalog(stored, dde_names=config.dde_names)
     catalog.update(fetched.sets)
     return catalog, fetched

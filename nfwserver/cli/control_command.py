@@ -77,5 +77,15 @@ def poke(args: argparse.Namespace) -> int:
 
 
 def status(args: argparse.Namespace) -> int:
-    print(_ask(args, "STATUS"))
+    """The STATUS line on stdout; a stale element set (``elements_stale=yes``) is also said on stderr."""
+    import sys
+
+    line = _ask(args, "STATUS")
+    print(line)
+    fields = dict(word.partition("=")[::2] for word in line.split() if "=" in word)
+    if fields.get("elements_stale") == "yes":
+        name = fields.get("name", "the selected satellite")
+        print(f"nfwserver: the elements of {name} are {fields.get('elements_age_d', '?')} days old, older than "
+              "[elements] stale_days: positions drift; `nfwserver elements update` fetches current ones",
+              file=sys.stderr)
     return 0

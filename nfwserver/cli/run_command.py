@@ -100,9 +100,9 @@ def _notes(station: Any, config: Any) -> tuple[list[str], str]:
              station.selection_note]
     hints = [] if config.observer_configured else [observer_hint(config)]
     ages = [s.age_days(station.clock.now()) for s in station.catalog]
-    if ages and min(ages) > 14:
-        hints.append(f"the newest element set is {min(ages):.0f} days old: positions drift; add current elements "
-                     "([elements] files or urls in the configuration)")
+    if ages and min(ages) > config.elements.stale_days:
+        hints.append(f"the newest element set is {min(ages):.0f} days old: positions drift; "
+                     "`nfwserver elements update` fetches current ones")
     return [n for n in notes if n] + hints, " ".join(hints + [station.selection_note])
 
 
@@ -112,7 +112,8 @@ def _make_console(station: Any, config: Any, hint: str) -> Any:
     return NfwConsole(station.core, station.transport_note, hint, radio=station.radio, rotor=station.rotor,
                       favourites=config.favourites or (25544, 27607, 43017, 44909, 7530),
                       clients=station.nova.client_count, tcp=station.tcp, easycomm=station.easycomm,
-                      config_file=config.path or "", schedules=config.schedules)
+                      config_file=config.path or "", schedules=config.schedules,
+                      stale_days=config.elements.stale_days)
 
 
 def _stop_on_signals(stop: threading.Event) -> None:

@@ -97,10 +97,11 @@ def _pick(catalog: Catalog, text: str) -> Satellite:
     return sat
 
 
-def _screen(sats: list[Any], catalog: Catalog, observer: Observer, ut1_utc: float, at: datetime) -> list[Any]:
-    """The satellites (or element sets) whose positions at ``at`` are usable; the rest and stale sets are
-    reported (by DDE name)."""
-    from nfwserver.tracking.screening import STALE_AFTER_DAYS, stale_satellites, usable_mask
+def _screen(sats: list[Any], catalog: Catalog, observer: Observer, ut1_utc: float, at: datetime,
+            stale_days: float) -> list[Any]:
+    """The satellites (or element sets) whose positions at ``at`` are usable; the rest and sets older than
+    ``stale_days`` (``[elements] stale_days``) are reported (by DDE name)."""
+    from nfwserver.tracking.screening import stale_satellites, usable_mask
 
     usable = usable_mask(sats, observer, at, ut1_utc).tolist()
     if not all(usable):
@@ -109,12 +110,17 @@ def _screen(sats: list[Any], catalog: Catalog, observer: Observer, ut1_utc: floa
         warn(f"skipped {len(unusable)} object(s) whose position at {format_time(at)} cannot be computed "
              f"or is implausibly far (decayed or elements far outside their validity): {names}")
         sats = [s for s, ok in zip(sats, usable) if ok]
-    stale = stale_satellites(sats, at)
+    stale = stale_satellites(sats, at, stale_days)
     if stale:
         names = _dde_names(stale[:5], catalog) + (", ..." if len(stale) > 5 else "")
-        warn(f"{len(stale)} element set(s) are more than {STALE_AFTER_DAYS:g} days older than {format_time(at)}, "
+        warn(f"{len(stale)} element set(s) are more than {stale_days:g} days older than {format_time(at)}, "
              f"so their positions drift ({names}); `nfwserver elements update` fetches newer ones")
     return sats
+
+
+def _stale_days(inputs: TrackingInputs) -> float:
+    """``[elements] stale_days`` of the configuration in use."""
+    return float(inputs.config().elements.stale_days)
 
 
 def _dde_names(sats: list[Any], catalog: Catalog) -> str:
@@ -148,7 +154,7 @@ def run_ephemeris(args: argparse.Namespace) -> int:
     if args.sat is None and inputs.satellite is None:
         raise CliError("no --sat given and no [server] satellite configured")
     sat = _pick(inputs.catalog, str(args.sat if args.sat is not None else inputs.satellite))
-    _screen([sat], inputs.catalog, inputs.observer, inputs.ut1_utc, start)
+    _screen([sat], inputs.catalog, inputs.observer, inputs.ut1_utc, start, _stale_days(inputs))
     calc = LookAngleCalculator(inputs.observer, inputs.ut1_utc)
     writer = RowWriter(EPHEMERIS_COLUMNS, args.format, sys.stdout)
     count = int(args.duration // args.step) + 1
@@ -225,7 +231,7 @@ def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str], di
     inputs = TrackingInputs(args)  # the configuration only if an option leaves a value to it
     horizon, observer, ut1_utc, catalog = inputs.horizon, inputs.observer, inputs.ut1_utc, inputs.catalog
     sets = _chosen_sets(args, inputs, catalog)
-    sets = _screen(sets, catalog, observer, ut1_utc, start)
+    sets = _screen(sets, catalog, observer, ut1_utc, start, _stale_days(inputs))
     passes = find_passes(sets, observer, start, start + timedelta(hours=args.hours), horizon=horizon,
                          ut1_utc=ut1_utc, workers=args.workers)
     numbers = np.unique(passes.columns["catalog_number"]).tolist()
@@ -274,7 +280,8 @@ def run_visible(args: argparse.Namespace) -> int:
 
     at = args.at
     inputs = load_tracking_inputs(args)
-    sats = _screen(inputs.catalog.satellites(), inputs.catalog, inputs.observer, inputs.ut1_utc, at)
+    sats = _screen(inputs.catalog.satellites(), inputs.catalog, inputs.observer, inputs.ut1_utc, at,
+                   _stale_days(inputs))
     if sats:
         jd, fr = julian_date(at)
         arr = look_angles_array([s.satrec for s in sats], inputs.observer, np.array([jd]), np.array([fr]),

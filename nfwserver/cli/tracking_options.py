@@ -172,13 +172,21 @@ def _load_config(args: argparse.Namespace) -> Config:
 
 
 def _catalog_from_files(paths: list[str], inputs: TrackingInputs) -> Catalog:
+    from nfwserver.app.element_sources import SourceError, read_file
+    from nfwserver.app.station_catalog import source_limits
     from nfwserver.cli import CliError
     from nfwserver.tracking.catalog import Catalog
-    from nfwserver.tracking.elements import load_element_file
+    from nfwserver.tracking.elements import load_elements
 
+    limits = source_limits(inputs.config().elements)
     sets = []
     for path in paths:
-        result = load_element_file(path)
+        try:
+            result = load_elements(read_file(path, limits), source=path)
+        except SourceError as exc:
+            raise CliError(str(exc)) from None
+        if len(result.sets) > limits.max_sets:
+            raise CliError(str(limits.too_many(path)))
         for rejection in result.rejected:
             warn(f"skipped element set: {rejection}")
         sets.extend(result.sets)

@@ -127,6 +127,10 @@ def _urls(setting: Setting, value: Any, base: Path | None) -> tuple[str, ...]:
     return urls
 
 
+def _url(setting: Setting, value: Any, base: Path | None) -> str:
+    return _urls(setting, [value], base)[0]
+
+
 def _path(value: Any, base: Path | None) -> str:
     if not isinstance(value, str) or not value or "\0" in value:
         raise ValueError("must be a file name")
@@ -274,7 +278,7 @@ def _channels(setting: Setting, value: Any, base: Path | None) -> dict[int, Chan
 CONVERTERS: dict[str, Converter] = {
     "bool": _bool, "int": _int, "number": _number, "choice": _choice, "text": _text, "texts": _texts,
     "choices": _choices, "catnr": _catnr, "catnrs": _catnrs, "host": _host, "networks": _networks,
-    "urls": _urls, "file": _file, "files": _files, "store": _store, "location": _location,
+    "urls": _urls, "url": _url, "file": _file, "files": _files, "store": _store, "location": _location,
     "points": _points, "names": _names, "schedules": _schedules, "channels": _channels, "device": _text,
 }
 

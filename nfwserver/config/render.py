@@ -72,7 +72,10 @@ def _template_lines(entry: Setting) -> list[str]:
         for key, example, help_text in CHANNEL_KEYS:
             lines.append(f"# {f'{key} = {toml_value(example)}':<40} # {help_text}")
         return lines
-    if entry.example is not None or entry.default is None:
+    if entry.initial is not None:
+        lines += _comment(f"(a starting choice; without this line: {entry.key} = {toml_value(entry.default)})")
+        lines.append(f"{entry.key} = {toml_value(entry.initial)}")
+    elif entry.example is not None or entry.default is None:
         lines.append(f"# {entry.key} = {toml_value(entry.example)}")
     else:
         lines.append(f"{entry.key} = {toml_value(entry.default)}")
@@ -82,7 +85,7 @@ def _template_lines(entry: Setting) -> list[str]:
 def _limits(entry: Setting) -> str:
     if entry.kind in ("number", "int") and entry.lo is not None:
         return f" ({_number(entry.lo)}..{_number(entry.hi)})"
-    if entry.kind in ("choice", "choices") and len(entry.choices) > 3:
+    if entry.kind in ("choice", "choices") and 3 < len(entry.choices) <= 12:
         return " (" + ", ".join(str(c) for c in entry.choices) + ")"
     return ""
 
@@ -93,8 +96,8 @@ def _number(value: float | None) -> str:
 
 def template() -> str:
     """The commented starting file written by ``nfwserver config init``."""
-    out = ["# nfwserver configuration.  Every key is optional: the values written below are the defaults,",
-           "# and commented-out lines show keys that are not set by default.",
+    out = ["# nfwserver configuration.  Every key is optional: the values written below are the defaults",
+           "# (except the starting choices, marked), and commented-out lines show keys that are not set by default.",
            "# Run `nfwserver config show` to see what the server makes of this file."]
     for section in SECTIONS:
         out += ["", f"[{section.name}]", *_comment(section.help)]

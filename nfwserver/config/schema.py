@@ -22,10 +22,15 @@ DEFAULT_OBSERVER = Observer(51.4779, -0.0015, 46.0)
 class ElementsConfig:
     files: tuple[str, ...] = default("elements", "files")  #: element files, read at start and on every refresh
     urls: tuple[str, ...] = default("elements", "urls")  #: element URLs (http/https)
+    sources: tuple[str, ...] = default("elements", "sources")  #: named sources (config.element_presets)
+    preset_mirror: str | None = default("elements", "preset_mirror")  #: base URL replacing the presets' sites
     refresh_hours: float = default("elements", "refresh_hours")  #: 0 disables the periodic refresh
     use_bundled: bool = default("elements", "use_bundled")  #: include the bundled amateur and weather satellites
     #: stored catalog file (``elements update``); "default": user data dir; None: off
     store: str | None = default("elements", "store")
+    max_source_mib: float = default("elements", "max_source_mib")  #: largest file or download, MiB
+    max_source_sets: int = default("elements", "max_source_sets")  #: most element sets in one source
+    stale_days: float = default("elements", "stale_days")  #: sets older than this are flagged as stale
 
 
 @dataclass(frozen=True)

@@ -26,6 +26,7 @@ class Setting:
     hi: float | None = None
     choices: tuple[Any, ...] = ()
     example: Any = None  #: shown commented out in the template instead of the default
+    initial: Any = None  #: written by ``config init`` instead of the default (a starting choice)
 
     @property
     def name(self) -> str:

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from nfwserver.config.element_presets import DEFAULT_PRESET, PRESETS
 from nfwserver.config.kinds import convert
 from nfwserver.config.setting import Section, Setting
 
@@ -60,12 +61,25 @@ SETTINGS: tuple[Setting, ...] = (
        "elements.files", example=["my-keps.txt"]),
     _S("elements", "urls", "urls", [], "element URLs (http or https)", "elements.urls",
        example=["https://example.org/amateur.txt"]),
-    _S("elements", "refresh_hours", "number", 24, "read files and URLs again this often while running; 0 = never",
+    _S("elements", "sources", "choices", [], "named sources (`nfwserver elements sources` lists them): CelesTrak "
+       "groups as TLE (\"amateur\", \"weather\", \"active\" ...), OMM JSON (\"amateur-json\") or OMM CSV "
+       "(\"amateur-csv\"), and \"amsat\" (AMSAT's bare TLE file)", "elements.sources", choices=tuple(PRESETS),
+       initial=[DEFAULT_PRESET]),
+    _S("elements", "preset_mirror", "url", None, "fetch the named sources from this base URL instead of their own "
+       "sites (a local mirror)", "elements.preset_mirror", example="http://mirror.example/elements"),
+    _S("elements", "refresh_hours", "number", 24, "read files, URLs and named sources again this often while "
+       "running; 0 = never",
        "elements.refresh_hours", 0, 24 * 30),
     _S("elements", "use_bundled", "bool", True, "include the bundled amateur and weather satellites",
        "elements.use_bundled"),
     _S("elements", "store", "store", "default", "catalog kept by `nfwserver elements update`: \"default\" (the user "
        "data directory), a file, or \"none\"", "elements.store"),
+    _S("elements", "max_source_mib", "number", 64, "largest element file or download read, MiB; a larger source "
+       "is refused whole", "elements.max_source_mib", 0.001, 1024),
+    _S("elements", "max_source_sets", "int", 100_000, "most element sets one file or URL may hold; a source with "
+       "more is refused whole", "elements.max_source_sets", 1, 1_000_000),
+    _S("elements", "stale_days", "number", 14, "element sets older than this are flagged in `passes`, `status` and "
+       "the console", "elements.stale_days", 0.1, 3650),
     # [server]
     _S("server", "rate_hz", "number", 5, "publish rate, Hz", "server.rate_hz", 1, 50),
     _S("server", "services", "texts", ["NFW32", "NFW_SERVER"], "DDE service names served", "server.services", hi=255),

@@ -37,7 +37,7 @@ from textual.widgets import Footer, Input, RichLog, Static
 from nfwserver.commands.help_text import help_lines
 from nfwserver.commands.parsing import parse_line
 from nfwserver.commands.table import CommandError, Face, Target
-from nfwserver.console.pass_view import PassSearch, next_pass_text, pass_table, search_passes
+from nfwserver.console.pass_view import STALE_DAYS, PassSearch, next_pass_text, pass_table, search_passes
 from nfwserver.console.picker import SatellitePicker
 from nfwserver.console.reflow_log import ReflowLog
 from nfwserver.console.skyplot import render_sky
@@ -97,7 +97,8 @@ class NfwConsole(App[None]):
                  radio: RadioCoupling | None = None, rotor: RotorCoupling | None = None,
                  favourites: tuple[int, ...] = (), clients: Callable[[], tuple[int, int]] | None = None, *,
                  tcp: object | None = None, easycomm: object | None = None, config_file: str = "",
-                 schedules: Mapping[int, str] | None = None, local_zone: tzinfo | None = None) -> None:
+                 schedules: Mapping[int, str] | None = None, local_zone: tzinfo | None = None,
+                 stale_days: float = STALE_DAYS) -> None:
         super().__init__()
         self.core = core
         self.transport_note = transport_note
@@ -111,6 +112,7 @@ class NfwConsole(App[None]):
         self.config_file = config_file
         self.schedules = dict(schedules or {})
         self.times = TimeDisplay(local_zone)
+        self.stale_days = stale_days  #: element sets older than this are marked in the pass list
         self.failure: BaseException | None = None  #: the exception that stopped the console, if one did
         self._queue: collections.deque[Event] = collections.deque(maxlen=2000)
         self._lock = threading.Lock()
@@ -230,7 +232,8 @@ class NfwConsole(App[None]):
         lines.append(status_line(snap, self.times, now))
         self.query_one("#state", Static).update(Text("\n").join(line for line in lines if line is not None))
         self.query_one("#side").border_title = f"Passes ({self.times.zone(now)})"
-        self.query_one("#passes", Static).update(pass_table(self._search, self.core.state.catalog, self.times, now))
+        self.query_one("#passes", Static).update(pass_table(self._search, self.core.state.catalog, self.times, now,
+                                                                 self.stale_days))
         current = (values.azimuth_deg, values.elevation_deg) if values is not None else None
         track = search.track if search is not None else []
         self.query_one("#sky", Static).update(Text(render_sky(track, current)))

@@ -14,6 +14,7 @@ from datetime import datetime, timedelta
 
 from rich.text import Text
 
+from nfwserver.config.table import default
 from nfwserver.console.time_display import TimeDisplay
 from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.horizon import HorizonTable
@@ -29,6 +30,8 @@ TRACK_STEP_S = 20.0
 #: Rows of the pass list.
 MAX_ROWS = 8
 NAME_WIDTH = 10
+#: Element sets older than this (days) are flagged under the list (``[elements] stale_days``' default).
+STALE_DAYS: float = default("elements", "stale_days")
 
 
 @dataclass(frozen=True)
@@ -75,9 +78,11 @@ def search_passes(catalog: Catalog, observer: Observer, horizon: HorizonTable, u
     return PassSearch(now, selected, passes, next_pass, track)
 
 
-def pass_table(search: PassSearch | None, catalog: Catalog, times: TimeDisplay, now: datetime) -> Text:
+def pass_table(search: PassSearch | None, catalog: Catalog, times: TimeDisplay, now: datetime,
+               stale_days: float = STALE_DAYS) -> Text:
     """The pass list under a header: satellite, date, AOS, max elevation, LOS (the pane's title names
-    the zone).  A pass already in progress is marked ``*``.
+    the zone).  A pass already in progress is marked ``*``; a satellite whose elements are more than
+    ``stale_days`` old is marked ``!``, and a line under the list says how old and what to run.
     """
     out = Text()
     out.append(f"{'Satellite':{NAME_WIDTH}} {'Date':5} {'AOS':5} {'Max':>3} {'LOS':5}\n", style="bold")
@@ -88,16 +93,24 @@ def pass_table(search: PassSearch | None, catalog: Catalog, times: TimeDisplay, 
     if not rows:
         out.append(f"none in the next {LIST_HOURS:g} h")
         return out
+    oldest = 0.0
     for i, p in enumerate(rows):
         sat = catalog.get(p.catalog_number)
         name = sat.dde_name if sat is not None else str(p.catalog_number)
+        age = sat.age_days(now) if sat is not None else 0.0
+        oldest = max(oldest, age)
         in_progress = p.aos is None or p.aos <= now
         start = p.aos if p.aos is not None else now
         out.append(f"{name[:NAME_WIDTH]:{NAME_WIDTH}} ")
         out.append(f"{times.date(start):5} {times.short(p.aos):5} {p.max_elevation_deg:3.0f} {times.short(p.los):5}"
                    f"{' *' if in_progress else ''}")
+        if age > stale_days:
+            out.append(" !", style="bold yellow")
         if i < len(rows) - 1:
             out.append("\n")
+    if oldest > stale_days:
+        out.append(f"\n! elements up to {oldest:.0f} days old (over {stale_days:g}): positions drift; "
+                   "run `nfwserver elements update`", style="yellow")
     return out
 
 

@@ -2,10 +2,16 @@
 
 :meth:`Catalog.update` follows InstantTrack's UPDATE: a set replaces the stored one only when
 its epoch is newer; new satellites are added.  Each satellite has a unique DDE name
-(:mod:`nfwserver.tracking.dde_names`); user overrides win.  Thread-safe for concurrent readers and
-one writer: updates build new objects and swap them in.  DDE names are assigned when first needed
+(:mod:`nfwserver.tracking.dde_names`); user overrides win.  DDE names are assigned when first needed
 (a reader asking for a :class:`Satellite`): a catalog used only for its element sets (a pass search
 over tens of thousands of objects) never pays for them.
+
+Threading: any number of readers and writers.  Writers (:meth:`Catalog.update`,
+:meth:`Catalog.set_dde_name`) take turns on a writer lock and do all their work -- merging and, once
+readers have asked for names, naming every satellite (about 6 us each) -- on their own thread, holding
+no lock a reader needs; they publish the result by swapping references under the reader lock.  A
+reader (the publish thread's tick) therefore never waits for a merge or a naming, however large the
+catalog; an update that changes nothing swaps nothing.
 """
 
 from __future__ import annotations
@@ -72,19 +78,23 @@ class Catalog:
     """Satellites by catalog number."""
 
     def __init__(self, sets: Iterable[ElementSet] = (), dde_names: dict[int, str] | None = None) -> None:
-        self._lock = threading.Lock()
+        self._lock = threading.Lock()  #: readers: held only to swap, or to name lazily the first time
+        self._write_lock = threading.Lock()  #: writers take turns, holding it through their work
         self._elements: dict[int, ElementSet] = {}
         self._overrides: dict[int, str] = {}
         #: satellites with their DDE names, made on first use from ``_elements`` (None: not made yet)
-        self._satellites: dict[int, Satellite] | None = {}
+        self._satellites: dict[int, Satellite] | None = None
         for catnr, name in (dde_names or {}).items():
             self._overrides[int(catnr)] = validate_dde_name(name)
         self.update(sets)
 
     def update(self, sets: Iterable[ElementSet]) -> UpdateSummary:
-        """Merge ``sets``: add unknown satellites, replace a set only by a newer epoch."""
+        """Merge ``sets``: add unknown satellites, replace a set only by a newer epoch.
+
+        Runs on the caller's thread (see the module docstring); readers see the previous catalog until
+        the new one, names included, is swapped in."""
         summary = UpdateSummary()
-        with self._lock:
+        with self._write_lock:
             elements = dict(self._elements)
             for es in sets:
                 old = elements.get(es.catalog_number)
@@ -96,27 +106,36 @@ class Catalog:
                     summary.not_newer.append(es.catalog_number)
                     continue
                 elements[es.catalog_number] = es
-            self._rebuild(elements)
+            if summary.added or summary.updated:
+                self._swap(elements, self._overrides)
         return summary
 
-    def _rebuild(self, elements: dict[int, ElementSet]) -> None:
-        """Swap in ``elements`` (the caller holds the lock); the satellites are made when first read."""
-        self._elements = elements
-        self._satellites = None
+    def _swap(self, elements: dict[int, ElementSet], overrides: dict[int, str]) -> None:
+        """Publish ``elements`` and ``overrides`` (the caller holds the writer lock).  Once readers have
+        asked for names, the new names are made here, before the swap, so that no reader makes them."""
+        satellites = self._make_satellites(elements, overrides) if self._satellites is not None else None
+        with self._lock:
+            old = self._elements, self._satellites
+            self._elements, self._overrides, self._satellites = elements, overrides, satellites
+        for table in old:  # freed one entry at a time: a whole catalog freed at once holds the GIL for 20-40 ms
+            while table:
+                table.popitem()
+
+    @staticmethod
+    def _make_satellites(elements: dict[int, ElementSet], overrides: dict[int, str]) -> dict[int, Satellite]:
+        names = assign_dde_names({k: v.name for k, v in elements.items()},
+                                 {k: v for k, v in overrides.items() if k in elements})
+        return {k: Satellite(elements[k], names[k]) for k in sorted(elements)}
 
     def _named(self) -> dict[int, Satellite]:
-        """The satellites with their DDE names, made now if no reader needed them since the last change."""
+        """The satellites with their DDE names, made now by the first reader that needs them; from then
+        on writers make them before they swap."""
         satellites = self._satellites
         if satellites is None:
             with self._lock:
                 satellites = self._satellites
                 if satellites is None:
-                    elements = self._elements
-                    names = assign_dde_names(
-                        {k: v.name for k, v in elements.items()},
-                        {k: v for k, v in self._overrides.items() if k in elements},
-                    )
-                    satellites = self._satellites = {k: Satellite(elements[k], names[k]) for k in sorted(elements)}
+                    satellites = self._satellites = self._make_satellites(self._elements, self._overrides)
         return satellites
 
     def set_dde_name(self, catalog_number: int, name: str) -> None:
@@ -125,12 +144,12 @@ class Catalog:
         Raises :class:`ValueError` for an unusable name or one held by another override.
         """
         validate_dde_name(name)
-        with self._lock:
+        with self._write_lock:
             for other, held in self._overrides.items():
                 if other != catalog_number and held.upper() == name.upper():
                     raise ValueError(f"DDE name {name!r} is already given to satellite {other}")
-            self._overrides[catalog_number] = name
-            self._rebuild(self._elements)
+            if self._overrides.get(catalog_number) != name:
+                self._swap(self._elements, {**self._overrides, catalog_number: name})
 
     def get(self, catalog_number: int) -> Satellite | None:
         return self._named().get(catalog_number)

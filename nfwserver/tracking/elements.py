@@ -17,6 +17,7 @@ cannot hold (non-finite numbers, epochs outside 1957..2056) are rejected
 
 from __future__ import annotations
 
+import codecs
 import csv
 import gc
 import json
@@ -62,22 +63,50 @@ def load_elements(data: str | bytes, source: str = "<text>") -> LoadResult:
     """Load every element set in ``data``; never raises for bad content (see module docstring)."""
     result = LoadResult()
     if isinstance(data, bytes):
-        data = data.decode("utf-8", errors="replace")
+        head = data[:4096].decode("utf-8", errors="replace").lstrip("\ufeff \t\r\n")
+        if head.startswith(("[", "{")) or not head:
+            data = data.decode("utf-8", errors="replace")
+        else:
+            _load_text(_split_lines(data), source, result)
+            return result
     stripped = data.lstrip("\ufeff \t\r\n")
     if stripped.startswith(("[", "{")):
         problem = _load_json(stripped, source, result)
         if problem is None:
             return result
-        _load_text(data, source, result)
+        _load_text(_split_lines(data), source, result)
         if not result.sets and not result.rejected:
             result.rejected.append(problem)
         return result
-    _load_text(data, source, result)
+    _load_text(_split_lines(data), source, result)
     return result
 
 
-def _load_text(data: str, source: str, result: LoadResult) -> None:
-    lines = data.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+#: Text is decoded and split in pieces of this many bytes: each piece is one call that holds the interpreter
+#: lock (about 2 ms), where a whole 64 MiB file split at once would hold it for about 150 ms.
+_PIECE = 2**20
+
+
+def _split_lines(data: str | bytes) -> list[str]:
+    """The lines of ``data`` (bytes: UTF-8, bad bytes replaced), split at CR LF, CR or LF."""
+    decoder = codecs.getincrementaldecoder("utf-8")(errors="replace")
+    lines: list[str] = []
+    carry = ""
+    for start in range(0, max(len(data), 1), _PIECE):
+        piece = data[start:start + _PIECE]
+        last = start + _PIECE >= len(data)
+        text = carry + (decoder.decode(piece, final=last) if isinstance(piece, bytes) else piece)
+        carry = ""
+        if text.endswith("\r") and not last:  # its LF may open the next piece
+            text, carry = text[:-1], "\r"
+        parts = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+        if not last:
+            carry = parts.pop() + carry
+        lines.extend(parts)
+    return lines
+
+
+def _load_text(lines: list[str], source: str, result: LoadResult) -> None:
     gc_was_on = gc.isenabled()
     gc.disable()  # tens of thousands of new objects, no cycles: collections would only cost time
     try:

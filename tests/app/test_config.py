@@ -18,8 +18,8 @@ def test_template_is_valid_and_means_the_defaults() -> None:
     config = parse_config(template())
     assert config.server.rate_hz == 5.0 and config.server.services == ("NFW32", "NFW_SERVER")
     assert config.observer == DEFAULT_OBSERVER and not config.observer_configured
-    assert config.elements.use_bundled
-    assert replace(config, source=Config().source) == Config()
+    assert config.elements.use_bundled and config.elements.sources == ("amateur",)  # the starting source
+    assert replace(config, source=Config().source, elements=replace(config.elements, sources=())) == Config()
 
 
 def test_a_full_file(tmp_path) -> None:

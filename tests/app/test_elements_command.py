@@ -106,9 +106,15 @@ def test_the_download_reports_progress_in_bytes(http_server) -> None:  # noqa: F
 
 def test_without_sources_and_configuration(tmp_path, capsys) -> None:
     config = tmp_path / "c.toml"
-    config.write_text("[elements]\nuse_bundled = true\n")
+    """Nothing given, nothing configured: the default named source, said so (here offline: one line naming it)."""
+    config.write_text('[elements]\nuse_bundled = true\npreset_mirror = "http://127.0.0.1:9"\n')
     assert main(["elements", "update", "--config", str(config), "--store", str(tmp_path / "s.txt")]) == 1
-    assert "no sources" in capsys.readouterr().err
+    err = capsys.readouterr().err.splitlines()
+    assert err[0] == (f"nfwserver: no element sources configured ([elements] sources, files or urls in {config}): "
+                      "using the amateur (CelesTrak, TLE) source")
+    assert err[1].startswith("nfwserver: amateur (CelesTrak, TLE): cannot fetch "
+                             "http://127.0.0.1:9/gp.php?GROUP=amateur&FORMAT=tle: ")
+    assert len(err) == 2 and not (tmp_path / "s.txt").exists()
 
 
 def test_update_and_list_follow_the_configured_store(tmp_path, capsys) -> None:

@@ -47,8 +47,12 @@ def test_every_key_is_in_the_template_under_its_section() -> None:
 
 
 def test_template_parses_back_to_exactly_the_defaults() -> None:
+    """Except the starting choices (the named element source), which the template says it sets."""
     config = parse_config(template())
-    assert replace(config, source=Config().source) == Config()
+    assert config.elements.sources == ("amateur",)
+    assert "(a starting choice; without this line: sources = [])" in template()
+    assert replace(config, source=Config().source, elements=Config().elements) == Config()
+    assert replace(config.elements, sources=()) == Config().elements
 
 
 def test_every_key_is_in_config_show(tmp_path, capsys) -> None:

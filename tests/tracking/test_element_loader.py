@@ -235,3 +235,22 @@ def test_random_line_mixtures_never_raise_and_account_for_every_tle(lines: list[
     for a, b in zip(lines, lines[1:]):
         if a in LINES and b in LINES and a.startswith("1 ") and LINES.index(a) + 1 == LINES.index(b):
             assert int(a[2:7]) in loaded
+
+
+def test_lines_split_in_pieces_match_a_whole_split(monkeypatch) -> None:
+    """Text is decoded and split a piece at a time (so no single call holds the interpreter lock for long);
+    CR LF pairs and UTF-8 sequences cut by a piece boundary come out as from one whole split (#23 item 16)."""
+    import random
+
+    from nfwserver.tracking import elements
+
+    monkeypatch.setattr(elements, "_PIECE", 7)
+    rng = random.Random(16)
+    for _ in range(2000):
+        text = "".join(rng.choice(["a", "é", "\r", "\n", "\r\n", "x", "€"]) for _ in range(rng.randint(0, 40)))
+        assert elements._split_lines(text) == text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+        data = text.encode()
+        cut = rng.randint(0, len(data))
+        data = data[:cut] + b"\xff" + data[cut:]
+        whole = data.decode("utf-8", "replace").replace("\r\n", "\n").replace("\r", "\n").split("\n")
+        assert elements._split_lines(data) == whole

@@ -76,7 +76,7 @@ def test_ephemeris_defaults_to_now_and_the_configured_satellite(tmp_path, capsys
     assert before - timedelta(milliseconds=1) <= when <= after
     _, el, _, _, _ = skyfield_look_angles(_iss(), OBSERVER, [when])
     assert float(row["elevation_deg"]) == pytest.approx(el[0], abs=0.01)
-    assert "more than 30 days older" in err  # the test data is from May 2026
+    assert "more than 14 days older" in err  # the test data is from May 2026; [elements] stale_days 14
 
 
 @pytest.mark.parametrize(("text", "offset"), [("+2h", timedelta(hours=2)), ("-30m", timedelta(minutes=-30)),
@@ -151,3 +151,17 @@ def test_after_config_init_and_a_location_the_commands_need_no_arguments(capsys)
         assert out.splitlines()[0].startswith(("catalog_number", "time_utc", "sat ")) and "no observer" not in err
     assert main(["ephemeris", "--sat", "AO-91", "--duration", "0", "--format", "csv"]) == 0
     assert len(_rows(capsys)) == 1
+
+
+def test_passes_flag_sets_older_than_the_configured_age(tmp_path, capsys) -> None:
+    """``[elements] stale_days`` decides which sets `passes` calls stale (#25 item 2)."""
+    config = tmp_path / "c.toml"
+    elements = f'"{DATA / "visual.txt"}"'
+    argv = ["passes", "--observer", "JO02ae", "--start", "2026-05-20", "--hours", "1", "--sat", "25544",
+            "--config", str(config)]
+    config.write_text(f"[elements]\nfiles = [{elements}]\nuse_bundled = false\nstore = \"none\"\nstale_days = 30\n")
+    assert main(argv) == 0
+    assert "older than" not in capsys.readouterr().err
+    config.write_text(f"[elements]\nfiles = [{elements}]\nuse_bundled = false\nstore = \"none\"\nstale_days = 5\n")
+    assert main(argv) == 0
+    assert "1 element set(s) are more than 5 days older than 2026-05-20T00:00:00.000Z" in capsys.readouterr().err

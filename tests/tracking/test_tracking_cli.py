@@ -120,7 +120,8 @@ def test_bad_argument_values_are_usage_errors(capsys, argv, flag) -> None:
         (["ephemeris", *ELEMENTS, "--observer", "1,2", "--sat", "1", "--start", "2026-05-08"], "not in the catalog"),
         (["passes", *ELEMENTS, "--observer", "1,2", "--sat", "NOSUCHSAT"], "not in the catalog"),
         (["passes", *ELEMENTS, "--observer", "1,2", "--start", "2026-05-08", "--horizon", "/nonexistent"], "--horizon"),
-        (["visible", "--elements", "/nonexistent/keps.txt", "--observer", "1,2"], "no usable element sets"),
+        (["visible", "--elements", "/nonexistent/keps.txt", "--observer", "1,2"],
+         "cannot read /nonexistent/keps.txt: no such file or directory"),
         (["visible", "--config", "/nonexistent/config.toml"], "configuration refused"),
     ],
 )
