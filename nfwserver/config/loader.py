@@ -69,7 +69,7 @@ def _unknown(where: str, kind: str, name: str, valid: tuple[str, ...]) -> str:
     return f"{where}: unknown {kind} ({hint}valid {kind}s: {', '.join(valid)})"
 
 
-def _exposure(host: str) -> str | None:
+def exposure(host: str) -> str | None:
     """Why listening on ``host`` reaches beyond this machine, or None for loopback."""
     if host.lower() == "localhost":
         return None
@@ -174,13 +174,13 @@ class _Reading:
 
     def warnings(self, config: Config) -> tuple[str, ...]:
         found = []
-        if config.tcp.enabled and (why := _exposure(config.tcp.host)):
+        if config.tcp.enabled and (why := exposure(config.tcp.host)):
             found.append(f"[tcp] host = \"{config.tcp.host}\": {why}; only [tcp] allow addresses are served "
                          f"({', '.join(config.tcp.allow)})")
-        if config.web.enabled and (why := _exposure(config.web.host)):
+        if config.web.enabled and (why := exposure(config.web.host)):
             found.append(f"[web] host = \"{config.web.host}\": {why}; only [web] allow addresses are served "
                          f"({', '.join(config.web.allow)})")
-        if config.dialects.predict_udp and (why := _exposure(config.dialects.predict_host)):
+        if config.dialects.predict_udp and (why := exposure(config.dialects.predict_host)):
             found.append(f"[dialects] predict_host = \"{config.dialects.predict_host}\": {why}; PREDICT UDP "
                          "answers any sender, with replies several times larger than the requests")
         return tuple(found)

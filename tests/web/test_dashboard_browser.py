@@ -145,3 +145,37 @@ def test_the_page_fits_a_phone(web_station) -> None:
         assert console_errors(phone) == []
     finally:
         phone.quit()
+
+
+def test_the_rotor_commanded_and_actual_positions_are_drawn_apart(browser) -> None:
+    from nfwserver.rotor.coupling import sky_from_rotor
+    from tests.web.conftest import config_text, start_station
+
+    web = start_station(config_text(extra="").replace("[web]", '[rotor]\nbackend = "sim"\nflip = "off"\n[web]')
+                        .replace("tune = true", "tune = true\ntrack = true"))
+    try:
+        rotor = web.station.rotor
+        assert rotor is not None
+        open_page(browser, web)
+
+        def markers() -> dict:
+            return browser.execute_script("""
+                const get = id => { const el = document.querySelector(`[data-testid="${id}"]`);
+                  return {hidden: el.classList.contains("hidden"), az: el.getAttribute("data-az"),
+                          el: el.getAttribute("data-el"), tag: el.tagName}; };
+                return {target: get("rotor-target"), actual: get("rotor-actual"),
+                        text: document.querySelector('[data-testid="rotor"]').textContent};""")
+
+        web.advance(2.0)
+        shown = wait_for(lambda: (m := markers())["target"]["az"] is not None and m["actual"]["az"] is not None
+                         and not m["target"]["hidden"] and m, what="both rotor marks")
+        assert shown["target"]["tag"] != shown["actual"]["tag"]  # distinct marks
+        assert shown["text"].startswith("rotor ok: commanded")
+        web.advance(1.0)
+        shown = wait_for(lambda: (m := markers()) and m, what="rotor marks")
+        position = rotor.driver.rotor_position()
+        az, el = sky_from_rotor(*position)
+        wait_for(lambda: abs(float(markers()["actual"]["az"]) - az) < 1.0, what="the actual mark at the rotor")
+        assert abs(float(markers()["actual"]["el"]) - el) < 1.0
+    finally:
+        web.station.stop()
