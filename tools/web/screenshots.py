@@ -16,7 +16,8 @@ from tests.web.conftest import config_text, make_browser, open_page, start_stati
 
 
 def main(target: str) -> None:
-    text = config_text().replace("[web]", '[rotor]\nbackend = "sim"\nflip = "off"\n[web]') \
+    text = config_text().replace("[web]", '[rotor]\nbackend = "sim"\nflip = "off"\n'
+                                 '[horizon]\npoints = [[0, 5], [90, 12], [180, 3], [270, 8]]\n[web]') \
         .replace("tune = true", "tune = true\ntrack = true")
     web = start_station(text)
     try:
