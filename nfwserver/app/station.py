@@ -47,6 +47,7 @@ from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.rotor.coupling import RotorCoupling
 from nfwserver.tcp.server import NovaTcpServer
 from nfwserver.tracking.catalog import Catalog, UpdateSummary
+from nfwserver.web import StationParts, WebServer
 
 log = logging.getLogger(__name__)
 
@@ -95,6 +96,10 @@ class Station:
                                    elements_status(self.core.state, clock, config.elements.stale_days)),
                           set_flip=self.rotor.set_flip_mode if self.rotor is not None else None)
             if config.tcp.enabled else None)
+        self.web: WebServer | None = (
+            WebServer(self.core, config.web, StationParts(self.rotor, self.radio, self.easycomm, self.tcp, self.nova,
+                                                          favourites=lambda: self.config.favourites))
+            if config.web.enabled else None)
         self.watcher: ConfigWatcher | None = None
         self.selection_note = ""  #: which satellite the station started with, and why (set by start())
         self._unsubscribe: list[Callable[[], None]] = []
@@ -221,13 +226,15 @@ class Station:
         self._restore_session()
         if self.predict is not None:
             self.predict.start()
-        if self.tcp is not None:
-            try:
-                self.tcp.start()
-            except OSError:
-                if self.predict is not None:
-                    self.predict.stop()
-                raise
+        try:
+            for listener in (self.tcp, self.web):
+                if listener is not None:
+                    listener.start()
+        except OSError:
+            for started in (self.predict, self.tcp):
+                if started is not None:
+                    started.stop()
+            raise
         if self.transport is None:
             self.transport, self.transport_note = default_transport()
         self._started = True
@@ -255,8 +262,9 @@ class Station:
             unsubscribe()
         if self.predict is not None:
             self.predict.stop()
-        if self.tcp is not None:
-            self.tcp.stop()
+        for listener in (self.tcp, self.web):
+            if listener is not None:
+                listener.stop()
         for dialect_server in self.dialect_servers:
             dialect_server.detach()
         for worker in (self.radio, self.rotor, self.saver, self.easycomm):

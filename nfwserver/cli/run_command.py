@@ -37,6 +37,8 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     p.add_argument("--config", metavar="FILE", help="configuration file (default: the platform's config directory)")
     p.add_argument("--headless", action="store_true", help="no console: run as a service, log to a rotating file")
     p.add_argument("--log-file", metavar="FILE", help="log file for --headless (default: user log directory)")
+    p.add_argument("--web", action="store_true", help="serve the web dashboard for this run ([web] enabled; "
+                   "the URL is printed at start)")
     p.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this many seconds (for checks)")
     p.set_defaults(func=run)
 
@@ -86,9 +88,25 @@ def run(args: argparse.Namespace) -> int:
         raise CliError(f"configuration refused: {exc}") from None
     if args.duration is not None and not args.duration > 0:
         raise CliError("--duration must be positive")
+    if getattr(args, "web", False) and not config.web.enabled:
+        config = with_web(config)
     plan = RunPlan(console=sys.stdout.isatty() and not args.headless,
                    log_file=Path(args.log_file) if args.log_file else default_log_file(), duration_s=args.duration)
     return serve(config, plan, watch=args.config)
+
+
+def with_web(config: Any) -> Any:
+    """``config`` with the web dashboard on (``--web``), warned about as the file's ``[web] enabled`` would be."""
+    from dataclasses import replace
+
+    from nfwserver.config.loader import exposure
+
+    config = replace(config, web=replace(config.web, enabled=True))
+    why = exposure(config.web.host)
+    if why:
+        config = replace(config, warnings=(*config.warnings, f"[web] host = \"{config.web.host}\": {why}; only "
+                                           f"[web] allow addresses are served ({', '.join(config.web.allow)})"))
+    return config
 
 
 def _notes(station: Any, config: Any) -> tuple[list[str], str]:
@@ -98,6 +116,8 @@ def _notes(station: Any, config: Any) -> tuple[list[str], str]:
     source = config.path or config.source
     notes = [f"configuration: {source}", station.transport_note, f"{len(station.catalog)} satellites loaded",
              station.selection_note]
+    if getattr(station, "web", None) is not None and station.web.address is not None:
+        notes.append(f"web dashboard: {station.web.url}")
     hints = [] if config.observer_configured else [observer_hint(config)]
     ages = [s.age_days(station.clock.now()) for s in station.catalog]
     if ages and min(ages) > config.elements.stale_days:

@@ -38,6 +38,9 @@ def enabled_outputs(station: Any) -> list[str]:
         outputs.append(f"TCP {cfg.tcp.host}:{cfg.tcp.port}")
     if getattr(station, "easycomm", None) is not None:
         outputs.append(f"EasyComm {cfg.easycomm.device}")
+    web = getattr(station, "web", None)
+    if web is not None and web.address is not None:
+        outputs.append(f"web dashboard {web.url} (control {'on' if web.control.enabled else 'off'})")
     if station.rotor is not None:
         outputs.append(f"rotor ({cfg.rotor.backend})")
     if station.radio is not None:

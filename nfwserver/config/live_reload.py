@@ -26,6 +26,7 @@ RESTART_ONLY: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("[dialects]", ("dialects",)),
     ("[tcp]", ("tcp",)),
     ("[easycomm]", ("easycomm",)),
+    ("[web]", ("web",)),
 )
 
 

@@ -29,6 +29,7 @@ from nfwserver.config.schema import (
     RotorConfig,
     ServerConfig,
     TcpConfig,
+    WebConfig,
 )
 from nfwserver.config.table import SECTION_NAMES, SETTINGS, keys_of, setting
 from nfwserver.tracking.horizon import HorizonTable, parse_horizon
@@ -42,7 +43,7 @@ else:  # pragma: no cover
 APP_NAME = "nfwserver"
 #: Config fields holding a section record, by field name.
 _RECORDS = {"elements": ElementsConfig, "server": ServerConfig, "radio": RadioConfig, "rotor": RotorConfig,
-            "dialects": DialectsConfig, "tcp": TcpConfig, "easycomm": EasyCommConfig}
+            "dialects": DialectsConfig, "tcp": TcpConfig, "easycomm": EasyCommConfig, "web": WebConfig}
 
 
 class ConfigError(ValueError):
@@ -68,7 +69,7 @@ def _unknown(where: str, kind: str, name: str, valid: tuple[str, ...]) -> str:
     return f"{where}: unknown {kind} ({hint}valid {kind}s: {', '.join(valid)})"
 
 
-def _exposure(host: str) -> str | None:
+def exposure(host: str) -> str | None:
     """Why listening on ``host`` reaches beyond this machine, or None for loopback."""
     if host.lower() == "localhost":
         return None
@@ -166,13 +167,21 @@ class _Reading:
         if ("easycomm" not in self.dirty and self.get("easycomm", "enabled")
                 and ("easycomm", "device") not in self.present):
             self.problems.append("[easycomm] device: required when enabled (e.g. \"/dev/ttyUSB0\")")
+        token = self.get("web", "token")
+        if "web" not in self.dirty and self.get("web", "control") and not token:
+            self.problems.append("[web] token: required when control is on (at least 8 characters)")
+        elif "web" not in self.dirty and token is not None and len(token) < 8:
+            self.problems.append("[web] token: at least 8 characters")
 
     def warnings(self, config: Config) -> tuple[str, ...]:
         found = []
-        if config.tcp.enabled and (why := _exposure(config.tcp.host)):
+        if config.tcp.enabled and (why := exposure(config.tcp.host)):
             found.append(f"[tcp] host = \"{config.tcp.host}\": {why}; only [tcp] allow addresses are served "
                          f"({', '.join(config.tcp.allow)})")
-        if config.dialects.predict_udp and (why := _exposure(config.dialects.predict_host)):
+        if config.web.enabled and (why := exposure(config.web.host)):
+            found.append(f"[web] host = \"{config.web.host}\": {why}; only [web] allow addresses are served "
+                         f"({', '.join(config.web.allow)})")
+        if config.dialects.predict_udp and (why := exposure(config.dialects.predict_host)):
             found.append(f"[dialects] predict_host = \"{config.dialects.predict_host}\": {why}; PREDICT UDP "
                          "answers any sender, with replies several times larger than the requests")
         return tuple(found)

@@ -106,13 +106,33 @@ class TcpConfig:
 
     def allows(self, address: str) -> bool:
         """True when the peer ``address`` (an IP address string) lies in one of the ``allow`` networks."""
-        try:
-            ip = ipaddress.ip_address(address.split("%", 1)[0])
-        except ValueError:
-            return False
-        if isinstance(ip, ipaddress.IPv6Address) and ip.ipv4_mapped is not None:
-            ip = ip.ipv4_mapped
-        return any(ip in ipaddress.ip_network(net) for net in self.allow)
+        return address_allowed(self.allow, address)
+
+
+def address_allowed(networks: tuple[str, ...], address: str) -> bool:
+    """True when ``address`` (an IP address string, IPv4-mapped IPv6 allowed) lies in one of ``networks``."""
+    try:
+        ip = ipaddress.ip_address(address.split("%", 1)[0])
+    except ValueError:
+        return False
+    if isinstance(ip, ipaddress.IPv6Address) and ip.ipv4_mapped is not None:
+        ip = ip.ipv4_mapped
+    return any(ip in ipaddress.ip_network(net) for net in networks)
+
+
+@dataclass(frozen=True)
+class WebConfig:
+    """The web dashboard (:mod:`nfwserver.web`)."""
+
+    enabled: bool = default("web", "enabled")
+    host: str = default("web", "host")  #: address listened on
+    port: int = default("web", "port")  #: 0: any free port
+    allow: tuple[str, ...] = default("web", "allow")  #: networks allowed to connect (normalised as [tcp] allow)
+    control: bool = default("web", "control")  #: the page may send TUNE/TRACK/SAT
+    token: str | None = default("web", "token")  #: required with every control request; always set with control
+
+    def allows(self, address: str) -> bool:
+        return address_allowed(self.allow, address)
 
 
 @dataclass(frozen=True)
@@ -147,6 +167,7 @@ class Config:
     source: str = "<built-in defaults>"  #: the file read, or "<built-in defaults>" / "<config>"
     tcp: TcpConfig = field(default_factory=TcpConfig)
     easycomm: EasyCommConfig = field(default_factory=EasyCommConfig)
+    web: WebConfig = field(default_factory=WebConfig)
     horizon_file: str | None = None  #: the horizon file read, if the horizon came from one
     path: str | None = None  #: the configuration file actually read; None when none was
     #: accepted but worth saying at start (e.g. a listener reachable from other hosts); the caller logs them

@@ -38,6 +38,8 @@ SECTIONS: tuple[Section, ...] = (
     Section("dialects", "Other trackers' interfaces served beside Nova's."),
     Section("tcp", "Nova's TCP server: a greeting, SUMMARY, the Nova pokes as commands, STATUS and WATCH."),
     Section("easycomm", "EasyComm I output on a serial port, for Arduino and K3NG-style rotor controllers."),
+    Section("web", "The web dashboard: the station's state live in a browser (phone or PC), nothing from the "
+                   "internet; controls only when control is on, each request carrying the token."),
 )
 
 _S = Setting
@@ -169,6 +171,17 @@ SETTINGS: tuple[Setting, ...] = (
     _S("easycomm", "uplink", "choice", "range-rate", "\"range-rate\" (Nova: range rate in UP, zeros in DN, "
        "XXX modes) or \"doppler\" (the channel's corrected frequencies and modes)", "easycomm.uplink",
        choices=("range-rate", "doppler")),
+    # [web]
+    _S("web", "enabled", "bool", False, "serve the web dashboard (`nfwserver run --web` for one run)", "web.enabled"),
+    _S("web", "host", "host", "127.0.0.1", "address to listen on; anything but loopback is warned about",
+       "web.host"),
+    _S("web", "port", "int", 8091, "HTTP port (0 = any free port)", "web.port", 0, 65535),
+    _S("web", "allow", "networks", ["127.0.0.1", "::1"], "addresses or networks allowed to connect, as [tcp] allow",
+       "web.allow"),
+    _S("web", "control", "bool", False, "let the page send TUNE, TRACK and SAT (each request needs the token)",
+       "web.control"),
+    _S("web", "token", "text", None, "the secret every control request must carry (required when control is on; "
+       "at least 8 characters)", "web.token", 8, 256, example="change-me-0123"),
 )
 del _S
 

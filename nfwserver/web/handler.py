@@ -1,0 +1,173 @@
+"""HTTP routes of the web dashboard (one :class:`WebHandler` per connection, on its own thread).
+
+======================  ===========================================================================
+``GET /``               the page (``static/index.html``)
+``GET /static/<name>``  the page's script, style sheet and map data, from the package (no CDN)
+``GET /api/state``      the newest frame as JSON, with the last log lines (``docs/WEB.md``)
+``GET /api/passes``     passes, the pass track, the ground track and the horizon (``docs/WEB.md``)
+``GET /api/help``       the commands the page may send, from the command table
+``GET /api/stream``     Server-Sent Events: ``history`` once, then ``state`` with every frame
+``POST /api/command``   ``{"command": "TRACK ON", "token": "..."}`` (:mod:`~nfwserver.web.control`)
+======================  ===========================================================================
+
+Every response carries a Content-Security-Policy allowing only the station's own scripts and styles,
+so nothing from a satellite or client name can run as script even if it reached the HTML (the page
+only ever sets ``textContent``).  Request bodies are limited to :data:`MAX_BODY_BYTES`.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import re
+import socket
+from http.server import BaseHTTPRequestHandler
+from importlib import resources
+from typing import Any
+
+from nfwserver.web.control import help_entries
+
+log = logging.getLogger(__name__)
+
+MAX_BODY_BYTES = 4096
+KEEPALIVE_S = 15.0  #: an idle event stream gets a comment line this often (real seconds)
+_STATIC_NAME = re.compile(r"[a-z0-9][a-z0-9_.-]{0,63}")
+_TYPES = {".html": "text/html; charset=utf-8", ".js": "text/javascript; charset=utf-8",
+          ".css": "text/css; charset=utf-8", ".json": "application/json", ".svg": "image/svg+xml",
+          ".png": "image/png"}
+SECURITY_HEADERS = (
+    ("Content-Security-Policy", "default-src 'self'; img-src 'self' data:; style-src 'self'; script-src 'self'; "
+                                "connect-src 'self'; frame-ancestors 'none'; base-uri 'none'; form-action 'none'"),
+    ("X-Content-Type-Options", "nosniff"),
+    ("Referrer-Policy", "no-referrer"),
+)
+
+
+def static_file(name: str) -> bytes | None:
+    """A file of the package's ``static`` folder, or None (names outside the pattern are never looked up)."""
+    if not _STATIC_NAME.fullmatch(name) or ".." in name:
+        return None
+    try:
+        return resources.files("nfwserver.web").joinpath("static").joinpath(name).read_bytes()
+    except (FileNotFoundError, IsADirectoryError, NotADirectoryError, OSError):
+        return None
+
+
+class WebHandler(BaseHTTPRequestHandler):
+    server_version = "nfwserver"
+    protocol_version = "HTTP/1.0"  # one request per connection: the event stream ends with the connection
+
+    def setup(self) -> None:
+        web = self.server.web  # type: ignore[attr-defined]
+        self.timeout = web.io_timeout_s  # type: ignore[misc]  # socketserver reads it per instance
+        super().setup()
+        if web.send_buffer_bytes:
+            self.connection.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, web.send_buffer_bytes)
+
+    @property
+    def web(self) -> Any:
+        return self.server.web  # type: ignore[attr-defined]
+
+    @property
+    def peer(self) -> str:
+        return f"web {self.client_address[0]}"
+
+    def log_message(self, format: str, *args: Any) -> None:  # noqa: A002 - the base class's name
+        log.debug("web %s: " + format, self.client_address[0], *args)
+
+    # -- responses -----------------------------------------------------------------------------------
+    def _send(self, status: int, body: bytes, content_type: str, cache: bool = False) -> None:
+        self.send_response(status)
+        self.send_header("Content-Type", content_type)
+        self.send_header("Content-Length", str(len(body)))
+        self.send_header("Cache-Control", "max-age=300" if cache else "no-store")
+        for name, value in SECURITY_HEADERS:
+            self.send_header(name, value)
+        self.end_headers()
+        if self.command != "HEAD":
+            self.wfile.write(body)
+
+    def _json(self, status: int, value: object) -> None:
+        self._send(status, json.dumps(value).encode(), "application/json")
+
+    def _raw_json(self, body: bytes) -> None:
+        self._send(200, body, "application/json")
+
+    # -- routes --------------------------------------------------------------------------------------
+    def do_GET(self) -> None:  # noqa: N802 - http.server's naming
+        path = self.path.split("?", 1)[0]
+        if path in ("/", "/index.html"):
+            body = static_file("index.html")
+            assert body is not None
+            self._send(200, body, _TYPES[".html"])
+        elif path.startswith("/static/") or path == "/favicon.ico":
+            name = "icon.svg" if path == "/favicon.ico" else path[len("/static/"):]
+            body = static_file(name)
+            if body is None:
+                self._json(404, {"error": "not found"})
+            else:
+                suffix = name[name.rfind("."):] if "." in name else ""
+                self._send(200, body, _TYPES.get(suffix, "application/octet-stream"), cache=suffix == ".json")
+        elif path == "/api/state":
+            self._raw_json(self.web.state_json())
+        elif path == "/api/passes":
+            self._raw_json(self.web.board.encoded())
+        elif path == "/api/help":
+            self._json(200, {"control": self.web.control.enabled, "commands": help_entries()})
+        elif path == "/api/stream":
+            self._stream()
+        else:
+            self._json(404, {"error": "not found"})
+
+    def do_HEAD(self) -> None:  # noqa: N802
+        self.do_GET()
+
+    def do_POST(self) -> None:  # noqa: N802
+        if self.path.split("?", 1)[0] != "/api/command":
+            self._json(404, {"error": "not found"})
+            return
+        try:
+            length = int(self.headers.get("Content-Length", "-1"))
+        except ValueError:
+            length = -1
+        if not 0 <= length <= MAX_BODY_BYTES:
+            self._json(413 if length > MAX_BODY_BYTES else 411, {"ok": False, "message": "body of 0..4096 bytes"})
+            return
+        try:
+            request = json.loads(self.rfile.read(length).decode("utf-8"))
+        except (UnicodeDecodeError, json.JSONDecodeError):
+            request = None
+        reply = self.web.control.run(request, self.peer)
+        self._json(reply.status, reply.as_json())
+
+    # -- the event stream ----------------------------------------------------------------------------
+    def _stream(self) -> None:
+        self.send_response(200)
+        self.send_header("Content-Type", "text/event-stream; charset=utf-8")
+        self.send_header("Cache-Control", "no-store")
+        for name, value in SECURITY_HEADERS:
+            self.send_header(name, value)
+        self.end_headers()
+        web = self.web
+        web.stream_opened(self.peer)
+        reason, dropped = "closed by the browser", False
+        try:
+            history = json.dumps(web.history(), default=str).encode()
+            self.wfile.write(b"event: history\ndata: " + history + b"\n\n")
+            seen, frame = web.hub.newest()
+            while not web.stopping:
+                if frame is not None:
+                    self.wfile.write(b"event: state\ndata: " + frame + b"\n\n")
+                else:
+                    self.wfile.write(b": keep-alive\n\n")
+                seen, frame = web.hub.wait_newer(seen, KEEPALIVE_S)
+            reason = "server stopping"
+        except TimeoutError:
+            reason, dropped = f"stopped reading (nothing sent for {web.io_timeout_s:g} s)", True
+        except (BrokenPipeError, ConnectionResetError, ConnectionAbortedError):
+            pass
+        except OSError as exc:
+            reason, dropped = f"send failed: {exc}", True
+        finally:
+            web.stream_closed(self.peer, reason, dropped)
+            self.close_connection = True

@@ -1,0 +1,227 @@
+"""Passes for the page, computed on a thread of their own (``nfw-web-passes``), never on the publish loop.
+
+What it computes, for the instant of the computation (``docs/WEB.md`` gives the JSON):
+
+- the passes of the favourites and the selected satellite over the next :data:`LIST_HOURS` hours that
+  are not over: AOS/TCA/LOS (UTC), maximum elevation (degrees), duration (s) and, when the rotor can
+  flip, whether the rotor's planner would fly the pass flipped;
+- the selected satellite's current or next pass as a sky track (azimuth/elevation in degrees, every
+  :data:`TRACK_STEP_S` s) with its AOS/TCA/LOS points, for the polar plot;
+- the selected satellite's ground track (geodetic latitude, east longitude in degrees) from
+  :data:`GROUND_BEFORE_S` before to :data:`GROUND_AFTER_S` after the instant, for the map;
+- the horizon table as azimuth/elevation points every 5 degrees (the polar plot's mask).
+
+It recomputes when the live state changes (its generation), when the first listed pass is over, and
+at least every :data:`REFRESH_S` seconds of the station's clock.  Readers get the newest result whole
+(:meth:`PassBoard.result`); the frame carries its ``version`` so a page fetches ``/api/passes`` again
+only when it changed.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import threading
+from collections.abc import Callable, Sequence
+from datetime import datetime, timedelta
+
+from nfwserver.clock import Clock
+from nfwserver.core.state import StationState
+from nfwserver.rotor.coupling import RotorCoupling
+from nfwserver.rotor.flip import plan_pass
+from nfwserver.tracking.derived import sub_satellite_point
+from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError
+from nfwserver.tracking.passes import Pass, find_passes
+from nfwserver.web.state_view import iso
+
+log = logging.getLogger(__name__)
+
+LIST_HOURS = 12.0
+NEXT_PASS_HOURS = 24.0
+TRACK_STEP_S = 10.0
+GROUND_BEFORE_S = 45 * 60.0
+GROUND_AFTER_S = 95 * 60.0
+GROUND_STEP_S = 60.0
+REFRESH_S = 120.0
+MAX_PASSES = 12
+
+
+def _track(calc: LookAngleCalculator, satrec: object, p: Pass, now: datetime) -> list[tuple[float, float]]:
+    start = p.aos or now
+    end = p.los or (start + timedelta(minutes=20))
+    out: list[tuple[float, float]] = []
+    t = start
+    while t <= end and len(out) < 2000:
+        la = calc.compute(satrec, t)  # type: ignore[arg-type]
+        out.append((round(la.azimuth_deg, 2), round(la.elevation_deg, 2)))
+        t += timedelta(seconds=TRACK_STEP_S)
+    return out
+
+
+def _point(calc: LookAngleCalculator, satrec: object, when: datetime | None) -> dict[str, object] | None:
+    if when is None:
+        return None
+    la = calc.compute(satrec, when)  # type: ignore[arg-type]
+    return {"time": iso(when), "az": round(la.azimuth_deg, 2), "el": round(la.elevation_deg, 2)}
+
+
+class PassBoard:
+    """See the module docstring.  ``favourites`` is read at each computation (the live configuration)."""
+
+    def __init__(self, state: StationState, clock: Clock, favourites: Callable[[], Sequence[int]],
+                 rotor: RotorCoupling | None = None) -> None:
+        self.state = state
+        self.clock = clock
+        self.favourites = favourites
+        self.rotor = rotor
+        self.version = 0
+        self._result: dict[str, object] = {"version": 0, "computed_at": None, "passes": [], "track": None,
+                                           "ground_track": [], "horizon": []}
+        self._encoded = json.dumps(self._result).encode()
+        self._wake = threading.Event()
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._done_generation = -1
+        self._done_at = -1e18
+        self._first_los: datetime | None = None
+
+    def result(self) -> dict[str, object]:
+        return self._result
+
+    def encoded(self) -> bytes:
+        return self._encoded
+
+    def next_event(self, now: datetime) -> dict[str, object] | None:
+        """AOS or LOS of the selected satellite's pass, with the seconds until it (negative: past)."""
+        track = self._result.get("track")
+        if not isinstance(track, dict):
+            return None
+        for kind in ("aos", "los"):
+            point = track.get(kind)
+            if isinstance(point, dict) and point.get("time"):
+                when = datetime.fromisoformat(str(point["time"]).replace("Z", "+00:00"))
+                if when > now:
+                    return {"kind": kind.upper(), "time": point["time"], "seconds": (when - now).total_seconds()}
+        return None
+
+    # -- life cycle ------------------------------------------------------------------------------
+    def start(self) -> None:
+        if self._thread is None:
+            self._stop.clear()
+            self._thread = threading.Thread(target=self._run, name="nfw-web-passes", daemon=True)
+            self._thread.start()
+
+    def stop(self) -> None:
+        if self._thread is not None:
+            self._stop.set()
+            self._wake.set()
+            self._thread.join(5.0)
+            self._thread = None
+
+    def request(self) -> None:
+        """Compute again soon (e.g. the favourites changed)."""
+        self._done_generation = -1
+        self._wake.set()
+
+    def _due(self) -> bool:
+        now = self.clock.now()
+        return (self.state.generation != self._done_generation
+                or self.clock.monotonic() - self._done_at >= REFRESH_S
+                or (self._first_los is not None and now >= self._first_los))
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            if self._due():
+                try:
+                    self.compute()
+                except Exception:  # keep the board alive; the page shows the last result
+                    log.exception("web: pass computation failed")
+                    self._done_at = self.clock.monotonic()
+                    self._done_generation = self.state.generation
+            self.clock.wait(self._wake, 1.0)
+            self._wake.clear()
+
+    # -- the work ------------------------------------------------------------------------------------
+    def compute(self) -> dict[str, object]:
+        """Compute everything now (on the calling thread) and publish it as the newest result."""
+        generation = self.state.generation
+        snap = self.state.snapshot()
+        now = self.clock.now()
+        result: dict[str, object] = {"computed_at": iso(now), "passes": [], "track": None, "ground_track": [],
+                                     "horizon": [[az, round(snap.horizon.min_elevation(float(az)), 2)]
+                                                 for az in range(0, 361, 5)]}
+        observer, selected = snap.observer, snap.satellite
+        if observer is not None:
+            numbers = list(dict.fromkeys([*self.favourites(), *([selected.catalog_number] if selected else [])]))
+            sats = [s for s in (snap.catalog.get(n) for n in numbers) if s is not None]
+            found = [p for p in find_passes(sats, observer, now, now + timedelta(hours=LIST_HOURS),
+                                            horizon=snap.horizon, ut1_utc=snap.ut1_utc_s)
+                     if p.los is None or p.los > now] if sats else []
+            calc = LookAngleCalculator(observer, snap.ut1_utc_s)
+            rows = []
+            for p in found[:MAX_PASSES]:
+                sat = snap.catalog.get(p.catalog_number)
+                rows.append(self._row(p, sat, calc, now))
+            result["passes"] = rows
+            self._first_los = found[0].los if found else None
+            if selected is not None:
+                result["track"] = self._selected_track(selected, found, observer, snap, calc, now)
+                result["ground_track"] = self._ground_track(selected.satrec, now, snap.ut1_utc_s)
+        self.version += 1
+        result["version"] = self.version
+        self._result = result
+        self._encoded = json.dumps(result).encode()
+        self._done_generation, self._done_at = generation, self.clock.monotonic()
+        return result
+
+    def _flipped(self, track: list[tuple[float, float]]) -> bool | None:
+        rotor = self.rotor
+        if rotor is None or not rotor.driver.geometry.can_flip or not track:
+            return None
+        try:
+            return plan_pass(rotor.driver.geometry, track, None, rotor.flip_mode).flipped
+        except ValueError:
+            return None
+
+    def _row(self, p: Pass, sat: object, calc: LookAngleCalculator, now: datetime) -> dict[str, object]:
+        flipped = None
+        if sat is not None and self.rotor is not None:
+            try:
+                flipped = self._flipped(_track(calc, sat.satrec, p, now))  # type: ignore[attr-defined]
+            except PropagationError:
+                flipped = None
+        return {"catalog_number": p.catalog_number, "name": getattr(sat, "dde_name", str(p.catalog_number)),
+                "aos": iso(p.aos), "tca": iso(p.tca), "los": iso(p.los),
+                "max_el": round(p.max_elevation_deg, 1), "duration_s": p.duration_s,
+                "in_progress": p.aos is None or p.aos <= now, "flipped": flipped}
+
+    def _selected_track(self, sat, found: list[Pass], observer, snap, calc: LookAngleCalculator,
+                        now: datetime) -> dict[str, object] | None:
+        own = [p for p in found if p.catalog_number == sat.catalog_number]
+        if not own:
+            own = [p for p in find_passes([sat], observer, now, now + timedelta(hours=NEXT_PASS_HOURS),
+                                          horizon=snap.horizon, ut1_utc=snap.ut1_utc_s)
+                   if p.los is None or p.los > now]
+        if not own:
+            return None
+        p = own[0]
+        try:
+            points = _track(calc, sat.satrec, p, now)
+            return {"catalog_number": sat.catalog_number, "points": points,
+                    "aos": _point(calc, sat.satrec, p.aos), "tca": _point(calc, sat.satrec, p.tca),
+                    "los": _point(calc, sat.satrec, p.los), "max_el": round(p.max_elevation_deg, 1),
+                    "flipped": self._flipped(points)}
+        except PropagationError:
+            return None
+
+    @staticmethod
+    def _ground_track(satrec: object, now: datetime, ut1_utc: float) -> list[list[float]]:
+        out = []
+        t = now - timedelta(seconds=GROUND_BEFORE_S)
+        end = now + timedelta(seconds=GROUND_AFTER_S)
+        while t <= end:
+            point = sub_satellite_point(satrec, t, ut1_utc)
+            if point is not None:
+                out.append([round(point[0], 2), round(point[1], 2)])
+            t += timedelta(seconds=GROUND_STEP_S)
+        return out

@@ -1,0 +1,275 @@
+"""The web dashboard's listener: :class:`WebServer`, one more adapter on the station core.
+
+Threads and what they do:
+
+- the publisher thread only runs :meth:`WebServer.on_tick`: it keeps a reference to the newest sample
+  and sets an event, at a cost that does not depend on the number of browsers;
+- ``nfw-web`` (the frame thread) wakes on that event, builds one frame (JSON) from the live state
+  (:mod:`~nfwserver.web.state_view`, :mod:`~nfwserver.web.station_parts`) at most
+  :data:`MAX_FRAME_HZ` times a second, and puts it in the :class:`~nfwserver.web.hub.FrameHub`;
+- ``nfw-web-http`` accepts connections (Python's :class:`http.server.ThreadingHTTPServer`); each
+  connection has a thread of its own, at most ``max_clients`` at once (others are closed at once);
+  an event-stream connection sends the hub's newest frame whenever there is one (Server-Sent Events);
+- ``nfw-web-passes``: :class:`~nfwserver.web.pass_board.PassBoard`.
+
+Bounds: every socket has a timeout (``io_timeout_s``): a browser that stops reading blocks only its
+own thread, for at most that long, and is then dropped (``stats.dropped``); there is no queue, so it
+never costs memory beyond its socket buffer, and no tick ever waits for it.  Peers outside
+``[web] allow`` are closed before a byte is read, logged once a minute per address and recorded in the
+event stream.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import socket
+import threading
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from http.server import ThreadingHTTPServer
+from typing import Any
+
+from nfwserver.config.schema import WebConfig
+from nfwserver.core.events import Direction
+from nfwserver.core.sample import TickSample
+from nfwserver.core.station_core import StationCore
+from nfwserver.easycomm.output import EasyCommOutput
+from nfwserver.radio.coupling import RadioCoupling
+from nfwserver.ratelimited_log import RateLimitedLog
+from nfwserver.rotor.coupling import RotorCoupling
+from nfwserver.web.control import Control
+from nfwserver.web.handler import WebHandler
+from nfwserver.web.hub import FrameHub
+from nfwserver.web.pass_board import PassBoard
+from nfwserver.web.state_view import now_tracking
+from nfwserver.web.station_parts import (
+    EventFollower,
+    clients_part,
+    event_json,
+    links_part,
+    radio_part,
+    rotor_part,
+)
+
+log = logging.getLogger(__name__)
+
+MAX_FRAME_HZ = 10.0  #: frames built per second at most, whatever the feed's rate
+MAX_CLIENTS = 64  #: connections served at once (each event stream holds one)
+IO_TIMEOUT_S = 10.0  #: a read or write that waits longer drops the connection
+HISTORY_EVENTS = 200  #: log lines a new page receives first
+
+
+@dataclass
+class StationParts:
+    """The station's adapters the page shows (None when not configured); read, never driven."""
+
+    rotor: RotorCoupling | None = None
+    radio: RadioCoupling | None = None
+    easycomm: EasyCommOutput | None = None
+    tcp: Any = None  #: NovaTcpServer (client_count)
+    nova: Any = None  #: NovaDdeService (client_count: conversations, advise loops)
+    favourites: Callable[[], Sequence[int]] = field(default=lambda: ())
+
+
+@dataclass
+class WebStats:
+    accepted: int = 0
+    refused: int = 0  #: outside [web] allow, or over max_clients
+    streams: int = 0  #: event streams open now
+    dropped: int = 0  #: event streams dropped for not reading (write timeout) or a failed send
+    frames: int = 0  #: frames built
+
+
+class _HttpServer(ThreadingHTTPServer):
+    daemon_threads = True
+    allow_reuse_address = True
+    request_queue_size = 64
+
+    def __init__(self, address: tuple, web: WebServer, family: int) -> None:
+        self.address_family = family
+        self.web = web
+        super().__init__(address, WebHandler)
+
+    def verify_request(self, request: Any, client_address: Any) -> bool:
+        return self.web._admit(client_address)
+
+    def process_request_thread(self, request: Any, client_address: Any) -> None:
+        try:
+            super().process_request_thread(request, client_address)
+        finally:
+            self.web._release()
+
+
+class WebServer:
+    """See the module docstring.  Construction is pure; :meth:`start` binds (OSError when it cannot)."""
+
+    def __init__(self, core: StationCore, config: WebConfig, parts: StationParts | None = None, *,
+                 max_clients: int = MAX_CLIENTS, io_timeout_s: float = IO_TIMEOUT_S,
+                 send_buffer_bytes: int | None = None) -> None:
+        self.core = core
+        self.config = config
+        self.parts = parts or StationParts()
+        self.max_clients = max_clients
+        self.io_timeout_s = io_timeout_s
+        self.send_buffer_bytes = send_buffer_bytes
+        self.stats = WebStats()
+        self.hub = FrameHub()
+        self.control = Control(core, config)
+        self.board = PassBoard(core.state, core.clock, self.parts.favourites, self.parts.rotor)
+        self.address: tuple[str, int] | None = None
+        self._follower = EventFollower(core.events)
+        self._latest: dict[str, object] = {}
+        self._sample: TickSample | None = None
+        self._ticked = threading.Event()
+        self._stop = threading.Event()
+        self._lock = threading.Lock()
+        self._active = 0
+        self._httpd: _HttpServer | None = None
+        self._threads: list[threading.Thread] = []
+        self._unsubscribe: Callable[[], None] | None = None
+        self._refusals = RateLimitedLog(log, core.clock, 60.0)
+
+    @property
+    def url(self) -> str:
+        assert self.address is not None
+        host = self.address[0]
+        return f"http://[{host}]:{self.address[1]}/" if ":" in host else f"http://{host}:{self.address[1]}/"
+
+    # -- life cycle --------------------------------------------------------------------------------
+    def start(self) -> None:
+        if self._httpd is not None:
+            return
+        family, _, _, _, sockaddr = socket.getaddrinfo(self.config.host, self.config.port, type=socket.SOCK_STREAM,
+                                                       flags=socket.AI_PASSIVE)[0]
+        self._httpd = _HttpServer(sockaddr, self, family)
+        self.address = self._httpd.server_address[:2]  # type: ignore[assignment]
+        self._stop.clear()
+        self.hub.reopen()
+        self._unsubscribe = self.core.subscribe(self.on_tick)
+        self.board.start()
+        self._build_frame()
+        self._threads = [threading.Thread(target=self._frames, name="nfw-web", daemon=True),
+                         threading.Thread(target=self._httpd.serve_forever, kwargs={"poll_interval": 0.25},
+                                          name="nfw-web-http", daemon=True)]
+        for thread in self._threads:
+            thread.start()
+        log.info("web dashboard on %s", self.url)
+
+    def stop(self) -> None:
+        if self._httpd is None:
+            return
+        if self._unsubscribe is not None:
+            self._unsubscribe()
+            self._unsubscribe = None
+        self._stop.set()
+        self._ticked.set()
+        self.hub.close()
+        self._httpd.shutdown()
+        self._httpd.server_close()
+        for thread in self._threads:
+            thread.join(5.0)
+        self.board.stop()
+        self._httpd = None
+
+    # -- the publisher's side ----------------------------------------------------------------------
+    def on_tick(self, sample: TickSample) -> None:
+        """Tick listener (publisher thread): keep the newest sample and wake the frame thread; O(1)."""
+        self._sample = sample
+        self._ticked.set()
+
+    # -- frames (thread nfw-web) -------------------------------------------------------------------
+    def _frames(self) -> None:
+        clock = self.core.clock
+        last = -1e18
+        while not self._stop.is_set():
+            clock.wait(self._ticked, 1.0)
+            if self._stop.is_set():
+                break
+            early = 1.0 / MAX_FRAME_HZ - (clock.monotonic() - last)
+            if early > 0:  # a feed faster than MAX_FRAME_HZ: frames carry the newest sample at that rate
+                clock.wait(self._stop, early)
+            self._ticked.clear()
+            last = clock.monotonic()
+            try:
+                self._build_frame()
+            except Exception:  # the page shows the last frame; the station carries on
+                log.exception("web: building a frame failed")
+
+    def _build_frame(self) -> None:
+        now = self.core.clock.now()
+        sample = self._sample or self.core.tracker.last_sample
+        events, skipped = self._follower.new_events()
+        frame: dict[str, object] = {
+            "now": now_tracking(self.core, sample, now),
+            "next_event": self.board.next_event(sample.time if sample is not None else now),
+            "rotor": rotor_part(self.parts.rotor),
+            "radio": radio_part(self.parts.radio, self.core.state.radio_tuning),
+            "links": links_part(self.core.health),
+            "clients": clients_part(self._follower, self._counts),
+            "log": [event_json(e) for e in events], "log_skipped": skipped,
+            "passes_version": self.board.version,
+            "control": self.control.enabled,
+        }
+        self._latest = frame
+        self.stats.frames += 1
+        self.hub.publish(json.dumps(frame, allow_nan=False, default=str).encode())
+
+    def _counts(self) -> dict[str, object]:
+        counts: dict[str, object] = {"web_streams": self.stats.streams}
+        if self.parts.nova is not None:
+            counts["dde_conversations"], counts["dde_advise_loops"] = self.parts.nova.client_count()
+        if self.parts.tcp is not None:
+            counts["tcp_clients"] = self.parts.tcp.client_count()
+        if self.parts.easycomm is not None:
+            counts["easycomm"] = "open" if self.parts.easycomm.connected else "closed"
+        return counts
+
+    # -- what the handler reads ------------------------------------------------------------------
+    def state_json(self) -> bytes:
+        """``/api/state``: the newest frame, with the last :data:`HISTORY_EVENTS` log lines."""
+        frame = dict(self._latest)
+        frame["log"] = self.history()
+        return json.dumps(frame, allow_nan=False, default=str).encode()
+
+    def history(self) -> list[dict[str, object]]:
+        return [event_json(e) for e in self.core.events.recent(HISTORY_EVENTS)]
+
+    # -- connections (nfw-web-http and connection threads) ---------------------------------------
+    def _admit(self, client_address: Any) -> bool:
+        host = str(client_address[0])
+        reason = None
+        if not self.config.allows(host):
+            reason = "not in [web] allow"
+        with self._lock:
+            if reason is None and self._active >= self.max_clients:
+                reason = f"already {self.max_clients} connections"
+            if reason is None:
+                self._active += 1
+                self.stats.accepted += 1
+                return True
+            self.stats.refused += 1
+        self._refusals.warning(host, "web connection from %s refused: %s", host, reason)
+        self.core.events.add(self.core.clock.now(), Direction.INFO, "note", f"connection refused: {reason}",
+                             client=f"web {host}", accepted=False)
+        return False
+
+    def _release(self) -> None:
+        with self._lock:
+            self._active -= 1
+
+    def stream_opened(self, peer: str) -> None:
+        with self._lock:
+            self.stats.streams += 1
+        log.info("web page %s connected", peer)
+
+    def stream_closed(self, peer: str, reason: str, dropped: bool) -> None:
+        with self._lock:
+            self.stats.streams -= 1
+            if dropped:
+                self.stats.dropped += 1
+        (log.warning if dropped else log.info)("web page %s disconnected: %s", peer, reason)
+
+    @property
+    def stopping(self) -> bool:
+        return self._stop.is_set()

@@ -1,0 +1,146 @@
+"""The device and diagnostic parts of a frame: rotor, radio, link health, clients and the string log.
+
+Rotor and radio values are what their worker threads last recorded (plain attribute reads, as the
+console and ``STATUS`` do); no device is ever asked from here.  Rotor angles are given twice: in the
+rotor's own frame (``*_rotor``: KCT, elevation above 90 when flipped) and in the sky (``az``/``el``, for
+the polar plot).  Clients and the log come from the station's event stream
+(:class:`~nfwserver.core.events.EventLog`): :class:`EventFollower` reads the events added since the last
+frame and keeps the last state of each client (bounded), so a page sees every string once.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections import OrderedDict
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from nfwserver.core.events import Event, EventLog
+from nfwserver.health.board import HealthBoard
+from nfwserver.radio.coupling import RadioCoupling
+from nfwserver.rotor.coupling import RotorCoupling, sky_from_rotor
+from nfwserver.web.state_view import iso
+
+log = logging.getLogger(__name__)
+
+#: Events sent in one frame at most (the rest are summarised as skipped); clients remembered at most.
+MAX_LOG_PER_FRAME = 100
+MAX_CLIENTS = 64
+
+
+def _angle(value: float | None) -> float | None:
+    return round(value, 2) if value is not None and math.isfinite(value) else None
+
+
+def rotor_part(rotor: RotorCoupling | None) -> dict[str, object] | None:
+    """Commanded (target) and actual positions, flip mode and state, link state, KCT status bits."""
+    if rotor is None:
+        return None
+    driver = rotor.driver
+    position = driver.rotor_position()
+    _, _, target_el, target_az = driver.positions()
+    out: dict[str, object] = {"flip_mode": rotor.flip_mode, "flipped": bool(rotor.flip_state),
+                              "suspended": rotor.suspended, "kct_status": f"0x{int(driver.status().bits):02X}"}
+    if position is None or not driver.backend_reachable:
+        out["state"] = "unreachable"
+    else:
+        out["state"] = "stalled" if driver.stalled else ("ok" if driver.health.ok else "retrying")
+    out["actual"] = None
+    if position is not None and all(map(math.isfinite, position)):
+        az, el = sky_from_rotor(position[0], position[1])
+        out["actual"] = {"az": _angle(az), "el": _angle(el), "az_rotor": _angle(position[0]),
+                         "el_rotor": _angle(position[1])}
+    out["target"] = None
+    if target_az is not None and target_el is not None and math.isfinite(target_az) and math.isfinite(target_el):
+        az, el = sky_from_rotor(target_az, target_el)
+        out["target"] = {"az": _angle(az), "el": _angle(el), "az_rotor": _angle(target_az),
+                         "el_rotor": _angle(target_el)}
+    return out
+
+
+def radio_part(radio: RadioCoupling | None, tuning_on: bool) -> dict[str, object] | None:
+    if radio is None:
+        return None
+    result = radio.last_result
+    return {"state": "ok" if radio.tuner.available else "unreachable", "tuning": tuning_on,
+            "error": None if radio.tuner.available else str(radio.tuner.last_error or ""),
+            "rx_hz": result.rx_hz if result is not None else None,
+            "tx_hz": result.tx_hz if result is not None and result.tx_hz else None}
+
+
+def links_part(health: HealthBoard) -> dict[str, object]:
+    """Every link's state (``ok`` or the fault's description) and the faults alone."""
+    states = health.states()
+    return {"states": states, "faults": {name: text for name, text in states.items() if text != "ok"}}
+
+
+@dataclass
+class ClientRecord:
+    """The last seen of one client of the station (a DDE conversation, a TCP peer, a browser)."""
+
+    name: str
+    connected: bool
+    last_kind: str
+    last_text: str
+    last_time: str | None
+    accepted: bool | None
+
+    def as_json(self) -> dict[str, object]:
+        return {"name": self.name, "connected": self.connected, "last_kind": self.last_kind,
+                "last_text": self.last_text, "last_time": self.last_time, "accepted": self.accepted}
+
+
+def event_json(event: Event) -> dict[str, object]:
+    return {"seq": event.seq, "time": iso(event.time), "dir": event.direction.value, "kind": event.kind,
+            "text": event.text, "client": event.client, "accepted": event.accepted, "detail": event.detail}
+
+
+class EventFollower:
+    """Reads the event stream forward; owned by the frame thread."""
+
+    def __init__(self, events: EventLog) -> None:
+        self.events = events
+        self.last_seq = 0
+        self.clients: OrderedDict[str, ClientRecord] = OrderedDict()
+
+    def new_events(self) -> tuple[list[Event], int]:
+        """Events added since the last call (at most :data:`MAX_LOG_PER_FRAME`) and how many were skipped."""
+        fresh = [e for e in self.events.recent(MAX_LOG_PER_FRAME * 4) if e.seq > self.last_seq]
+        if not fresh:
+            return [], 0
+        skipped = max(0, fresh[-1].seq - self.last_seq - MAX_LOG_PER_FRAME)
+        self.last_seq = fresh[-1].seq
+        for event in fresh:
+            self._note_client(event)
+        return fresh[-MAX_LOG_PER_FRAME:], skipped
+
+    def _note_client(self, event: Event) -> None:
+        if not event.client or event.kind == "note" and event.client in ("config", "health", "startup"):
+            return
+        record = self.clients.pop(event.client, None)
+        if record is None:
+            record = ClientRecord(event.client, True, "", "", None, None)
+        if event.kind == "disconnect":
+            record.connected = False
+        elif event.kind == "connect":
+            record.connected = True
+        if event.kind != "connect" and event.kind != "disconnect" or not record.last_kind:
+            record.last_kind, record.last_text = event.kind, event.text
+            record.last_time, record.accepted = iso(event.time), event.accepted
+        self.clients[event.client] = record
+        while len(self.clients) > MAX_CLIENTS:
+            self.clients.popitem(last=False)
+
+    def client_list(self) -> list[dict[str, object]]:
+        return [c.as_json() for c in reversed(self.clients.values())]
+
+
+def clients_part(follower: EventFollower, counts: Callable[[], dict[str, object]]) -> dict[str, object]:
+    """Counts from the adapters (DDE conversations and loops, TCP clients, browsers) and the client list."""
+    try:
+        numbers = counts()
+    except Exception:  # an adapter's count must not stop the frame
+        log.debug("web: client counts failed", exc_info=True)
+        numbers = {}
+    return {"counts": numbers, "list": follower.client_list()}
