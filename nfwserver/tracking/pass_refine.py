@@ -243,8 +243,8 @@ def _next_point(cross: np.ndarray, ca: np.ndarray, g: np.ndarray, g1: np.ndarray
         newton = ca - g / g1
         disc = g1 * g1 - 2.0 * g * f_accel
         quad = ca - 2.0 * g / (g1 + np.copysign(np.sqrt(np.maximum(disc, 0.0)), g1))
-        newton = np.where(cross & (disc > 0.0) & np.isfinite(quad), quad, newton)
-    return newton
+        point: np.ndarray = np.where(cross & (disc > 0.0) & np.isfinite(quad), quad, newton)
+    return point
 
 
 def _final_step(v: _Live, k: Kinematics, ca: np.ndarray, step: np.ndarray) -> np.ndarray:
