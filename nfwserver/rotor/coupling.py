@@ -205,7 +205,7 @@ class RotorCoupling(TickWorker):
             if params.delay_minutes > 0:
                 self.driver.start_parking_timer()
             else:
-                self.driver.set_target(params.elevation_deg, params.azimuth_deg)
+                self.driver.set_target(azimuth_deg=params.azimuth_deg, elevation_deg=params.elevation_deg)
         elif self.after_los == "next-aos":
             track = self.pass_track(when + timedelta(seconds=1))
             if track:
@@ -213,7 +213,7 @@ class RotorCoupling(TickWorker):
                 _, az, el = track[0]
                 el = max(el, 0.0)  # AOS lies on the horizon
                 az_k, el_k = flip(az, el) if plan.flipped else (az, el)
-                self.driver.set_target(el_k, az_k)
+                self.driver.set_target(azimuth_deg=az_k, elevation_deg=el_k)
 
     # -- per tick --------------------------------------------------------------------------
     def process(self, sample: TickSample) -> None:
@@ -266,7 +266,7 @@ class RotorCoupling(TickWorker):
 
     def _send(self, az: float, el: float) -> None:
         az_k, el_k = flip(az, el) if self.plan and self.plan.flipped else (az % 360.0, el)
-        if self.driver.set_target(el_k, az_k):
+        if self.driver.set_target(azimuth_deg=az_k, elevation_deg=el_k):
             self._sent = (az, el)
         elif not self._unreachable_reported:
             self._unreachable_reported = True
