@@ -17,9 +17,9 @@ import time
 from bench.campaign.station_rig import StationRig
 from bench.campaign.tally import Tally
 from nfwserver.clock import SystemClock
+from nfwserver.core.channel import Channel
 from nfwserver.radio.backend import RadioError
 from nfwserver.radio.rigctld_backend import RigctldBackend
-from nfwserver.radio.transponder import Channel
 from nfwserver.radio.tuning import DopplerTuner
 from nfwserver.rotor.backend import RotorError
 from nfwserver.rotor.geometry import RotorGeometry

@@ -17,8 +17,8 @@ from typing import Any
 
 from nfwserver.config.files import check_regular_file
 from nfwserver.config.setting import Setting
+from nfwserver.core.channel import Channel
 from nfwserver.radio.defaults import DEFAULT_CHANNELS
-from nfwserver.radio.transponder import Channel
 from nfwserver.tracking.dde_names import validate_dde_name
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer, parse_observer

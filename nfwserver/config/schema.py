@@ -10,7 +10,7 @@ import ipaddress
 from dataclasses import dataclass, field
 
 from nfwserver.config.table import default
-from nfwserver.radio.transponder import Channel
+from nfwserver.core.channel import Channel
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer
 

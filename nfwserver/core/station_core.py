@@ -25,13 +25,13 @@ from nfwserver.clock import Clock
 from nfwserver.commands.parsing import parse_poke
 from nfwserver.commands.table import CommandError as PokeError
 from nfwserver.commands.table import Face, Poke, PokeKind, escape_for_log
+from nfwserver.core.channel import Channel
 from nfwserver.core.events import Direction, EventLog
 from nfwserver.core.sample import TickSample
 from nfwserver.core.state import DEFAULT_RATE_HZ, StateSnapshot, StationState
 from nfwserver.core.status import INTERFACE_VERSION, StatusBit
 from nfwserver.core.tracker import TickListener, Tracker
 from nfwserver.health.board import HealthBoard
-from nfwserver.radio.transponder import Channel
 from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.tracking.catalog import Catalog, Satellite
 from nfwserver.tracking.horizon import HorizonTable

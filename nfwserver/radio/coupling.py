@@ -13,10 +13,10 @@ from __future__ import annotations
 import logging
 
 from nfwserver.clock import Clock
+from nfwserver.core.channel import Channel
 from nfwserver.core.sample import TickSample
 from nfwserver.core.state import StationState
 from nfwserver.core.tick_worker import TickWorker
-from nfwserver.radio.transponder import Channel
 from nfwserver.radio.tuning import DopplerTuner, TuneResult
 
 log = logging.getLogger(__name__)

@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 
 from nfwserver.clock import Clock
+from nfwserver.core.channel import MAX_FREQUENCY_HZ, MIN_FREQUENCY_HZ
+from nfwserver.core.modes import HAMLIB_MODES
 from nfwserver.hamlib.commands import (
     GET_FREQUENCY,
     GET_SPLIT_FREQUENCY,
@@ -24,8 +26,6 @@ from nfwserver.hamlib.commands import (
 from nfwserver.hamlib.connection import HamlibConnection, HamlibError, HamlibUnavailable
 from nfwserver.health import LinkHealth
 from nfwserver.radio.backend import RadioError, RadioUnavailable
-from nfwserver.radio.modes import HAMLIB_MODES
-from nfwserver.radio.transponder import MAX_FREQUENCY_HZ, MIN_FREQUENCY_HZ
 
 
 def _check_hz(hz: int) -> int:

@@ -8,8 +8,8 @@ import math
 import pytest
 
 from nfwserver.config import ConfigError, parse_config
-from nfwserver.radio.modes import HAMLIB_MODES
-from nfwserver.radio.transponder import Channel
+from nfwserver.core.channel import Channel
+from nfwserver.core.modes import HAMLIB_MODES
 
 
 @pytest.mark.parametrize("field", ["downlink_correction_hz", "uplink_correction_hz"])

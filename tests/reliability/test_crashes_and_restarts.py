@@ -12,8 +12,8 @@ import pytest
 
 from nfwserver.app.element_store import ElementStore
 from nfwserver.clock import SystemClock
+from nfwserver.core.channel import Channel
 from nfwserver.radio.rigctld_backend import RigctldBackend
-from nfwserver.radio.transponder import Channel
 from nfwserver.radio.tuning import DopplerTuner
 from nfwserver.rotor.geometry import RotorGeometry
 from nfwserver.rotor.kct_driver import KctDriver

@@ -13,9 +13,9 @@ from datetime import datetime, timezone
 import pytest
 
 from nfwserver.clock import VirtualClock
+from nfwserver.core.channel import Channel
 from nfwserver.radio.backend import RadioError
 from nfwserver.radio.rigctld_backend import RigctldBackend
-from nfwserver.radio.transponder import Channel
 from nfwserver.radio.tuning import DopplerTuner
 from nfwserver.rotor.backend import RotorError
 from nfwserver.rotor.geometry import RotorGeometry

@@ -14,10 +14,10 @@ from hypothesis import strategies as st
 
 from nfwserver.clock import SystemClock
 from nfwserver.config import ConfigError, parse_config
+from nfwserver.core.channel import Channel
 from nfwserver.fake_dde import DdeError
 from nfwserver.radio.backend import RadioError
 from nfwserver.radio.rigctld_backend import RigctldBackend
-from nfwserver.radio.transponder import Channel
 from nfwserver.radio.tuning import DopplerTuner
 from nfwserver.rotor.backend import RotorError
 from nfwserver.rotor.geometry import RotorGeometry
