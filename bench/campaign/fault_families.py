@@ -16,8 +16,8 @@ import time
 
 from bench.campaign.station_rig import StationRig
 from bench.campaign.tally import Tally
+from nfwserver.channels.channel import Channel
 from nfwserver.clock import SystemClock
-from nfwserver.core.channel import Channel
 from nfwserver.radio.backend import RadioError
 from nfwserver.radio.rigctld_backend import RigctldBackend
 from nfwserver.radio.tuning import DopplerTuner

@@ -24,6 +24,7 @@ from nfwserver.app.devices import make_radio, make_rotor
 from nfwserver.app.element_refresher import ElementRefresher
 from nfwserver.app.element_sources import FetchResult, fetch_all
 from nfwserver.app.live_config import CONFIG_PARTS
+from nfwserver.app.platform_transport import default_transport
 from nfwserver.app.session_state import SessionSaver, SessionState, StateFile
 from nfwserver.app.station_catalog import configured_store, load_station_catalog
 from nfwserver.app.status_fields import device_status
@@ -34,7 +35,6 @@ from nfwserver.core.events import Direction
 from nfwserver.core.publisher import Publisher
 from nfwserver.core.station_core import StationCore
 from nfwserver.dde.nova_service import NovaDdeService
-from nfwserver.dde.platform_transport import default_transport
 from nfwserver.dde.transport import DdeServerTransport
 from nfwserver.dialects.dde_service import DialectServer
 from nfwserver.dialects.orbitron import ORBITRON

@@ -7,7 +7,6 @@ Every output (DDE, dialects, TCP, EasyComm, PREDICT, rotor, radio, console) is a
 from nfwserver.lazy_exports import lazy_exports
 
 _EXPORTS = {
-    "Channel": "channel",
     "Direction": "events",
     "Event": "events",
     "EventLog": "events",

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 from datetime import datetime
 from types import MappingProxyType
 
-from nfwserver.core.channel import Channel
+from nfwserver.channels.channel import Channel
 from nfwserver.core.sample import AntennaPosition
 from nfwserver.tracking.catalog import Catalog, Satellite
 from nfwserver.tracking.horizon import HorizonTable

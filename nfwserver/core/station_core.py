@@ -21,11 +21,11 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from datetime import datetime
 
+from nfwserver.channels.channel import Channel
 from nfwserver.clock import Clock
 from nfwserver.commands.parsing import parse_poke
 from nfwserver.commands.table import CommandError as PokeError
 from nfwserver.commands.table import Face, Poke, PokeKind, escape_for_log
-from nfwserver.core.channel import Channel
 from nfwserver.core.events import Direction, EventLog
 from nfwserver.core.sample import TickSample
 from nfwserver.core.state import DEFAULT_RATE_HZ, StateSnapshot, StationState

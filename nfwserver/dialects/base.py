@@ -13,7 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import datetime, tzinfo
 
-from nfwserver.core.channel import Channel
+from nfwserver.channels.channel import Channel
 from nfwserver.core.sample import TickSample
 
 

@@ -21,7 +21,7 @@ elevation in degrees with one decimal and *not* fixed width; uplink and downlink
 
 from __future__ import annotations
 
-from nfwserver.core.channel import Channel
+from nfwserver.channels.channel import Channel
 from nfwserver.core.nova_protocol import format_azimuth, format_elevation, format_range_rate
 
 LINE_END = "\r\n"

@@ -1,5 +1,5 @@
 """Doppler tuning through Hamlib's rigctld (the channels it tunes are the core's:
-:class:`nfwserver.core.channel.Channel`).
+:class:`nfwserver.channels.channel.Channel`).
 """
 
 from nfwserver.lazy_exports import lazy_exports

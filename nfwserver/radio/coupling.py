@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import logging
 
+from nfwserver.channels.channel import Channel
 from nfwserver.clock import Clock
-from nfwserver.core.channel import Channel
 from nfwserver.core.sample import TickSample
 from nfwserver.core.state import StationState
 from nfwserver.core.tick_worker import TickWorker

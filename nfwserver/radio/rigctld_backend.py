@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import math
 
+from nfwserver.channels.channel import MAX_FREQUENCY_HZ, MIN_FREQUENCY_HZ
+from nfwserver.channels.modes import HAMLIB_MODES
 from nfwserver.clock import Clock
-from nfwserver.core.channel import MAX_FREQUENCY_HZ, MIN_FREQUENCY_HZ
-from nfwserver.core.modes import HAMLIB_MODES
 from nfwserver.hamlib.commands import (
     GET_FREQUENCY,
     GET_SPLIT_FREQUENCY,

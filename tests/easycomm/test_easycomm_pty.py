@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
+from nfwserver.channels.channel import Channel
 from nfwserver.config.schema import EasyCommConfig
-from nfwserver.core.channel import Channel
 from nfwserver.easycomm import EasyCommOutput
 from nfwserver.easycomm.output import open_serial
 from tests.conftest import advance_until

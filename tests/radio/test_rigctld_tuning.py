@@ -8,8 +8,8 @@ from datetime import datetime, timedelta, timezone
 
 import pytest
 
+from nfwserver.channels.channel import Channel
 from nfwserver.clock import VirtualClock
-from nfwserver.core.channel import Channel
 from nfwserver.core.sample import TickSample
 from nfwserver.core.state import StationState
 from nfwserver.radio.backend import RadioError

@@ -11,8 +11,8 @@ import time
 import pytest
 
 from nfwserver.app.element_store import ElementStore
+from nfwserver.channels.channel import Channel
 from nfwserver.clock import SystemClock
-from nfwserver.core.channel import Channel
 from nfwserver.radio.rigctld_backend import RigctldBackend
 from nfwserver.radio.tuning import DopplerTuner
 from nfwserver.rotor.geometry import RotorGeometry

@@ -12,8 +12,8 @@ from datetime import datetime, timezone
 
 import pytest
 
+from nfwserver.channels.channel import Channel
 from nfwserver.clock import VirtualClock
-from nfwserver.core.channel import Channel
 from nfwserver.radio.backend import RadioError
 from nfwserver.radio.rigctld_backend import RigctldBackend
 from nfwserver.radio.tuning import DopplerTuner

@@ -12,9 +12,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from nfwserver.channels.channel import Channel
 from nfwserver.clock import SystemClock
 from nfwserver.config import ConfigError, parse_config
-from nfwserver.core.channel import Channel
 from nfwserver.fake_dde import DdeError
 from nfwserver.radio.backend import RadioError
 from nfwserver.radio.rigctld_backend import RigctldBackend
