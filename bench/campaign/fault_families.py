@@ -16,10 +16,10 @@ import time
 
 from bench.campaign.station_rig import StationRig
 from bench.campaign.tally import Tally
+from nfwserver.channels.channel import Channel
 from nfwserver.clock import SystemClock
 from nfwserver.radio.backend import RadioError
 from nfwserver.radio.rigctld_backend import RigctldBackend
-from nfwserver.radio.transponder import Channel
 from nfwserver.radio.tuning import DopplerTuner
 from nfwserver.rotor.backend import RotorError
 from nfwserver.rotor.geometry import RotorGeometry
@@ -123,7 +123,8 @@ def run_hostile_hamlib(tally: Tally, count: int, seed: int) -> None:
                 tally.crash(f"backend call {step}", exc)
             try:  # the driver and the tuner absorb device faults: nothing may escape them
                 if step == 4:
-                    driver.set_target(rng.uniform(0, 90), rng.uniform(0, 360))
+                    elevation = rng.uniform(0, 90)  # drawn first, as before
+                    driver.set_target(azimuth_deg=rng.uniform(0, 360), elevation_deg=elevation)
                     driver.service()
                     driver.status()
                     if not _position_ok(driver.rotor_position()):

@@ -23,7 +23,9 @@ from nfwserver.app.config_watcher import ConfigWatcher
 from nfwserver.app.devices import make_radio, make_rotor
 from nfwserver.app.element_refresher import ElementRefresher
 from nfwserver.app.element_sources import FetchResult
+from nfwserver.app.live_config import CONFIG_PARTS
 from nfwserver.app.long_lived import building_long_lived, release
+from nfwserver.app.platform_transport import default_transport
 from nfwserver.app.session_state import SessionSaver, SessionState, StateFile
 from nfwserver.app.station_catalog import configured_store, configured_urls, fetch_configured, load_station_catalog
 from nfwserver.app.status_fields import combined, device_status, elements_status
@@ -34,7 +36,6 @@ from nfwserver.core.events import Direction
 from nfwserver.core.publisher import Publisher
 from nfwserver.core.station_core import StationCore
 from nfwserver.dde.nova_service import NovaDdeService
-from nfwserver.dde.platform_transport import default_transport
 from nfwserver.dde.transport import DdeServerTransport
 from nfwserver.dialects.dde_service import DialectServer
 from nfwserver.dialects.orbitron import ORBITRON
@@ -118,20 +119,14 @@ class Station:
     def apply_config(self, new: Config) -> list[str]:
         """Apply a changed configuration to the running station; returns what needs a restart.
 
-        Observer, horizon, UT1-UTC, rate, channels, DDE names and radio tuning change the live state at
-        once; the rest is compared with what is *running* and listed when it differs."""
-        self.core.state.configure(observer=new.observer, horizon=new.horizon, ut1_utc_s=new.server.ut1_utc_s,
-                                  rate_hz=new.server.rate_hz, channels=new.channels)
-        for catnr, name in new.dde_names.items():
-            try:
-                self.core.state.catalog.set_dde_name(catnr, name)
-            except ValueError as exc:
-                log.warning("DDE name for %s not applied: %s", catnr, exc)
-        self.core.state.catalog_changed()
-        if new.radio.enabled != self.config.radio.enabled:
-            self.core.set_radio_tuning(new.radio.enabled, source="configuration")
-        restart = restart_needed(self.config, new)
-        self.config = keep_running(self.config, new)  # what needs a restart keeps running as it was
+        One table drives it (:data:`~nfwserver.app.live_config.CONFIG_PARTS`): every live part that changed
+        (observer, horizon, UT1-UTC, rate, channels, DDE names, radio tuning) changes the live state at once;
+        the restart-only parts are compared with what is *running* and listed when they differ."""
+        for part in CONFIG_PARTS:
+            if part.apply is not None and part.differs(self.config, new):
+                part.apply(self.core, new)
+        restart = restart_needed(CONFIG_PARTS, self.config, new)
+        self.config = keep_running(CONFIG_PARTS, self.config, new)  # what needs a restart keeps running as it was
         return restart
 
     def _config_changed(self, new: Config) -> None:

@@ -15,10 +15,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from nfwserver.channels.channel import Channel
 from nfwserver.config.files import check_regular_file
 from nfwserver.config.setting import Setting
 from nfwserver.radio.defaults import DEFAULT_CHANNELS
-from nfwserver.radio.transponder import Channel
 from nfwserver.tracking.dde_names import validate_dde_name
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer, parse_observer

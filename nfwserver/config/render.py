@@ -14,11 +14,11 @@ from collections.abc import Mapping
 from operator import attrgetter
 from typing import Any
 
+from nfwserver.channels.channel import Channel
 from nfwserver.config.kinds import CHANNEL_KEYS
 from nfwserver.config.schema import Config
 from nfwserver.config.setting import Setting
 from nfwserver.config.table import SECTIONS, SETTINGS
-from nfwserver.radio.transponder import Channel
 from nfwserver.tracking.horizon import HorizonTable
 
 _WIDTH = 100

@@ -9,8 +9,8 @@ from __future__ import annotations
 import ipaddress
 from dataclasses import dataclass, field
 
+from nfwserver.channels.channel import Channel
 from nfwserver.config.table import default
-from nfwserver.radio.transponder import Channel
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer
 

@@ -23,8 +23,8 @@ from dataclasses import dataclass, field
 from datetime import datetime
 from types import MappingProxyType
 
+from nfwserver.channels.channel import Channel
 from nfwserver.core.sample import AntennaPosition
-from nfwserver.radio.transponder import Channel
 from nfwserver.tracking.catalog import Catalog, Satellite
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer

@@ -21,6 +21,7 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from datetime import datetime
 
+from nfwserver.channels.channel import Channel
 from nfwserver.clock import Clock
 from nfwserver.commands.parsing import parse_poke
 from nfwserver.commands.table import CommandError as PokeError
@@ -31,7 +32,6 @@ from nfwserver.core.state import DEFAULT_RATE_HZ, StateSnapshot, StationState
 from nfwserver.core.status import INTERFACE_VERSION, StatusBit
 from nfwserver.core.tracker import TickListener, Tracker
 from nfwserver.health.board import HealthBoard
-from nfwserver.radio.transponder import Channel
 from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.tracking.catalog import Catalog, Satellite
 from nfwserver.tracking.horizon import HorizonTable

@@ -8,7 +8,6 @@ _EXPORTS = {
     "DdeServerHandler": "transport",
     "DdeServerTransport": "transport",
     "PokeResult": "transport",
-    "default_transport": "platform_transport",
     "CF_TEXT": "clipboard",
     "CF_UNICODETEXT": "clipboard",
 }

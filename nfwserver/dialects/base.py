@@ -13,8 +13,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import datetime, tzinfo
 
+from nfwserver.channels.channel import Channel
 from nfwserver.core.sample import TickSample
-from nfwserver.radio.transponder import Channel
 
 
 @dataclass(frozen=True)

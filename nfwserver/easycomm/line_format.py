@@ -21,8 +21,8 @@ elevation in degrees with one decimal and *not* fixed width; uplink and downlink
 
 from __future__ import annotations
 
+from nfwserver.channels.channel import Channel
 from nfwserver.core.nova_protocol import format_azimuth, format_elevation, format_range_rate
-from nfwserver.radio.transponder import Channel
 
 LINE_END = "\r\n"
 STOP_LINE = "SA SE"

@@ -1,10 +1,10 @@
-"""Radio channels and Doppler tuning through Hamlib's rigctld.
+"""Doppler tuning through Hamlib's rigctld (the channels it tunes are the core's:
+:class:`nfwserver.channels.channel.Channel`).
 """
 
 from nfwserver.lazy_exports import lazy_exports
 
 _EXPORTS = {
-    "Channel": "transponder",
     "DopplerTuner": "tuning",
     "RadioCoupling": "coupling",
     "RigctldBackend": "rigctld_backend",

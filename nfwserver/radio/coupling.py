@@ -12,11 +12,11 @@ from __future__ import annotations
 
 import logging
 
+from nfwserver.channels.channel import Channel
 from nfwserver.clock import Clock
 from nfwserver.core.sample import TickSample
 from nfwserver.core.state import StationState
 from nfwserver.core.tick_worker import TickWorker
-from nfwserver.radio.transponder import Channel
 from nfwserver.radio.tuning import DopplerTuner, TuneResult
 
 log = logging.getLogger(__name__)

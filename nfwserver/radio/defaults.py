@@ -6,7 +6,7 @@ configuration add to or replace them.
 
 from __future__ import annotations
 
-from nfwserver.radio.transponder import Channel
+from nfwserver.channels.channel import Channel
 
 DEFAULT_CHANNELS: dict[int, Channel] = {
     25544: Channel("ISS FM repeater", 437_800_000, 145_990_000, "FM", "FM"),

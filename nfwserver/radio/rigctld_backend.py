@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import math
 
+from nfwserver.channels.channel import MAX_FREQUENCY_HZ, MIN_FREQUENCY_HZ
+from nfwserver.channels.modes import HAMLIB_MODES
 from nfwserver.clock import Clock
 from nfwserver.hamlib.commands import (
     GET_FREQUENCY,
@@ -24,8 +26,6 @@ from nfwserver.hamlib.commands import (
 from nfwserver.hamlib.connection import HamlibConnection, HamlibError, HamlibUnavailable
 from nfwserver.health import LinkHealth
 from nfwserver.radio.backend import RadioError, RadioUnavailable
-from nfwserver.radio.modes import HAMLIB_MODES
-from nfwserver.radio.transponder import MAX_FREQUENCY_HZ, MIN_FREQUENCY_HZ
 
 
 def _check_hz(hz: int) -> int:

@@ -1,7 +1,7 @@
 """Doppler tuning: keep a transceiver on a channel as the range rate changes.
 
 Each :meth:`DopplerTuner.update` computes the ground receive and transmit frequencies for the
-current range rate (:meth:`nfwserver.radio.transponder.Channel.ground_frequencies`) and sends a
+current range rate (:meth:`nfwserver.channels.channel.Channel.ground_frequencies`) and sends a
 frequency only when it moved by at least ``step_hz`` since it was last sent (radios tune in steps,
 and fewer commands keep the CAT bus quiet).
 
@@ -21,9 +21,9 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass
 
+from nfwserver.channels.channel import Channel
 from nfwserver.clock import Clock, SystemClock
 from nfwserver.radio.backend import RadioBackend, RadioError, RadioUnavailable
-from nfwserver.radio.transponder import Channel
 from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.tracking.doppler import downlink_frequency_hz
 

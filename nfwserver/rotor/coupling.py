@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import logging
 import math
+import threading
 from collections.abc import Callable, Sequence
 from datetime import datetime, timedelta
 
@@ -101,6 +102,10 @@ class RotorCoupling(TickWorker):
         self._unreachable_reported = False
         self._catalog_number: int | None = None  # the satellite the plan belongs to
         self._seen_satellite = False
+        # Guards flip_mode, flip_state, _replan and _retry_asked, which set_flip_mode writes from other
+        # threads (TCP, console); never held across a call into the driver or the tracking engine.
+        self._lock = threading.Lock()
+        self._retry_asked = False  # an operator's action asked for a stalled rotor to be tried at once
         driver.table_load_listeners.append(self._table_loaded)
         driver.annunciator.listeners.append(self._announced)
 
@@ -133,18 +138,25 @@ class RotorCoupling(TickWorker):
         self.driver.retry_now()
         if self.suspended is not None:
             self.suspended = None
-            self._replan = True
+            with self._lock:
+                self._replan = True
             self._event("autotracking enabled again")
 
     def set_flip_mode(self, mode: str) -> None:
-        """``"auto"``, ``"on"`` or ``"off"`` from now on; a pass in progress is re-planned at the next tick."""
+        """``"auto"``, ``"on"`` or ``"off"`` from now on; a pass in progress is re-planned at the next tick.
+
+        Any thread may call this (TCP, console): it only records the choice under the coupling's lock; the
+        rotor itself (re-planning, re-trying a stalled rotor) is driven from the coupling's own thread at
+        its next tick, never from the caller's.
+        """
         if mode not in FLIP_MODES:
             raise ValueError(f"flip mode must be one of {FLIP_MODES}, not {mode!r}")
-        self.flip_mode = mode
-        self._replan = True
-        self.driver.retry_now()  # an operator's action: a stalled rotor is tried again at once
-        if mode != "auto":
-            self.flip_state = mode == "on"
+        with self._lock:
+            self.flip_mode = mode
+            self._replan = True
+            self._retry_asked = True  # an operator's action: a stalled rotor is tried again at once
+            if mode != "auto":
+                self.flip_state = mode == "on"
         note = ""
         if mode == "on" and not self.driver.geometry.can_flip:
             note = (f"; this rotor's elevation stops at {self.driver.geometry.el_max:g} deg, so inverted targets "
@@ -163,22 +175,24 @@ class RotorCoupling(TickWorker):
         return 1 if self.flip_state else 0
 
     # -- planning --------------------------------------------------------------------------
-    def _plan(self, track: Sequence[tuple[datetime, float, float]]) -> PassPlan:
+    def _plan(self, track: Sequence[tuple[datetime, float, float]], mode: str) -> PassPlan:
         sky = [(az, el) for _, az, el in track]
         pos = self.driver.rotor_position()
-        plan = plan_pass(self.driver.geometry, sky, pos[0] if pos is not None else None, self.flip_mode)
+        plan = plan_pass(self.driver.geometry, sky, pos[0] if pos is not None else None, mode)
         if not plan.fits:
             log.warning("this pass does not fit the rotor's range in flip mode %s; targets beyond the stops "
-                        "will be ignored", self.flip_mode)
+                        "will be ignored", mode)
         if sky:
             azs = [flip(az, el)[0] if plan.flipped else az for az, el in sky]
             self.driver.set_reference_azimuth(unwrap(azs)[0] + plan.offset_deg if plan.fits else azs[0])
         return plan
 
-    def _start_pass(self, when: datetime) -> None:
+    def _start_pass(self, when: datetime, mode: str) -> None:
         track = self.pass_track(when) or []
-        self.plan = self._plan(track)
-        self.flip_state = self.plan.flipped
+        self.plan = self._plan(track, mode)
+        with self._lock:
+            if not self._replan:  # else a newer flip mode arrived meanwhile: its state stands until its re-plan
+                self.flip_state = self.plan.flipped
         self._sent = None
         self._unreachable_reported = False
         self.driver.stop_parking_timer()
@@ -191,19 +205,23 @@ class RotorCoupling(TickWorker):
             if params.delay_minutes > 0:
                 self.driver.start_parking_timer()
             else:
-                self.driver.set_target(params.elevation_deg, params.azimuth_deg)
+                self.driver.set_target(azimuth_deg=params.azimuth_deg, elevation_deg=params.elevation_deg)
         elif self.after_los == "next-aos":
             track = self.pass_track(when + timedelta(seconds=1))
             if track:
-                plan = self._plan(track)
+                plan = self._plan(track, self.flip_mode)
                 _, az, el = track[0]
                 el = max(el, 0.0)  # AOS lies on the horizon
                 az_k, el_k = flip(az, el) if plan.flipped else (az, el)
-                self.driver.set_target(el_k, az_k)
+                self.driver.set_target(azimuth_deg=az_k, elevation_deg=el_k)
 
     # -- per tick --------------------------------------------------------------------------
     def process(self, sample: TickSample) -> None:
         """One tick's work (the worker's step; tests call it directly)."""
+        with self._lock:
+            retry, self._retry_asked = self._retry_asked, False
+        if retry:
+            self.driver.retry_now()
         if sample.tracking and not self._track_on_seen:
             self.resume()  # a new TRACK ON enables autotracking again
         self._track_on_seen = sample.tracking
@@ -213,9 +231,11 @@ class RotorCoupling(TickWorker):
         la = sample.look_angles
         if self._tracking and la is not None:
             if sample.above_horizon:
-                if self.plan is None or self._replan:
-                    self._replan = False
-                    self._start_pass(sample.time)
+                with self._lock:
+                    replan, self._replan = self.plan is None or self._replan, False
+                    mode = self.flip_mode
+                if replan:
+                    self._start_pass(sample.time, mode)
                 az, el = self._aim(sample.time, la.azimuth_deg, la.elevation_deg)
                 if self._sent is None or angular_distance(az, el, *self._sent) >= self.threshold_deg:
                     self._send(az, el)
@@ -239,13 +259,14 @@ class RotorCoupling(TickWorker):
         self.plan = None
         self._sent = None
         self._unreachable_reported = False
-        if self.flip_mode == "auto":
-            self.flip_state = False
+        with self._lock:
+            if self.flip_mode == "auto":
+                self.flip_state = False
         self.driver.retry_now()
 
     def _send(self, az: float, el: float) -> None:
         az_k, el_k = flip(az, el) if self.plan and self.plan.flipped else (az % 360.0, el)
-        if self.driver.set_target(el_k, az_k):
+        if self.driver.set_target(azimuth_deg=az_k, elevation_deg=el_k):
             self._sent = (az, el)
         elif not self._unreachable_reported:
             self._unreachable_reported = True

@@ -124,12 +124,13 @@ class KctDriver(KctRotorLink):
         tgt_el, tgt_az = self._target if self._target is not None else (None, None)
         return cur_el, cur_az, tgt_el, tgt_az
 
-    def reachable(self, elevation_deg: float, azimuth_deg: float) -> bool:
-        """Whether this rotor can point at the KCT target (el, az) with the current slew offsets."""
+    def reachable(self, azimuth_deg: float, elevation_deg: float) -> bool:
+        """Whether this rotor can point at the KCT target (az, el; degrees) with the current slew offsets."""
         return _valid_target(elevation_deg, azimuth_deg) and self._command_for(elevation_deg, azimuth_deg) is not None
 
-    def set_target(self, elevation_deg: float, azimuth_deg: float) -> bool:
-        """Function 4: point at (el, az); el -90..269, az 0..359 (fractions allowed).
+    def set_target(self, azimuth_deg: float, elevation_deg: float) -> bool:
+        """Function 4: point at (az, el), degrees; az 0..359, el -90..269 (fractions allowed).  The KCT call
+        passes elevation first; this method, like every other call here, takes azimuth first.
 
         An invalid or unreachable target is ignored as a whole (module docstring); returns False then.
         """
@@ -279,9 +280,10 @@ class KctDriver(KctRotorLink):
                 if isinstance(segment, RepetitiveEntry):
                     el = self._target[0] if self._target else 0.0
                     if self._target is None or self._target[1] != segment.azimuth_deg:
-                        self.set_target(el, segment.azimuth_deg)
+                        self.set_target(azimuth_deg=segment.azimuth_deg, elevation_deg=el)
         if self.parking.due(now):
-            self.set_target(self.parking.parameters.elevation_deg, self.parking.parameters.azimuth_deg)
+            parking = self.parking.parameters
+            self.set_target(azimuth_deg=parking.azimuth_deg, elevation_deg=parking.elevation_deg)
         self.read_position()
 
     def _process_normal(self, now: datetime) -> None:
@@ -299,5 +301,5 @@ class KctDriver(KctRotorLink):
             if now - entry.time <= timedelta(seconds=STALE_ENTRY_S):
                 due = entry
         if due is not None:
-            self.set_target(due.elevation_deg, due.azimuth_deg)
+            self.set_target(azimuth_deg=due.azimuth_deg, elevation_deg=due.elevation_deg)
 

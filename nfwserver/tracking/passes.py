@@ -31,9 +31,11 @@ extension gets ``None`` for that time.
 from __future__ import annotations
 
 import math
+import sys
 import threading
 from collections.abc import Sequence
 from datetime import datetime, timedelta, timezone
+from multiprocessing.connection import Connection
 from typing import Any
 
 import numpy as np
@@ -63,15 +65,54 @@ _CHUNK = 200
 #: Brackets refined together (at least; a batch takes whole chunks): bounds the memory of one refinement.
 _BATCH_BRACKETS = 10000
 
-#: Fork-time hand-over of the work to worker processes (Satrec objects cannot be pickled); set only
-#: for the duration of one parallel :func:`find_passes` call.
-_FORK_JOB: tuple[Any, ...] | None = None
+
+def _fork_worker(satellites: list[Any], args: tuple[Any, ...], results: Connection) -> None:
+    """A forked worker's whole life: the passes of its share of the satellites, sent back through
+    ``results`` (or the exception that stopped it).  Runs in the child only; the satellites reached it by
+    the fork (Satrec objects cannot be pickled), only the result is pickled."""
+    try:
+        outcome: PassList | BaseException = find_passes(satellites, *args)
+    except BaseException as exc:  # handed to the parent, which raises it
+        outcome = exc
+    try:
+        results.send(outcome)
+    finally:
+        results.close()
 
 
-def _fork_worker(indices: list[int]) -> PassList:
-    assert _FORK_JOB is not None
-    satellites, args = _FORK_JOB
-    return find_passes([satellites[i] for i in indices], *args)
+def _in_forked_workers(satellites: list[Any], args: tuple[Any, ...], workers: int) -> list[PassList]:
+    """The passes of ``satellites`` found by ``workers`` forked processes, one share each (every
+    ``workers``-th satellite), in the order of the shares (POSIX: the caller checked that fork exists)."""
+    import multiprocessing
+
+    if sys.platform == "win32":
+        raise OSError("fork is POSIX only")
+
+    context = multiprocessing.get_context("fork")
+    receivers: list[Connection] = []
+    processes = []
+    try:
+        for k in range(workers):
+            receiver, sender = context.Pipe(duplex=False)
+            process = context.Process(target=_fork_worker, args=(satellites[k::workers], args, sender), daemon=True)
+            process.start()
+            sender.close()  # the child holds its own end: EOF here if it dies without an answer
+            receivers.append(receiver)
+            processes.append(process)
+        outcomes = [receiver.recv() for receiver in receivers]  # before joining: a large answer fills the pipe
+        for process in processes:
+            process.join()
+    finally:
+        for receiver in receivers:
+            receiver.close()
+        for process in processes:
+            if process.is_alive():
+                process.terminate()
+                process.join()
+    for outcome in outcomes:
+        if isinstance(outcome, BaseException):
+            raise outcome
+    return outcomes
 
 
 def find_passes(
@@ -99,19 +140,13 @@ def find_passes(
     work stays in this process unless it is single-threaded.  The passes found are the same as
     with one worker.
     """
-    global _FORK_JOB
     satellites = [getattr(s, "elements", s) for s in satellites]  # a catalog satellite's element set
-    if workers > 1 and len(satellites) >= 200 * workers and _FORK_JOB is None and threading.active_count() == 1:
+    if workers > 1 and len(satellites) >= 200 * workers and threading.active_count() == 1:
         import multiprocessing
 
         if "fork" in multiprocessing.get_all_start_methods():
-            _FORK_JOB = (satellites, (observer, start, end, horizon, ut1_utc, fine_step_s))
-            try:
-                chunks = [list(range(k, len(satellites), workers)) for k in range(workers)]
-                with multiprocessing.get_context("fork").Pool(workers) as pool:
-                    worker_parts = pool.map(_fork_worker, chunks)
-            finally:
-                _FORK_JOB = None
+            worker_parts = _in_forked_workers(satellites, (observer, start, end, horizon, ut1_utc, fine_step_s),
+                                              workers)
             return PassList.concat(worker_parts[0].start, worker_parts[0].window_s, worker_parts)
     horizon = horizon or _FLAT
     if start.tzinfo is None:

@@ -15,8 +15,8 @@ from zoneinfo import ZoneInfo
 
 from skyfield.api import EarthSatellite, load, wgs84
 
+from nfwserver.channels.channel import Channel
 from nfwserver.console.app import NfwConsole
-from nfwserver.radio.transponder import Channel
 from tests.app.console_helpers import log_text, screen_text, settle, static_text
 from tests.dde.conftest import CATALOG, ISS, ISS_PASS, OBSERVER, make_station
 

@@ -11,10 +11,10 @@ from pathlib import Path
 
 import pytest
 
+from nfwserver.channels.channel import Channel
 from nfwserver.config.schema import EasyCommConfig
 from nfwserver.easycomm import EasyCommOutput
 from nfwserver.easycomm.output import open_serial
-from nfwserver.radio.transponder import Channel
 from tests.conftest import advance_until
 from tests.dde.conftest import CATALOG, ISS, ISS_PASS, OBSERVER, make_station
 from tests.tracking.skyfield_oracle import skyfield_look_angles

@@ -7,9 +7,9 @@ import math
 
 import pytest
 
+from nfwserver.channels.channel import Channel
+from nfwserver.channels.modes import HAMLIB_MODES
 from nfwserver.config import ConfigError, parse_config
-from nfwserver.radio.modes import HAMLIB_MODES
-from nfwserver.radio.transponder import Channel
 
 
 @pytest.mark.parametrize("field", ["downlink_correction_hz", "uplink_correction_hz"])

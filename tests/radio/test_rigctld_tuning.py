@@ -8,13 +8,13 @@ from datetime import datetime, timedelta, timezone
 
 import pytest
 
+from nfwserver.channels.channel import Channel
 from nfwserver.clock import VirtualClock
 from nfwserver.core.sample import TickSample
 from nfwserver.core.state import StationState
 from nfwserver.radio.backend import RadioError
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.radio.rigctld_backend import RigctldBackend
-from nfwserver.radio.transponder import Channel
 from nfwserver.radio.tuning import DopplerTuner
 from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.doppler import SPEED_OF_LIGHT_KM_S as C

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from nfwserver.radio.transponder import Channel
+from nfwserver.channels.channel import Channel
 from nfwserver.tracking.doppler import SPEED_OF_LIGHT_KM_S as C
 
 LINEAR = Channel("RS-44", downlink_hz=435_640_000, uplink_hz=145_965_000, downlink_mode="USB", uplink_mode="LSB",

@@ -11,9 +11,9 @@ import time
 import pytest
 
 from nfwserver.app.element_store import ElementStore
+from nfwserver.channels.channel import Channel
 from nfwserver.clock import SystemClock
 from nfwserver.radio.rigctld_backend import RigctldBackend
-from nfwserver.radio.transponder import Channel
 from nfwserver.radio.tuning import DopplerTuner
 from nfwserver.rotor.geometry import RotorGeometry
 from nfwserver.rotor.kct_driver import KctDriver
@@ -132,7 +132,7 @@ def test_rotor_resumes_within_two_seconds_after_each_of_20_rotctld_restarts() ->
 
         def attempt() -> bool:
             target[0] = 10.0 if target[0] > 15 else 20.0
-            driver.set_target(5.0, target[0])
+            driver.set_target(target[0], 5.0)
             driver.service()
             return not driver.status().bits & KctStatusBit.CARD_ABSENT and driver.rotor_position() is not None
 

@@ -12,10 +12,10 @@ from datetime import datetime, timezone
 
 import pytest
 
+from nfwserver.channels.channel import Channel
 from nfwserver.clock import VirtualClock
 from nfwserver.radio.backend import RadioError
 from nfwserver.radio.rigctld_backend import RigctldBackend
-from nfwserver.radio.transponder import Channel
 from nfwserver.radio.tuning import DopplerTuner
 from nfwserver.rotor.backend import RotorError
 from nfwserver.rotor.geometry import RotorGeometry
@@ -104,7 +104,7 @@ def test_a_garbage_rotctld_polled_at_50_hz_is_reported_once_then_summarised(peer
     p = peer(lambda cmd, n: b"\x00\xff garbage\n\x01\n" if cmd == "p" else b"RPRT 0\n")
     clock = _clock()
     driver = KctDriver(clock, RotctldBackend(clock, GEOMETRY, port=p.port, timeout_s=2.0), GEOMETRY)
-    driver.set_target(10.0, 20.0)
+    driver.set_target(20.0, 10.0)
     caplog.set_level(logging.INFO, logger="nfwserver")
     for _ in range(50 * 150):  # 150 s of 50 Hz ticks on the virtual clock
         driver.service()

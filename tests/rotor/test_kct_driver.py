@@ -26,18 +26,18 @@ def rig():
 
 def test_set_target_validates_the_whole_command(rig) -> None:
     clock, rotor, driver = rig
-    assert driver.set_target(45, 90)
-    assert not driver.set_target(270, 10)  # elevation out of -90..269: ignored
-    assert not driver.set_target(10, 360)
+    assert driver.set_target(90, 45)
+    assert not driver.set_target(10, 270)  # elevation out of -90..269: ignored
+    assert not driver.set_target(360, 10)
     assert driver.positions()[2:] == (45.0, 90.0)
     assert rotor.target == (90.0, 45.0)
-    assert driver.set_target(150, 10)  # over the top: allowed by KCT, within this rotor's 0..180
+    assert driver.set_target(10, 150)  # over the top: allowed by KCT, within this rotor's 0..180
     assert rotor.target == (10.0, 150.0)
 
 
 def test_slew_offsets(rig) -> None:
     _, rotor, driver = rig
-    driver.set_target(30, 100)
+    driver.set_target(100, 30)
     assert not driver.write_slew(26, 0) and driver.read_slew() == (0, 0)
     assert driver.write_slew(-5, 10)
     assert rotor.target == (110.0, 25.0)
@@ -45,7 +45,7 @@ def test_slew_offsets(rig) -> None:
 
 def test_status_bits_follow_the_rotor(rig) -> None:
     clock, rotor, driver = rig
-    driver.set_target(30, 60)
+    driver.set_target(60, 30)
     driver.service()
     status = driver.status()
     assert status.bits & KctStatusBit.AZ_MOVING and status.bits & KctStatusBit.AZ_INCREASING
@@ -136,7 +136,7 @@ def test_parking_after_the_delay(rig) -> None:
     clock, rotor, driver = rig
     assert not driver.set_parking(61, 0, 0) and not driver.set_parking(5, 360, 0)
     assert driver.set_parking(2, 180, 10)
-    driver.set_target(40, 100)
+    driver.set_target(100, 40)
     driver.start_parking_timer()
     clock.advance(119)
     driver.service()
@@ -144,7 +144,7 @@ def test_parking_after_the_delay(rig) -> None:
     clock.advance(2)
     driver.service()
     assert driver.positions()[2:] == (10.0, 180.0)
-    driver.set_target(40, 100)
+    driver.set_target(100, 40)
     driver.start_parking_timer()
     driver.stop_parking_timer()
     clock.advance(300)
@@ -170,7 +170,7 @@ def test_annunciator_popups_and_status_in_morse(rig) -> None:
     assert driver.morse_enabled() and driver.set_morse(False) is True
     driver.announce("not sent")
     assert driver.announcements == []
-    driver.set_target(10, 20)
+    driver.set_target(20, 10)
     driver.service()
     text = driver.announce_status()  # sent even with the annunciator disabled
     assert text.startswith("ST ") and "TGT 20 10" in text and driver.announcements[-1].text == text

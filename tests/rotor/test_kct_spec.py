@@ -33,20 +33,20 @@ def test_an_unreachable_elevation_is_ignored_not_clamped() -> None:
     # FlipAnts caution 2: "Your rotor driver program must ignore any angles that your antennas are not
     # physically capable of. ... Your driver must know not to try to comply."
     _, rotor, driver = _rig(RotorGeometry(0.0, 360.0, 0.0, 90.0))
-    assert driver.set_target(30, 100)
+    assert driver.set_target(100, 30)
     assert rotor.commands == [(100.0, 30.0)]
-    assert driver.set_target(150, 280) is False  # over the top: this rotor stops at 90
+    assert driver.set_target(280, 150) is False  # over the top: this rotor stops at 90
     assert rotor.commands == [(100.0, 30.0)]  # never (280, 90)
     assert driver.positions()[2:] == (30.0, 100.0)  # the previous target stays in force
-    assert driver.set_target(-1, 100) is False  # below this rotor's 0 degrees
+    assert driver.set_target(100, -1) is False  # below this rotor's 0 degrees
     assert rotor.commands == [(100.0, 30.0)]
 
 
 def test_an_azimuth_in_the_rotors_gap_is_ignored() -> None:
     # A rotor turning 0..350: azimuth 355 cannot be reached, so "the entire command will be ignored".
     _, rotor, driver = _rig(RotorGeometry(0.0, 350.0, 0.0, 90.0))
-    assert driver.set_target(10, 340)
-    assert driver.set_target(10, 355) is False
+    assert driver.set_target(340, 10)
+    assert driver.set_target(355, 10) is False
     assert rotor.commands == [(340.0, 10.0)]
 
 
@@ -54,12 +54,12 @@ def test_slew_that_carries_the_target_out_of_reach_sends_nothing() -> None:
     # Function 2 "If either value is invalid the entire command will be ignored" -- a slew of -5 is valid,
     # but target el 3 - 5 = -2 is beyond this rotor, so no command goes out; back in reach, it does.
     _, rotor, driver = _rig(RotorGeometry(0.0, 360.0, 0.0, 90.0))
-    assert driver.set_target(3, 100)
+    assert driver.set_target(100, 3)
     assert driver.write_slew(-5, 0)
     assert rotor.commands == [(100.0, 3.0)]
     assert driver.write_slew(-2, 0)
     assert rotor.commands == [(100.0, 3.0), (100.0, 1.0)]
-    assert driver.set_target(1, 100) is False  # 1 - 2 = -1: out of reach with this slew
+    assert driver.set_target(100, 1) is False  # 1 - 2 = -1: out of reach with this slew
 
 
 # -- item 10: status bits 20h / 10h -----------------------------------------------------------------
@@ -68,7 +68,7 @@ def test_a_reported_stall_sets_the_axis_bit_and_holds_the_axis() -> None:
     # KCT function 0: "20 - =1 if the ELEV rotor is stalled & has been disabled
     #                  10 - =1 if the AZIM rotor is stalled & has been disabled"
     clock, rotor, driver = _rig(RotorGeometry(0.0, 360.0, 0.0, 90.0))
-    driver.set_target(20, 90)
+    driver.set_target(90, 20)
     clock.advance(2)
     driver.service()
     rotor.az_stalled = True
@@ -78,13 +78,13 @@ def test_a_reported_stall_sets_the_axis_bit_and_holds_the_axis() -> None:
     assert driver.announcements[-1].kind == "alarm" and "azimuth" in driver.announcements[-1].text
     held_az = driver.rotor_position()[0]
     assert held_az == pytest.approx(12.0)  # 2 s at 6 deg/s, then stalled
-    driver.set_target(40, 120)  # elevation still moves; the stalled azimuth is held where it is
+    driver.set_target(120, 40)  # elevation still moves; the stalled azimuth is held where it is
     assert rotor.commands[-1] == (pytest.approx(held_az), 40.0)
     rotor.el_stalled = True
     driver.service()
     assert driver.status().bits & 0x30 == 0x30
     count = len(rotor.commands)
-    driver.set_target(45, 130)
+    driver.set_target(130, 45)
     assert len(rotor.commands) == count  # both axes disabled: nothing is sent
     rotor.az_stalled = rotor.el_stalled = False
     driver.enable(True)  # function 9: "The enable function reverses this effect."
@@ -97,7 +97,7 @@ def test_no_movement_toward_the_target_is_a_stall() -> None:
     clock = VirtualClock(T0)
     rotor = SimulatedRotor(clock, RotorGeometry(), az_speed_deg_s=0.0, el_speed_deg_s=6.0)
     driver = KctDriver(clock, rotor, rotor.geometry, stall_timeout_s=10.0)
-    driver.set_target(30, 90)
+    driver.set_target(90, 30)
     for _ in range(9):
         clock.advance(1)
         driver.service()
@@ -114,7 +114,7 @@ def test_a_rotor_that_lags_but_keeps_turning_is_not_stalled() -> None:
     rotor = SimulatedRotor(clock, RotorGeometry(0.0, 450.0, 0.0, 90.0), az_speed_deg_s=1.0)
     driver = KctDriver(clock, rotor, rotor.geometry, stall_timeout_s=10.0)
     for k in range(60):  # the target runs away at 2 deg/s, the rotor follows at 1 deg/s
-        driver.set_target(10, (20 + 2 * k) % 360)
+        driver.set_target((20 + 2 * k) % 360, 10)
         clock.advance(1)
         driver.service()
     assert not driver.status().bits & (KctStatusBit.AZ_STALLED | KctStatusBit.EL_STALLED)
@@ -131,9 +131,9 @@ def test_repeated_rotctld_refusals_are_a_stall() -> None:
                            stall_timeout_s=None)
         driver.set_reference_azimuth(400.0)
         for az in (40, 41):
-            assert driver.set_target(10, az)  # accepted by the driver; refused by the daemon (as 400, 401)
+            assert driver.set_target(az, 10)  # accepted by the driver; refused by the daemon (as 400, 401)
         assert not driver.status().bits & 0x30
-        driver.set_target(10, 42)
+        driver.set_target(42, 10)
         assert driver.status().bits & 0x30 == 0x30
         assert not driver.status().bits & KctStatusBit.CARD_ABSENT  # the daemon answers; it refuses
 
@@ -216,7 +216,7 @@ def test_a_rotor_resting_just_short_of_its_target_is_not_stalled() -> None:
     clock = VirtualClock(T0)
     rotor = SimulatedRotor(clock, RotorGeometry(), start=(98.0, 30.0))
     driver = KctDriver(clock, rotor, rotor.geometry, stall_timeout_s=10.0)
-    driver.set_target(30, 100)
+    driver.set_target(100, 30)
     rotor.az_speed = 0.0  # it will not move the last 2 degrees
     for _ in range(30):
         clock.advance(1)

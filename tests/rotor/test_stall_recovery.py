@@ -110,11 +110,11 @@ def test_refusals_from_a_real_rotctld_stall_the_rotor_until_it_accepts_and_moves
         try:
             clock = VirtualClock(ISS_PASS.aos)
             driver = KctDriver(clock, RotctldBackend(clock, GEOMETRY, port=proxy.port), GEOMETRY)
-            assert driver.set_target(10.0, 40.0)
+            assert driver.set_target(40.0, 10.0)
             driver.service()
             proxy.set_mode("refuse")
             for k in range(3):  # three targets in a row, as autotracking sends them, each refused
-                assert driver.set_target(20.0 + k, 80.0 + k)
+                assert driver.set_target(80.0 + k, 20.0 + k)
                 driver.service()
                 clock.advance(0.2)
             assert driver.stalled and "refused" in driver.health.describe()

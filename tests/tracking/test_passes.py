@@ -166,6 +166,31 @@ print("same", len(serial))
     assert done.stdout.startswith("same ")
 
 
+@pytest.mark.skipif(sys.platform == "win32", reason="fork")
+def test_a_failure_in_a_worker_process_reaches_the_caller() -> None:
+    """A worker that fails hands its exception back; the caller raises it (no hang, no silent gap)."""
+    import subprocess
+
+    script = """
+import sys
+from datetime import datetime, timedelta, timezone
+from nfwserver.tracking.elements import load_element_file
+from nfwserver.tracking.observer import Observer
+from nfwserver.tracking.passes import find_passes
+sats = load_element_file(sys.argv[1]).sets[:500]
+sats[501 % 500] = object()  # in the second worker's share
+start = datetime(2026, 5, 8, tzinfo=timezone.utc)
+try:
+    find_passes(sats, Observer(52.2, 0.12, 20.0), start, start + timedelta(hours=6), workers=2)
+except AttributeError as exc:
+    print("raised", exc)
+"""
+    done = subprocess.run([sys.executable, "-c", script, str(DATA / "active.txt")], capture_output=True, text=True,
+                          timeout=100)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("raised "), done.stdout
+
+
 def test_element_sets_and_their_models_give_the_same_passes_and_no_model_is_kept() -> None:
     """Element sets are grouped by their own fields and propagated by models made for the search only;
     the passes are exactly those of the same satellites given as sgp4 Satrecs."""

@@ -6,7 +6,7 @@ import sys
 
 import pytest
 
-from nfwserver.dde.platform_transport import FAKE_NOTE, default_transport
+from nfwserver.app.platform_transport import FAKE_NOTE, default_transport
 from nfwserver.fake_dde import FakeDdeSystem
 
 

@@ -103,7 +103,7 @@ def test_failures_on_the_dde_thread_reach_the_caller() -> None:
 
 
 def test_default_transport_is_real_ddeml_here() -> None:
-    from nfwserver.dde.platform_transport import default_transport
+    from nfwserver.app.platform_transport import default_transport
     from nfwserver.dde.windows_transport import WindowsDdeTransport
 
     transport, note = default_transport()

@@ -13,6 +13,7 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+import time
 from pathlib import Path
 
 
@@ -30,11 +31,21 @@ def session_members(sid: int) -> list[int]:
 
 
 def kill_session(proc: subprocess.Popen, timeout_s: float = 30.0) -> None:
-    """SIGKILL every process in ``proc``'s session (``proc`` was started with ``start_new_session``)."""
-    for pid in session_members(proc.pid):
-        try:
-            os.kill(pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
+    """SIGKILL every process in ``proc``'s session (``proc`` was started with ``start_new_session``).
+
+    Reading /proc and signalling are not one step: a member may start another process in between (``timeout``
+    starting the program, a launcher starting ``wine``), which a single pass would leave running.  So the
+    session is read and killed again until no live member is left (or ``timeout_s`` passes: RuntimeError).
+    """
+    deadline = time.monotonic() + timeout_s
+    while members := session_members(proc.pid):
+        if time.monotonic() > deadline:
+            raise RuntimeError(f"session {proc.pid} still has processes {members} after {timeout_s:g} s of SIGKILL")
+        for pid in members:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+        time.sleep(0.01)  # let the signalled ones die before the session is read again
     if proc.poll() is None:
         proc.wait(timeout_s)

@@ -1,5 +1,7 @@
 """Satellite channels and the ground frequencies that put a signal where it belongs on the satellite.
 
+A plain record of the station's state (the core holds it; the radio, dialects and EasyComm adapters read it).
+
 Frequencies are Hz, range rate km/s (positive receding).  A :class:`Channel` describes one
 transponder or beacon: the satellite-side downlink and uplink centre frequencies, whether the
 transponder inverts (uplink up = downlink down), per-satellite corrections for the satellite's own
@@ -18,7 +20,7 @@ downlink side; the uplink moves the other way on an inverting transponder.
 
 A channel checks itself when built and raises :class:`ValueError` with one clear sentence: frequencies
 finite and within 100 kHz..300 GHz, corrections finite and within ±1 MHz, the passband offset finite,
-modes among Hamlib's names (:mod:`nfwserver.radio.modes`; stored upper-case).
+modes among Hamlib's names (:mod:`nfwserver.channels.modes`; stored upper-case).
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from nfwserver.radio.modes import check_mode
+from nfwserver.channels.modes import check_mode
 from nfwserver.tracking.doppler import downlink_frequency_hz, uplink_frequency_hz
 
 HOLD_SIDES = ("satellite", "uplink", "downlink")

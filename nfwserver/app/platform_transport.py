@@ -1,4 +1,8 @@
-"""The DDE transport a station serves on by default: real DDEML on Windows, the fake one elsewhere."""
+"""The DDE transport a station serves on by default: real DDEML on Windows, the fake one elsewhere.
+
+The choice is the station builder's: :mod:`nfwserver.dde` holds the transport interface and the Nova adapter,
+:mod:`nfwserver.fake_dde` implements the interface, and neither imports the other's side of it.
+"""
 
 from __future__ import annotations
 

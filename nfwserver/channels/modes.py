@@ -3,7 +3,7 @@
 The set is Hamlib 4.5's mode table (``rig_strrmode``/``rig_parse_mode``), aliases included
 (``USB-D`` is ``PKTUSB``, ``CW-R`` is ``CWR``).  ``rigctld`` answers ``RPRT 0`` to a name outside
 it and leaves the mode unchanged, so a misspelt mode would pass unnoticed: channels refuse such
-names when they are built (:class:`nfwserver.radio.transponder.Channel`).
+names when they are built (:class:`nfwserver.channels.channel.Channel`).
 """
 
 from __future__ import annotations
