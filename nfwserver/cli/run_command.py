@@ -74,7 +74,7 @@ class RunPlan:
     transport: Any = None  #: a DDE server transport (default: the platform's)
     make_console: Callable[..., Any] | None = None  #: builds the console app (default: NfwConsole)
     console_options: dict | None = None  #: passed to the app's run() (tests: headless=True)
-    stop: threading.Event | None = None  #: set to stop (default: set by SIGINT/SIGTERM)
+    stop: threading.Event | None = None  #: set to stop (default: signals and NFW_CONTROL_FILE; cli/signals.py)
 
 
 def run(args: argparse.Namespace) -> int:

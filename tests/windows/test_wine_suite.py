@@ -10,6 +10,7 @@ What runs:
   60 s, every conversation kept, then ``XTYP_DISCONNECT`` to each when the station stops;
 - docs/WINE.md's set-up: a Windows DDE client under Wine pointing a Linux ``rotctld`` over TCP
   from the station's feed, while the station under Wine tunes a Linux ``rigctld``.
+- SIGTERM, SIGINT and SIGHUP to ``tools/wine/nfwserver`` stop the Windows station cleanly within 5 s.
 """
 
 from __future__ import annotations
