@@ -9,6 +9,10 @@ A valid file is handed to ``apply`` (the station's live reload); anything else i
 with one sentence and the running configuration stays until a good file arrives.  Only regular files
 are read, so a FIFO or device put in place of the file never blocks the watcher.
 
+:meth:`ConfigWatcher.request` asks for a read now, whether or not the file looks changed (SIGHUP, the
+daemon convention: ``nfwserver run`` calls it through ``Station.reload_config``); the same rules apply.
+With ``interval_s=None`` the watcher reads only on request.
+
 Owned by its own thread, ``nfw-config``; it waits on the injected clock, so tests drive it with a
 :class:`~nfwserver.clock.VirtualClock`.
 """
@@ -46,8 +50,11 @@ class ConfigWatcher(ServiceThread):
 
     thread_name = "nfw-config"
 
+    #: station-clock seconds between looks when the watcher only reads on request
+    IDLE_S = 3600.0
+
     def __init__(self, path: str | Path, clock: Clock, apply: Callable[[Config], None],
-                 refused: Callable[[str], None], interval_s: float = 2.0, settle_s: float = 1.0) -> None:
+                 refused: Callable[[str], None], interval_s: float | None = 2.0, settle_s: float = 1.0) -> None:
         self.path = Path(path)
         self.clock = clock
         self.apply = apply
@@ -56,21 +63,28 @@ class ConfigWatcher(ServiceThread):
         self.settle_s = settle_s
         super().__init__()
         self._seen: Signature = None
+        self._requested = False
+
+    def request(self) -> None:
+        """Read the file on the watcher's thread now, changed or not (any thread; only sets flags)."""
+        self._requested = True
+        self._wake.set()
 
     def start(self) -> None:
         if self._thread is None:
             self._seen = file_signature(self.path)
         super().start()
 
-    def check(self) -> bool:
-        """One look at the file (the thread's step; returns True when a change was handled)."""
+    def check(self, force: bool = False) -> bool:
+        """One look at the file (the thread's step; returns True when a change was handled).  With
+        ``force`` (a reload request) the file is read even if it looks unchanged, without settling first."""
         from nfwserver.config.loader import ConfigError, has_settings, parse_config, read_config_text
 
         now = file_signature(self.path)
-        if now == self._seen:
+        if now == self._seen and not force:
             return False
         # Let a writer finish: read only once the file has stayed the same for settle_s.
-        while not self.clock.wait(self._stop, self.settle_s):
+        while not force and not self.clock.wait(self._stop, self.settle_s):
             later = file_signature(self.path)
             if later == now:
                 break
@@ -103,8 +117,18 @@ class ConfigWatcher(ServiceThread):
         return True
 
     def _run(self) -> None:
-        while not self.clock.wait(self._stop, self.interval_s):
+        while True:
+            self.clock.wait(self._wake, self.interval_s if self.interval_s is not None else self.IDLE_S)
+            if self._stop.is_set():
+                return
+            self._wake.clear()
+            forced, self._requested = self._requested, False
+            if not forced and self.interval_s is None:
+                continue
             try:
-                self.check()
+                handled = self.check(force=forced)
             except Exception:  # the watcher must outlive any surprise
                 log.exception("checking the configuration file failed")
+                continue
+            if forced and not handled and not self.clock.wait(self._stop, self.settle_s):
+                self.request()  # written to while being read: read it again once it has settled

@@ -148,6 +148,22 @@ class Station:
             self.watcher = ConfigWatcher(path, self.clock, self._config_changed, self._config_refused, interval_s)
             self.watcher.start()
 
+    def reload_config(self) -> bool:
+        """Re-read the configuration file now, changed or not (SIGHUP; any thread): applied only when whole,
+        as a change the watcher sees.  False when the station runs on built-in defaults or is not running."""
+        if not self._started:
+            return False
+        if not self.config.path:
+            log.warning("reload requested, but the station runs on built-in defaults: there is no file to read")
+            return False
+        if self.watcher is None:  # not watching: a watcher that reads only on request
+            self.watcher = ConfigWatcher(self.config.path, self.clock, self._config_changed, self._config_refused,
+                                         None)
+            self.watcher.start()
+        log.info("reloading the configuration from %s", self.config.path)
+        self.watcher.request()
+        return True
+
     # -- elements ----------------------------------------------------------------------------------
     @staticmethod
     def _report(fetched: FetchResult) -> None:

@@ -11,7 +11,6 @@ from __future__ import annotations
 import argparse
 import logging
 import logging.handlers
-import signal
 import sys
 import threading
 from collections.abc import Callable
@@ -19,6 +18,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from nfwserver.cli.control_file import ControlFile, control_path
+from nfwserver.cli.signals import StationSignals, signal_actions
 from nfwserver.cli.station_runner import run_console, serve_headless, start_report
 from nfwserver.clock import Clock, SystemClock
 
@@ -75,7 +76,7 @@ class RunPlan:
     transport: Any = None  #: a DDE server transport (default: the platform's)
     make_console: Callable[..., Any] | None = None  #: builds the console app (default: NfwConsole)
     console_options: dict[str, Any] | None = None  #: passed to the app's run() (tests: headless=True)
-    stop: threading.Event | None = None  #: set to stop (default: set by SIGINT/SIGTERM)
+    stop: threading.Event | None = None  #: set to stop (default: signals and NFW_CONTROL_FILE; cli/signals.py)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -136,14 +137,6 @@ def _make_console(station: Any, config: Any, hint: str) -> Any:
                       stale_days=config.elements.stale_days)
 
 
-def _stop_on_signals(stop: threading.Event) -> None:
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        try:
-            signal.signal(sig, lambda *_: stop.set())
-        except ValueError:  # not the main thread (embedded use)
-            pass
-
-
 def _exit_app(app: Any) -> None:
     try:
         app.call_from_thread(app.exit)
@@ -151,64 +144,121 @@ def _exit_app(app: Any) -> None:
         pass
 
 
+class _Requests:
+    """Stop and reload requests (signals, the control file) for one run: set ``stop``, leave the console,
+    reload the station's configuration.  The console and the station are filled in as they come up."""
+
+    def __init__(self, stop: threading.Event) -> None:
+        self.stop = stop
+        self.station: Any = None
+        self.app: Any = None
+
+    def on_stop(self) -> None:
+        self.stop.set()
+        if self.app is not None:
+            _exit_app(self.app)
+
+    def on_reload(self) -> None:
+        if self.station is not None:
+            self.station.reload_config()
+
+
+def _listen(plan: RunPlan, requests: _Requests, clock: Clock) -> tuple[StationSignals | None, ControlFile | None]:
+    """Signal handlers and the control file's watcher, unless the caller stops the run itself (``plan.stop``)."""
+    if plan.stop is not None:
+        return None, None
+    signals = StationSignals(signal_actions(headless=not plan.console), requests.on_stop, requests.on_reload)
+    signals.install()
+    path = control_path()
+    control = ControlFile(path, clock, signals.request) if path is not None else None
+    if control is not None:
+        control.start()
+    return signals, control
+
+
 def serve(config: Any, plan: RunPlan, watch: str | None = None) -> int:
-    """Start the station from ``config``, run it as ``plan`` says, stop it; the exit code."""
+    """Start the station from ``config``, run it as ``plan`` says, stop it; the exit code.
+
+    Without ``plan.stop``, signals and the control file stop it or reload its configuration
+    (:mod:`nfwserver.cli.signals`), from before the station starts until it has stopped."""
     from nfwserver.app.station import Station
     from nfwserver.cli import CliError
     from nfwserver.cli.log_file import LOG_BACKOFF
 
     clock = plan.clock or SystemClock()
-    file_handler = None
-    if not plan.console:
-        file_handler = _log_to_file(plan.log_file, clock)
-        print(f"nfwserver: logging to {plan.log_file}", file=sys.stderr)
-    station = Station(config, clock, transport=plan.transport)
-    if file_handler is not None:
-        file_handler.attach(station.core.health.link("log-file", LOG_BACKOFF))
-    try:
-        station.start()
-    except OSError as exc:
-        station.stop()
-        raise CliError(f"cannot start the station: {exc}") from None
-    notes, hint = _notes(station, config)
-    if watch:
-        station.watch_config(watch)
-    started = clock.monotonic()
     stop = plan.stop or threading.Event()
+    requests = _Requests(stop)
+    signals, control = _listen(plan, requests, clock)
+    file_handler = None
     try:
-        if plan.console:
-            app = (plan.make_console or _make_console)(station, config, hint)
-            timer = None
-            if plan.duration_s:
-                timer = threading.Timer(plan.duration_s, _exit_app, (app,))
-                timer.daemon = True
-                timer.start()
-            failure = run_console(app, **(plan.console_options or {}))
-            if timer is not None:
-                timer.cancel()
-            if failure is None:
-                return 0
+        if not plan.console:
             file_handler = _log_to_file(plan.log_file, clock)
+            print(f"nfwserver: logging to {plan.log_file}", file=sys.stderr)
+        station = Station(config, clock, transport=plan.transport)
+        if file_handler is not None:
             file_handler.attach(station.core.health.link("log-file", LOG_BACKOFF))
-            log.error("the console stopped: %s: %s", type(failure).__name__, failure, exc_info=failure)
-            print(f"nfwserver: the console failed ({type(failure).__name__}: {failure}); the station keeps "
-                  f"serving without it, logging to {plan.log_file}; stop it with Ctrl+C.", file=sys.stderr)
-        else:
-            for note in notes:
-                print(f"nfwserver: {note}", file=sys.stderr)
-                log.info(note)
-        for line in start_report(station):
-            log.info(line)
-        if plan.stop is None:
-            _stop_on_signals(stop)
-        remaining = None
-        if plan.duration_s is not None:
-            remaining = max(0.0, plan.duration_s - (clock.monotonic() - started))
-        serve_headless(station, stop, remaining)
+        try:
+            station.start()
+        except OSError as exc:
+            station.stop()
+            raise CliError(f"cannot start the station: {exc}") from None
+        requests.station = station
+        try:
+            file_handler = _serve_started(station, config, plan, watch, requests, file_handler)
+        finally:
+            if signals is not None:
+                signals.stopping()  # no reload from here on; a further stop request is only noted
+            station.stop()
+            log.info("stopped")
     finally:
-        station.stop()
-        log.info("stopped")
+        if control is not None:
+            control.stop()
+        if signals is not None:
+            signals.close()
         if file_handler is not None:
             logging.getLogger().removeHandler(file_handler)
             file_handler.close()
     return 0
+
+
+def _serve_started(station: Any, config: Any, plan: RunPlan, watch: str | None, requests: _Requests,
+                   file_handler: StationLogFile | None) -> StationLogFile | None:
+    """Keep the started ``station`` serving until ``requests.stop`` or the duration; the log file in use."""
+    from nfwserver.cli.log_file import LOG_BACKOFF
+
+    clock = station.clock
+    notes, hint = _notes(station, config)
+    if watch:
+        station.watch_config(watch)
+    started = clock.monotonic()
+    stop = requests.stop
+    if plan.console and not stop.is_set():
+        app = (plan.make_console or _make_console)(station, config, hint)
+        requests.app = app
+        timer = None
+        if plan.duration_s:
+            timer = threading.Timer(plan.duration_s, _exit_app, (app,))
+            timer.daemon = True
+            timer.start()
+        failure = run_console(app, **(plan.console_options or {}))
+        requests.app = None
+        if timer is not None:
+            timer.cancel()
+        if failure is None:
+            return file_handler
+        file_handler = _log_to_file(plan.log_file, clock)
+        file_handler.attach(station.core.health.link("log-file", LOG_BACKOFF))
+        log.error("the console stopped: %s: %s", type(failure).__name__, failure, exc_info=failure)
+        print(f"nfwserver: the console failed ({type(failure).__name__}: {failure}); the station keeps "
+              f"serving without it, logging to {plan.log_file}; stop it with Ctrl+C.", file=sys.stderr)
+    elif not plan.console:
+        for note in notes:
+            print(f"nfwserver: {note}", file=sys.stderr)
+            log.info(note)
+    for line in start_report(station):
+        log.info(line)
+    remaining = None
+    if plan.duration_s is not None:
+        remaining = max(0.0, plan.duration_s - (clock.monotonic() - started))
+    serve_headless(station, stop, remaining)
+    return file_handler

@@ -12,7 +12,9 @@ window starts once every conversation is up, or with ``--start-at`` at that wall
 seconds, shared by several programs: ``python -m bench wine-dde``; ``late`` says a program was not
 connected by then and started its window late).
 With ``--wait-disconnect`` the program then waits until the station ends every conversation
-(``XTYP_DISCONNECT``).  Results go to ``--out`` as JSON, one record per client.
+(``XTYP_DISCONNECT``), having first created the file ``--ready`` if given (a test stops the station
+then).  ``--poke TEXT`` pokes one more command on the first conversation once all are up.  Results go
+to ``--out`` as JSON, one record per client.
 """
 
 from __future__ import annotations
@@ -53,6 +55,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--start-at", type=float, default=0.0, help="window start, Unix seconds")
     parser.add_argument("--services", default=",".join(SERVICES), help="service names, used in turn")
     parser.add_argument("--out", required=True)
+    parser.add_argument("--ready", default="", help="file created when waiting for the disconnects begins")
+    parser.add_argument("--poke", default="", help="a command poked on the first conversation")
     args = parser.parse_args(argv)
     services = args.services.split(",")
     records = [{"client": i, "service": services[i % len(services)], "error": None} for i in range(args.clients)]
@@ -67,6 +71,8 @@ def main(argv: list[str] | None = None) -> int:
         records[len(convs)]["error"] = f"{type(exc).__name__}: {exc}"
         Path(args.out).write_text(json.dumps(records, indent=1))
         return 1
+    if args.poke:
+        shared.poke(convs[0], "NFW_SERVER", args.poke)
     pump = clients[0].pump  # one thread: pumping dispatches every instance's messages
     late = time.time() > args.start_at if args.start_at else False
     if args.start_at and not late:
@@ -93,6 +99,8 @@ def main(argv: list[str] | None = None) -> int:
         except DdeRefused as exc:
             record["request_after"] = f"refused: {exc}"
     if args.wait_disconnect:
+        if args.ready:
+            Path(args.ready).write_text("waiting\n")
         t0 = time.monotonic()
         pump(args.wait_disconnect, until=lambda: all(c.ended_by_server(v) for c, v in zip(clients, convs)))
         for record, c, conv in zip(records, clients, convs):

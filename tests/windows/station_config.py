@@ -14,7 +14,8 @@ OBSERVER = "52.2053,0.1218,20"
 
 
 def write_station_config(directory: Path, satellite: int = 25544, rate_hz: float = 10.0,
-                         elements: Path = DATA / "visual.txt", observer: str = OBSERVER, extra: str = "") -> Path:
+                         elements: Path = DATA / "visual.txt", observer: str = OBSERVER, extra: str = "",
+                         state_file: str = "none") -> Path:
     """Write ``station.toml`` into ``directory`` and return its path; ``extra`` is appended TOML."""
     directory.mkdir(parents=True, exist_ok=True)
     path = directory / "station.toml"
@@ -22,7 +23,7 @@ def write_station_config(directory: Path, satellite: int = 25544, rate_hz: float
     path.write_text(
         f"[observer]\nlocation = '{observer}'\n"
         f"[elements]\nfiles = ['{elements}']\nuse_bundled = false\nstore = 'none'\nrefresh_hours = 0\n"
-        f"[server]\nrate_hz = {rate_hz:g}\nsatellite = {satellite}\nstate_file = 'none'\n{extra}",
+        f"[server]\nrate_hz = {rate_hz:g}\nsatellite = {satellite}\nstate_file = '{state_file}'\n{extra}",
         encoding="utf-8",
     )
     return path

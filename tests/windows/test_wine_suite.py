@@ -10,6 +10,7 @@ What runs:
   60 s, every conversation kept, then ``XTYP_DISCONNECT`` to each when the station stops;
 - docs/WINE.md's set-up: a Windows DDE client under Wine pointing a Linux ``rotctld`` over TCP
   from the station's feed, while the station under Wine tunes a Linux ``rigctld``.
+- SIGTERM, SIGINT and SIGHUP to ``tools/wine/nfwserver`` stop the Windows station cleanly within 5 s.
 """
 
 from __future__ import annotations
@@ -163,3 +164,68 @@ def test_wine_md_windows_rotor_client_and_station_radio_reach_linux_hamlib(tmp_p
         time.sleep(0.5)
     assert abs(pos[0] - az) < 0.11 and abs(pos[1] - el) < 0.11, (pos, az, el)
     assert abs(radio_hz - 1_537_700_000) < 1_537_700_000 * 1 / 299792.458  # tuned: within 1 km/s of Doppler
+
+
+def _station_processes(marker: str) -> list[int]:
+    """Pids of live processes whose command line holds ``marker`` (the station's unique config path)."""
+    found = []
+    for cmdline in Path("/proc").glob("[0-9]*/cmdline"):
+        try:
+            text = cmdline.read_bytes().replace(b"\0", b" ").decode("utf-8", "replace")
+            state = (cmdline.parent / "stat").read_text().rsplit(")", 1)[1].split()[0]
+        except (OSError, IndexError):
+            continue
+        if marker in text and state != "Z":
+            found.append(int(cmdline.parent.name))
+    return found
+
+
+@pytest.mark.parametrize("how", ["SIGTERM to the launcher", "SIGINT to its process group",
+                                 "SIGHUP to its process group"])
+def test_a_signal_to_the_launcher_stops_the_windows_station_cleanly_within_5_s(tmp_path, how) -> None:
+    """What systemd (SIGTERM to the main process) and a terminal (Ctrl+C, hang-up: the foreground process
+    group) send: the station under Wine saves its state, ends its DDE conversations and exits 0, and no
+    process of it is left."""
+    import signal
+    import time
+
+    from tests.windows.wine_session import session_members
+
+    sig = getattr(signal, how.split()[0])
+    state = tmp_path / "state.json"
+    config = write_station_config(tmp_path, elements=Path(winpath(ROOT / "tests" / "data" / "visual.txt")),
+                                  state_file=winpath(state))
+    station = start_station(config, 120, tmp_path / "station.log")
+    out, ready = tmp_path / "clients.json", tmp_path / "ready"
+    client = subprocess.Popen(
+        [str(WINE / "run"), "python", winpath(ROOT / "tests" / "windows" / "dde_clients.py"), "--clients", "2",
+         "--seconds", "2", "--poke", "SAT=694", "--wait-disconnect", "30", "--ready", winpath(ready),
+         "--out", winpath(out)],
+        cwd=ROOT, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        env={**os.environ, "NFW_WINE_TIMEOUT": "120"}, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 90
+        while not ready.exists():
+            assert client.poll() is None and station.poll() is None and time.monotonic() < deadline, \
+                (client.poll(), station.poll())
+            time.sleep(0.1)
+        if how.endswith("process group"):
+            os.killpg(station.pid, sig)
+        else:
+            station.send_signal(sig)
+        started = time.monotonic()
+        stdout, stderr = station.communicate(timeout=30)
+        took = time.monotonic() - started
+        client_out, _ = client.communicate(timeout=60)
+    finally:
+        for proc in (client, station):
+            kill_session(proc)
+    assert station.returncode == 0 and took < 5.0, (station.returncode, took, stderr[-3000:])
+    assert "Traceback" not in stderr
+    log = (tmp_path / "station.log").read_text(encoding="utf-8", errors="replace")
+    assert "control file" in log and log.rstrip().endswith("stopped"), log[-2000:]
+    assert '"satellite": 694' in state.read_text()  # the run-time choice survives the stop
+    results = json.loads(out.read_text())
+    assert len(results) == 2 and all(r["disconnected"] for r in results), (results, client_out[-2000:])
+    assert session_members(station.pid) == []
+    assert _station_processes(winpath(config)) == []

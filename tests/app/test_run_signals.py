@@ -1,0 +1,182 @@
+"""Real signals to a real ``python -m nfwserver run --headless``: SIGTERM and SIGINT stop it cleanly (state saved,
+EasyComm ``SA SE`` sent, exit 0), also during start-up and when repeated; SIGHUP reloads the configuration.
+
+The station runs with its configuration and state in the XDG directories of a temporary home (no
+``--config``: the configuration file is not watched, so only SIGHUP can make the station read it
+again), the TCP server on a free port and EasyComm on a real pseudo-terminal.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import DATA, ROOT
+from tests.easycomm.test_easycomm_pty import Pty
+from tests.hamlib_daemons import free_port
+
+pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+
+STOP_WITHIN_S = 5.0
+
+
+class Station:
+    """``nfwserver run --headless`` in a process of its own, configured through ``$XDG_CONFIG_HOME``."""
+
+    def __init__(self, home: Path, elements: Path = DATA / "visual.txt", extra: str = "") -> None:
+        self.home = home
+        self.elements = elements
+        self.port = free_port()
+        self.pty = Pty(home / "ttyUSB0")
+        self.config = home / "config" / "nfwserver" / "config.toml"
+        self.config.parent.mkdir(parents=True)
+        self.state = home / "state" / "nfwserver" / "state.json"
+        self.log = home / "nfw.log"
+        self.write_config(extra)
+        env = {**os.environ, "PYTHONPATH": str(ROOT), "XDG_CONFIG_HOME": str(home / "config"),
+               "XDG_STATE_HOME": str(home / "state")}
+        env.pop("NFW_CONTROL_FILE", None)
+        self.proc = subprocess.Popen([sys.executable, "-m", "nfwserver", "run", "--headless", "--log-file",
+                                      str(self.log)], cwd=ROOT, env=env, stdin=subprocess.DEVNULL,
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        self.stderr = ""
+
+    def write_config(self, extra: str = "") -> None:
+        self.config.write_text(
+            '[observer]\nlocation = "52.2053,0.1218,20"\n'
+            f'[elements]\nfiles = ["{self.elements}"]\nuse_bundled = false\nstore = "none"\n'
+            '[server]\nsatellite = 25544\ntune = true\ntrack = true\n'
+            f'[tcp]\nenabled = true\nport = {self.port}\n'
+            f'[easycomm]\nenabled = true\ndevice = "{self.pty.path}"\nrate_hz = 2\n{extra}')
+
+    def ask(self, line: str, timeout_s: float = 2.0) -> str:
+        """One line to the station's TCP port and its answer."""
+        with socket.create_connection(("127.0.0.1", self.port), timeout=timeout_s) as sock:
+            reader = sock.makefile("rb")
+            reader.readline()  # the greeting
+            sock.sendall(line.encode("ascii") + b"\r\n")
+            return reader.readline().decode("ascii").strip()
+
+    def status(self) -> dict[str, str]:
+        return dict(pair.split("=", 1) for pair in self.ask("STATUS").split(" "))
+
+    def wait_serving(self, timeout_s: float = 30.0) -> None:
+        deadline = time.monotonic() + timeout_s
+        while True:
+            assert self.proc.poll() is None, self.finish()
+            try:
+                if self.status().get("tune") == "on":
+                    return
+            except OSError:
+                pass
+            assert time.monotonic() < deadline, "the station never answered"
+            time.sleep(0.1)
+
+    def finish(self, timeout_s: float = STOP_WITHIN_S) -> str:
+        """Wait for the exit (killing the process if it overstays); stderr."""
+        try:
+            self.proc.wait(timeout_s)
+        finally:
+            if self.proc.poll() is None:
+                self.proc.kill()
+                self.proc.wait(10)
+            assert self.proc.stderr is not None
+            self.stderr += self.proc.stderr.read().decode("utf-8", "replace")
+        return self.stderr
+
+    def stop(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait(10)
+
+
+@pytest.fixture
+def station(tmp_path):
+    made: list[Station] = []
+
+    def make(**kw) -> Station:
+        made.append(Station(tmp_path, **kw))
+        return made[-1]
+
+    yield make
+    for st in made:
+        st.stop()
+
+
+def _until(predicate, timeout_s: float) -> bool:
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.05)
+    return True
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_sigterm_and_sigint_stop_the_station_cleanly_within_5_s(station, sig) -> None:
+    st = station()
+    st.wait_serving()
+    assert st.ask("SAT=694") == "OK"  # a run-time choice: the state file must keep it
+    assert _until(lambda: "694" in (st.state.read_text() if st.state.exists() else ""), 5.0)
+    st.pty.lines(0.5)  # what EasyComm wrote so far
+    st.proc.send_signal(sig)
+    started = time.monotonic()
+    err = st.finish()
+    took = time.monotonic() - started
+    assert st.proc.returncode == 0 and took < STOP_WITHIN_S, (st.proc.returncode, took, err)
+    assert "Traceback" not in err
+    assert '"satellite": 694' in st.state.read_text()
+    assert st.pty.lines() == ["SA SE"]  # written at shutdown: the rotor controller was told to stop
+    log = st.log.read_text()
+    assert f"{sig.name}: stopping" in log and log.rstrip().endswith("stopped")
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+@pytest.mark.parametrize("second_after_s", [0.0, 0.05])
+def test_signals_during_start_up_stop_the_station_once_started_without_a_traceback(station, sig,
+                                                                                    second_after_s) -> None:
+    """Two signals while 15,347 element sets load (Ctrl+C pressed twice): the station finishes starting,
+    stops cleanly and exits 0 (two signals sent at once may arrive as one)."""
+    st = station(elements=DATA / "active.txt")
+    assert st.proc.stderr is not None
+    first = st.proc.stderr.readline().decode()  # printed once the handlers are in place, before loading
+    assert first.startswith("nfwserver: logging to"), first
+    st.stderr = first
+    st.proc.send_signal(sig)
+    time.sleep(second_after_s)
+    st.proc.send_signal(sig)
+    err = st.finish(30.0)
+    assert st.proc.returncode == 0, err
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err
+    log = st.log.read_text()
+    assert "15347 satellites loaded" in log or "outputs:" in log
+    assert log.rstrip().endswith("stopped")
+
+
+def test_sighup_reloads_the_configuration_and_the_station_keeps_serving(station) -> None:
+    st = station()
+    st.wait_serving()
+    assert st.status()["name"] == "ISS"
+    st.write_config('[satellites]\nnames = { 25544 = "ZARYA" }\n')
+    st.proc.send_signal(signal.SIGHUP)
+    assert _until(lambda: st.status()["name"] == "ZARYA", 5.0), st.status()
+    # A half-written file on SIGHUP is refused: the running configuration stays, STATUS says why.
+    st.config.write_text("")
+    st.proc.send_signal(signal.SIGHUP)
+    assert _until(lambda: "config" in st.status()["faults"], 5.0), st.status()
+    assert st.status()["name"] == "ZARYA" and st.proc.poll() is None
+    st.write_config('[satellites]\nnames = { 25544 = "ZARYA" }\n')
+    st.proc.send_signal(signal.SIGHUP)
+    assert _until(lambda: "config" not in st.status()["faults"], 5.0), st.status()
+    st.proc.send_signal(signal.SIGTERM)
+    err = st.finish()
+    assert st.proc.returncode == 0 and "Traceback" not in err, err
+    log = st.log.read_text()
+    assert log.count("SIGHUP: reloading the configuration") == 3 and "configuration reloaded" in log

@@ -1,0 +1,117 @@
+"""The parts behind ``run``'s signal handling: real signals to this process through StationSignals, the control
+file, and a configuration read on request."""
+
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from nfwserver.app.config_watcher import ConfigWatcher
+from nfwserver.cli.control_file import ControlFile, control_path
+from nfwserver.cli.signals import RELOAD, STOP, StationSignals, signal_actions
+from nfwserver.clock import SystemClock
+
+
+def _until(predicate, timeout_s: float = 5.0) -> bool:
+    deadline = time.monotonic() + timeout_s
+    while not predicate() and time.monotonic() < deadline:
+        time.sleep(0.01)
+    return predicate()
+
+
+def test_sighup_reloads_when_headless_and_stops_under_the_console() -> None:
+    assert signal_actions(headless=True)[signal.SIGTERM] == STOP
+    assert signal_actions(headless=True)[signal.SIGINT] == STOP
+    if hasattr(signal, "SIGHUP"):
+        assert signal_actions(headless=True)[signal.SIGHUP] == RELOAD
+        assert signal_actions(headless=False)[signal.SIGHUP] == STOP
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_real_signals_become_one_stop_and_reloads_and_later_ones_are_only_noted(caplog) -> None:
+    saved = {sig: signal.getsignal(sig) for sig in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP)}
+    calls: list[str] = []
+    signals = StationSignals(signal_actions(headless=True), lambda: calls.append("stop"),
+                             lambda: calls.append("reload"))
+    try:
+        with caplog.at_level(logging.INFO, logger="nfwserver"):
+            assert signals.install()
+            os.kill(os.getpid(), signal.SIGHUP)
+            assert _until(lambda: calls == ["reload"])
+            os.kill(os.getpid(), signal.SIGTERM)
+            assert _until(lambda: calls == ["reload", "stop"])
+            os.kill(os.getpid(), signal.SIGINT)  # a second Ctrl+C while stopping: no KeyboardInterrupt
+            os.kill(os.getpid(), signal.SIGHUP)  # and no reload once stopping
+            assert _until(lambda: caplog.text.count("already stopping") == 2)
+            assert calls == ["reload", "stop"]
+            signals.close()
+            os.kill(os.getpid(), signal.SIGINT)  # after the run: ignored, the process exits cleanly
+            time.sleep(0.05)
+        assert "SIGHUP: reloading the configuration" in caplog.text and "SIGTERM: stopping" in caplog.text
+    finally:
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)
+
+
+def test_off_the_main_thread_nothing_is_installed() -> None:
+    result: list[bool] = []
+    signals = StationSignals(signal_actions(headless=True), lambda: None, lambda: None)
+    worker = threading.Thread(target=lambda: result.append(signals.install()))
+    worker.start()
+    worker.join()
+    signals.close()
+    assert result == [False]
+
+
+def test_the_control_file_asks_for_reload_and_stop_and_is_removed(tmp_path: Path, caplog) -> None:
+    path = tmp_path / "control"
+    assert control_path({"NFW_CONTROL_FILE": str(path)}) == path and control_path({}) is None
+    got: list[tuple[str, str]] = []
+    control = ControlFile(path, SystemClock(), lambda word, origin: got.append((word, origin)), interval_s=0.01)
+    path.write_text("stop\n")  # left by an earlier run: removed at start, never acted on
+    control.start()
+    try:
+        assert not path.exists()
+        path.write_text("")  # being written: left alone
+        time.sleep(0.05)
+        assert path.exists() and got == []
+        path.write_text("RELOAD\n")
+        assert _until(lambda: len(got) == 1) and not path.exists()
+        path.write_text("halt now\n")
+        assert _until(lambda: not path.exists())
+        assert "'halt' is not a request" in caplog.text
+        path.write_text("stop")
+        assert _until(lambda: len(got) == 2)
+    finally:
+        control.stop()
+    assert got == [("reload", f"control file {path}"), ("stop", f"control file {path}")]
+
+
+def test_a_requested_read_applies_the_file_even_when_it_looks_unchanged(tmp_path: Path) -> None:
+    path = tmp_path / "station.toml"
+    path.write_text('[server]\nsatellite = 25544\n')
+    applied: list[int | None] = []
+    refused: list[str] = []
+    watcher = ConfigWatcher(path, SystemClock(), lambda c: applied.append(c.server.satellite), refused.append,
+                            interval_s=None)
+    watcher.start()
+    try:
+        stat = path.stat()
+        path.write_text('[server]\nsatellite = 27607\n')  # same size, same time: a watcher sees no change
+        os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns))
+        time.sleep(0.05)
+        assert applied == []
+        watcher.request()
+        assert _until(lambda: applied == [27607])
+        path.write_text("# being saved\n")
+        watcher.request()
+        assert _until(lambda: len(refused) == 1) and applied == [27607]
+    finally:
+        watcher.stop()
