@@ -122,7 +122,7 @@ class FaultRig:
             f'[elements]\nfiles = ["{ELEMENTS}"]\nuse_bundled = false\nstore = "none"\n'
             f'[server]\nstate_file = "{self.state_path}"\nsatellite = {ISS}\ntune = true\ntrack = true\n'
             f'rate_hz = {RATE_HZ:g}\n'
-            '[tcp]\nenabled = true\nport = 0\n'
+            '[tcp]\nenabled = true\nport = 0\nallow = ["127.0.0.0/8"]\n'
             f'[rotor]\nbackend = "rotctld"\nport = {self.rotor_proxy.port}\ngeometry = "overlap-450"\n'
             f'[radio]\nenabled = true\nbackend = "rigctld"\nport = {self.radio_proxy.port}\n'
             f'[easycomm]\nenabled = true\ndevice = "{self.tty}"\n')

@@ -163,6 +163,63 @@ def _nothing(rig: FaultRig) -> None:
     return None
 
 
+#: connections of the slow-loris fault (one address, trickling bytes, never a whole line)
+_LORIS: list[socket.socket] = []
+
+
+def _slow_loris(rig: FaultRig) -> None:
+    """Forty connections from 127.0.0.1, each sending a byte now and then and never a line: more than the
+    per-address cap, so the later ones are refused with a line; the station's other clients must not notice."""
+    assert rig.station.tcp is not None
+    for _ in range(40):
+        s = socket.create_connection(rig.station.tcp.address, timeout=2.0)
+        s.sendall(b"S")
+        _LORIS.append(s)
+
+
+def _loris_gone(rig: FaultRig) -> None:
+    while _LORIS:
+        _LORIS.pop().close()
+
+
+def tcp_served(rig: FaultRig, record: TickRecord) -> bool:
+    """The feed publishes and a client from another address (127.0.0.2) is greeted and answered."""
+    if not record.published or rig.station.tcp is None or rig.index % 5:
+        return record.published
+    with socket.socket() as s:
+        s.bind(("127.0.0.2", 0))
+        s.settimeout(2.0)
+        s.connect(rig.station.tcp.address)
+        s.sendall(b"STATUS\r\n")
+        data = b""
+        while data.count(b"\r\n") < 2:
+            chunk = s.recv(65536)
+            if not chunk:
+                return False
+            data += chunk
+    return data.startswith(b"Hello") and b"satellite=" in data
+
+
+def _foreign_digits(rig: FaultRig) -> None:
+    """Pokes with other scripts' digits (SAT=², ANTAZ=٣) over TCP and DDE: refused, nothing else changes."""
+    assert rig.station.tcp is not None
+    with socket.create_connection(rig.station.tcp.address, timeout=2.0) as s:
+        s.sendall("SAT=²\r\nANTAZ=٣\r\nSAT=２５５４４\r\n".encode())
+        data = b""
+        while data.count(b"\r\n") < 4:
+            chunk = s.recv(65536)
+            if not chunk:
+                break
+            data += chunk
+    conv = rig.system.connect("NFW32", "NFW_DATA", client_name="digits")
+    for text in ("SAT=²", "ANTEL=١"):
+        try:
+            conv.poke("NFW_SERVER", text)
+        except Exception:  # refused (DDE_FNOTPROCESSED), as it must be
+            pass
+    conv.disconnect()
+
+
 FAULTS = (
     Fault("rotctld refuses every move (RPRT -1)", "rotor",
           lambda rig: rig.rotor_proxy.set_mode("refuse"), lambda rig: rig.rotor_proxy.set_mode("pass"), rotor_works,
@@ -188,6 +245,10 @@ FAULTS = (
     Fault("process stopped for 120 s (SIGSTOP/SIGCONT)", None, _stop_process, _nothing, feed_and_easycomm_current,
           duration_s=0.2),
     Fault("TCP lines of VT, FF and 0x1C-0x1F", None, _tcp_junk, _nothing, feed_works, duration_s=0.2),
+    Fault("TCP slow-loris: 40 connections from one address, never a line", None, _slow_loris, _loris_gone,
+          tcp_served, duration_s=10.0),
+    Fault("pokes with other scripts' digits (SAT=², ANTAZ=٣) over TCP and DDE", None, _foreign_digits, _nothing,
+          feed_works, duration_s=0.2),
 )
 
 

@@ -95,7 +95,7 @@ class Station:
             NovaTcpServer(self.core, config.tcp,
                           combined(device_status(self.rotor, self.radio, self.easycomm),
                                    elements_status(self.core.state, clock, config.elements.stale_days)),
-                          set_flip=self.rotor.set_flip_mode if self.rotor is not None else None)
+                          rotor=self.rotor)
             if config.tcp.enabled else None)
         self.web: WebServer | None = (
             WebServer(self.core, config.web, StationParts(self.rotor, self.radio, self.easycomm, self.tcp, self.nova,

@@ -189,6 +189,10 @@ COMMANDS: tuple[Command, ...] = (
     Command("FLIP", r"FLIP(?:\s+(\S+))?", "FLIP AUTO|ON|OFF", "FLIP AUTO|ON|OFF", "AUTO, ON or OFF",
             "FlipAnts' inverted (flip) tracking: forced on, off, or chosen per pass (auto)",
             "OK, or ERROR no rotor is configured", Face.TCP | Face.CONSOLE, Target.ROTOR, _flip_mode),
+    Command("PARK", r"PARK", "PARK", "PARK", "nothing after it",
+            "stop tracking (as TRACK OFF) and send the rotor to its park position ([rotor] park_azimuth_deg and "
+            "park_elevation_deg); TRACK ON resumes", "OK, or ERROR no rotor is configured",
+            Face.TCP | Face.CONSOLE, Target.ROTOR),
     Command("Z", r"Z", "Z", "Z", "nothing after it", "show times in UTC or in the local zone",
             "a note in the console", Face.CONSOLE, Target.DISPLAY),
 )

@@ -36,6 +36,7 @@ from textual.widgets import Footer, Input, RichLog, Static
 
 from nfwserver.commands.help_text import help_lines
 from nfwserver.commands.parsing import parse_line
+from nfwserver.commands.rotor_commands import NO_ROTOR, run_rotor_command
 from nfwserver.commands.table import CommandError, Face, Target
 from nfwserver.console.pass_view import STALE_DAYS, PassSearch, next_pass_text, pass_table, search_passes
 from nfwserver.console.picker import SatellitePicker
@@ -276,8 +277,8 @@ class NfwConsole(App[None]):
         try:
             parsed = parse_line(text, Face.CONSOLE)
         except CommandError as exc:  # the core records and explains station commands' refusals
-            if exc.command is not None and exc.command.target is Target.ROTOR:
-                self._set_flip("")
+            if exc.command is not None and exc.command.target is Target.ROTOR and self.rotor is None:
+                self._note(f"{NO_ROTOR} ([rotor] backend), so there is no rotor to command")
             elif exc.command is not None and exc.command.target is not Target.STATION:
                 self._note(str(exc), "red")
             else:
@@ -287,7 +288,9 @@ class NfwConsole(App[None]):
             if target is Target.DISPLAY:
                 self.action_toggle_zone()
             elif target is Target.ROTOR:
-                self._set_flip(str(parsed.value))
+                why = run_rotor_command(parsed, self.rotor, self.core, "console")
+                if why is not None:
+                    self._note(f"{why} ([rotor] backend), so there is no rotor to command")
             elif target is Target.SESSION:  # HELP
                 for line in help_lines(Face.CONSOLE):
                     self._note(line, "cyan")

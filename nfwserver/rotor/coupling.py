@@ -35,6 +35,7 @@ import logging
 import math
 import threading
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from datetime import datetime, timedelta
 
 from nfwserver.core.sample import TickSample
@@ -106,6 +107,8 @@ class RotorCoupling(TickWorker):
         # threads (TCP, console); never held across a call into the driver or the tracking engine.
         self._lock = threading.Lock()
         self._retry_asked = False  # an operator's action asked for a stalled rotor to be tried at once
+        self._park_asked = False  # PARK asked for; done at the next tick
+        self._parked = False  # parked by PARK: samples still marked tracking are not followed
         driver.table_load_listeners.append(self._table_loaded)
         driver.annunciator.listeners.append(self._announced)
 
@@ -141,6 +144,14 @@ class RotorCoupling(TickWorker):
             with self._lock:
                 self._replan = True
             self._event("autotracking enabled again")
+
+    def request_park(self) -> None:
+        """Send the rotor to its park position at its next tick (``PARK``; any thread may call this).  The
+        caller switches tracking off; samples still marked tracking that were computed before are not
+        followed, so the rotor stays parked until a later ``TRACK ON``."""
+        with self._lock:
+            self._park_asked = True
+        self._event("parking: tracking off, rotor to its park position")
 
     def set_flip_mode(self, mode: str) -> None:
         """``"auto"``, ``"on"`` or ``"off"`` from now on; a pass in progress is re-planned at the next tick.
@@ -215,13 +226,29 @@ class RotorCoupling(TickWorker):
                 az_k, el_k = flip(az, el) if plan.flipped else (az, el)
                 self.driver.set_target(azimuth_deg=az_k, elevation_deg=el_k)
 
+    def _park_now(self) -> None:
+        self.plan = None
+        self._sent = None
+        self._parked = True
+        self.driver.stop_parking_timer()
+        params = self.driver.parking_parameters()
+        self.driver.set_target(azimuth_deg=params.azimuth_deg, elevation_deg=params.elevation_deg)
+
     # -- per tick --------------------------------------------------------------------------
     def process(self, sample: TickSample) -> None:
         """One tick's work (the worker's step; tests call it directly)."""
         with self._lock:
             retry, self._retry_asked = self._retry_asked, False
+            park, self._park_asked = self._park_asked, False
         if retry:
             self.driver.retry_now()
+        if park:
+            self._park_now()
+        if self._parked:
+            if sample.tracking:  # computed before TRACK OFF reached the state: not followed
+                sample = replace(sample, tracking=False)
+            else:
+                self._parked = False  # from here on a TRACK ON is a new one
         if sample.tracking and not self._track_on_seen:
             self.resume()  # a new TRACK ON enables autotracking again
         self._track_on_seen = sample.tracking

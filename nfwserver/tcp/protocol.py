@@ -27,6 +27,7 @@ Nova's commands    ``TUNE ON|OFF``, ``TRACK ON|OFF``, ``SAT=n``, ``ANTAZ=deg``, 
 ``QUIT``           ``OK``, then the server closes the connection.
 ``FLIP AUTO|ON|OFF`` FlipAnts' inverted tracking forced on (function 7F), off (7E) or chosen per
                    pass; ``ERROR`` when the station has no rotor.
+``PARK``           ``TRACK OFF`` and the rotor to its park position; ``ERROR`` without a rotor.
 =================  ==========================================================================
 
 Keywords are accepted in any case with blanks around them.  An empty line outside ``WATCH`` gets
@@ -41,6 +42,7 @@ from dataclasses import dataclass
 
 from nfwserver.commands.help_text import help_lines
 from nfwserver.commands.parsing import clean_command_text, parse_line
+from nfwserver.commands.rotor_commands import RotorControl, run_rotor_command
 from nfwserver.commands.table import CommandError, Face, Target
 from nfwserver.core.events import Direction
 from nfwserver.core.nova_protocol import format_azimuth, format_elevation, format_range_rate
@@ -81,10 +83,10 @@ class NovaTcpProtocol:
     """Answers one line at a time for the station ``core``; ``extra`` adds STATUS fields."""
 
     def __init__(self, core: StationCore, extra: StatusFields | None = None,
-                 set_flip: Callable[[str], None] | None = None) -> None:
+                 rotor: RotorControl | None = None) -> None:
         self.core = core
         self.extra = extra
-        self.set_flip = set_flip  #: the rotor's flip-mode port (None without a rotor)
+        self.rotor = rotor  #: the rotor's command port (None without a rotor)
 
     def _record(self, peer: str, text: str, detail: str = "") -> None:
         self.core.events.add(self.core.clock.now(), Direction.IN, "request", text, client=peer, accepted=True,
@@ -99,7 +101,7 @@ class NovaTcpProtocol:
         try:
             parsed = parse_line(line, Face.TCP)
         except CommandError as exc:
-            if exc.command is not None and exc.command.target is Target.ROTOR and self.set_flip is None:
+            if exc.command is not None and exc.command.target is Target.ROTOR and self.rotor is None:
                 self._record(peer, clean_command_text(line))
                 return Reply(("ERROR no rotor is configured",))
             if exc.command is not None and exc.command.target is not Target.STATION:
@@ -111,10 +113,8 @@ class NovaTcpProtocol:
             return self._station(line, peer, rate_key)
         if entry.target is Target.ROTOR:
             self._record(peer, clean_command_text(line))
-            if self.set_flip is None:
-                return Reply(("ERROR no rotor is configured",))
-            self.set_flip(str(parsed.value))
-            return Reply(("OK",))
+            why = run_rotor_command(parsed, self.rotor, self.core, peer)
+            return Reply(("OK",) if why is None else (f"ERROR {why}",))
         return self._session(entry.word, peer)
 
     def _station(self, line: str, peer: str, rate_key: str | None) -> Reply:

@@ -38,6 +38,7 @@ import threading
 from collections import Counter, deque
 from collections.abc import Callable
 
+from nfwserver.commands.rotor_commands import RotorControl
 from nfwserver.config.schema import TcpConfig
 from nfwserver.core.events import Direction
 from nfwserver.core.sample import TickSample
@@ -67,10 +68,10 @@ class NovaTcpServer:
 
     def __init__(self, core: StationCore, config: TcpConfig, extra: StatusFields | None = None, *,
                  output_limit: int = DEFAULT_OUTPUT_LIMIT, send_buffer_bytes: int | None = None,
-                 max_clients: int | None = None, set_flip: Callable[[str], None] | None = None) -> None:
+                 max_clients: int | None = None, rotor: RotorControl | None = None) -> None:
         self.core = core
         self.config = config
-        self.protocol = NovaTcpProtocol(core, extra, set_flip)
+        self.protocol = NovaTcpProtocol(core, extra, rotor)
         self.output_limit = output_limit
         self.send_buffer_bytes = send_buffer_bytes
         self.max_clients = max_clients if max_clients is not None else config.max_clients

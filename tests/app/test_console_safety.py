@@ -144,7 +144,7 @@ def test_rotor_flip_state_events_and_the_flip_commands() -> None:
             await pilot.press(*"FLIP SIDEWAYS", "enter")
             await pilot.pause(0.3)
             assert rotor.flip_mode == "off"
-            assert "FLIP AUTO, FLIP ON or FLIP OFF" in " ".join(log_text(app, "incoming").split())
+            assert "FLIP needs AUTO, ON or OFF" in " ".join(log_text(app, "incoming").split())
 
     asyncio.run(scenario())
 

@@ -40,7 +40,7 @@ def test_help_over_tcp_is_one_line_per_command_then_ok(tcp_station, client) -> N
     assert lines[-1] == "OK"
     words = [line.split()[0].split("=")[0] for line in lines[:-1]]
     assert words == ["TUNE", "TRACK", "SAT", "ANTAZ", "ANTEL", "SUMMARY", "STATUS", "WATCH", "HELP", "QUIT",
-                     "FLIP"]
+                     "FLIP", "PARK"]
 
 
 def test_poke_help_lists_the_tcp_commands() -> None:
@@ -59,7 +59,15 @@ def test_flip_without_a_rotor_says_so_before_judging_the_argument(tcp_station, c
 def test_flip_with_a_rotor_checks_the_argument(tcp_station, client) -> None:
     _, server = tcp_station
     modes: list[str] = []
-    server.protocol.set_flip = modes.append
+
+    class Rotor:
+        def set_flip_mode(self, mode: str) -> None:
+            modes.append(mode)
+
+        def request_park(self) -> None:
+            modes.append("park")
+
+    server.protocol.rotor = Rotor()
     assert client.ask("FLIP sideways") == "ERROR FLIP needs AUTO, ON or OFF"
     assert client.ask("flip On") == "OK"
     assert modes == ["on"]

@@ -115,3 +115,34 @@ def test_daemon_killed_and_restarted_mid_pass() -> None:
         az, el = (float(v) for v in daemon.query("p", 2))
         assert -180 <= az <= 450 and 0 <= el <= 90
         assert target_el is not None and target_az is not None
+
+
+def test_park_stops_tracking_and_sends_the_rotor_to_its_park_position_until_track_on() -> None:
+    """``PARK`` (TCP and console, through the command table): TRACK OFF, the rotor to the park position,
+    and samples computed before TRACK OFF reached the state are not followed."""
+    from nfwserver.tcp import NovaTcpServer
+    from tests.tcp.conftest import LOOPBACK_ONLY, LineClient
+
+    geometry = RotorGeometry(-180.0, 450.0, 0.0, 90.0)
+    with HamlibDaemon("rotctld") as daemon:
+        clock, core, driver, coupling = _tracking(daemon, geometry, CROSSING.tca, max_lead_s=0.0)
+        assert driver.set_parking(0, 180, 10)
+        run_virtual(core, clock, 1.0)
+        target_el, target_az = driver.positions()[2:]
+        assert target_el is not None and target_el > 10  # following the satellite near its TCA
+        server = NovaTcpServer(core, LOOPBACK_ONLY, rotor=coupling)
+        server.start()
+        client = LineClient(server.address)
+        try:
+            client.read_line()
+            assert client.ask("PARK") == "OK"
+            assert not core.state.snapshot().tracking
+            coupling.process(core.tracker.last_sample)  # a sample still marked tracking, computed before
+            run_virtual(core, clock, 5.0)
+            assert driver.positions()[2:] == (10, 180) and driver.health.ok
+            assert client.ask("TRACK ON").startswith("OK")
+            run_virtual(core, clock, 1.0)
+            assert driver.positions()[2:] != (10, 180)  # following the satellite again
+        finally:
+            client.close()
+            server.stop()

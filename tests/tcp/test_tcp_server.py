@@ -207,7 +207,7 @@ def test_flip_sets_the_rotors_inverted_tracking_mode(tcp_station, client) -> Non
 
     assert client.ask("FLIP ON") == "ERROR no rotor is configured"  # this station has no rotor
     clock, core, _, _, coupling, _ = rotor_station(ISS_PASS.aos, RotorGeometry.preset("north-stop+flip"))
-    server = NovaTcpServer(core, LOOPBACK_ONLY, set_flip=coupling.set_flip_mode)
+    server = NovaTcpServer(core, LOOPBACK_ONLY, rotor=coupling)
     server.start()
     try:
         with_rotor = LineClient(server.address)

@@ -108,9 +108,12 @@ def test_control_requests_are_checked_whole_before_the_core_sees_them() -> None:
         assert status == 200 and core.state.catalog_number == 25544
         status, body = web.post({"command": "SAT=1", "token": TOKEN})
         assert status == 409 and "not in the catalog" in body["message"]
+        status, body = web.post({"command": "PARK", "token": TOKEN})  # a rotor command; this station has none
+        assert (status, body["message"]) == (409, "no rotor is configured")
         help_ = web.get("/api/help")
         assert [c["usage"] for c in help_["commands"]] == ["TUNE ON|OFF", "TRACK ON|OFF", "SAT=<catalog number>",
-                                                           "ANTAZ=<degrees>", "ANTEL=<degrees>"]
+                                                           "ANTAZ=<degrees>", "ANTEL=<degrees>",
+                                                           "FLIP AUTO|ON|OFF", "PARK"]
     finally:
         web.station.stop()
 
