@@ -232,7 +232,8 @@ FAULTS = (
     Fault("rigctld killed, restarted", "rigctld",
           lambda rig: rig.rigctld.kill(), lambda rig: rig.rigctld.restart(), radio_works),
     Fault("rigctld answers one byte at a time", "rigctld",
-          lambda rig: rig.radio_proxy.set_mode("trickle"), lambda rig: rig.radio_proxy.set_mode("pass"), radio_works),
+          lambda rig: rig.radio_proxy.set_mode("trickle"), lambda rig: rig.radio_proxy.set_mode("pass"), radio_works,
+          real_time=True),  # the reply deadline is real time: virtual seconds would not mean anything here
     Fault("EasyComm adapter unplugged, then plugged in again", "easycomm",
           lambda rig: rig.unplug_tty(), lambda rig: rig.plug_tty(), easycomm_works),
     Fault("selected set past decay (SGP4 error 6), then a fresh set", "tracking",
@@ -253,8 +254,12 @@ FAULTS = (
 
 
 def restore_baseline(rig: FaultRig) -> None:
-    """Between faults: ISS selected again (a fault may have changed it)."""
+    """Between faults: ISS selected again (a fault may have changed it); EasyComm lines written for the
+    satellite selected before are drained and the stale-line count starts afresh (it belongs to one fault)."""
     if rig.station.core.state.catalog_number != ISS:
         rig.station.core.select_satellite(ISS, source="campaign")
+        rig.tick()
+    rig.drain_tty()
+    rig.stale_easycomm = 0
 
 

@@ -85,7 +85,7 @@ class Station:
         self.core.rotor_configured = self.rotor is not None
         self.radio: RadioCoupling | None = make_radio(config.radio, self.core, clock)
         self.saver = (SessionSaver(self.state_file, config.server.satellite,
-                                   self.core.health.link("state-file", Backoff(1.0, 60.0)))
+                                   self.core.health.link("state-file", Backoff(0.2, 0.4)))
                       if self.state_file else None)
         self.easycomm: EasyCommOutput | None = (
             EasyCommOutput(config.easycomm, self.core.state, clock,

@@ -69,6 +69,7 @@ class KctRotorLink:
             self._card_absent = False
         except RotorUnavailable:
             self._card_absent = True
+            self.stall.lost_sight()  # an outage is not a stall: the no-movement timers restart on return
             return None
         except RotorError as exc:
             self._diagnostics.warning("read", "rotor position read failed: %s", exc)

@@ -59,6 +59,11 @@ class StallWatch:
         self._moved = [False, False]
         self._progress = [_Progress(), _Progress()]
 
+    def lost_sight(self) -> None:
+        """The rotor cannot be read (its daemon is away): time without a reading is not time without
+        movement, so the no-movement timers start afresh at the next reading."""
+        self._progress = [_Progress(), _Progress()]
+
     def forget_progress(self) -> None:
         """A move was refused: progress seen before it says nothing about the rotor now."""
         self.progressed = False
