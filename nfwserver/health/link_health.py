@@ -152,8 +152,8 @@ class LinkHealth:
             return
         self.recoveries += 1
         if self._announced:
-            self.logger.warning("%s: recovered after %.1f s (%d failures)", self.name,
-                                self.clock.monotonic() - old.since, old.failures)
+            count = f" ({old.failures} failure{'s' if old.failures != 1 else ''})" if old.failures else ""
+            self.logger.warning("%s: recovered after %.1f s%s", self.name, self.clock.monotonic() - old.since, count)
         self._changed()
 
     def retry_now(self) -> None:
