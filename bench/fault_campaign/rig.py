@@ -190,8 +190,15 @@ class FaultRig:
         deadline = time.monotonic() + 2.0
         while publisher.stats.ticks == before and time.monotonic() < deadline:
             time.sleep(0.0005)
-        time.sleep(0.003)  # let the device workers take the sample
         sample = self.station.core.tracker.last_sample
+        # Judge the devices once their workers have handled this tick (bounded: a worker held by a fault
+        # is judged as it is then).
+        workers = [w for w in (self.station.rotor, self.station.radio) if w is not None]
+        until = time.monotonic() + 0.3
+        while sample is not None and time.monotonic() < until and any(
+                w.processed_time is None or w.processed_time < sample.time for w in workers):
+            time.sleep(0.0005)
+        time.sleep(0.002)
         text = sample.text if sample is not None else ""
         got = any(i == self.index and t for i, t in self.received[-3:])
         assert self.station.tcp is not None

@@ -66,6 +66,7 @@ def rotor_works(rig: FaultRig, record: TickRecord) -> bool:
     driver sent it or closing on it (a restarted dummy rotctld starts at 0 degrees and slews back)."""
     rotor = rig.station.rotor
     if rotor is None or "rotor" in record.faults or "rotctld" in record.faults:
+        rig.rotor_distance = float("inf")  # the first reading after the fault counts as closing
         return False
     commanded = rotor.driver.commanded_position
     if commanded is None:

@@ -9,6 +9,7 @@ thread with the newest sample, skipping any that arrived while it was busy.
 from __future__ import annotations
 
 import logging
+from datetime import datetime
 
 from nfwserver.clock import Clock, SystemClock
 from nfwserver.core.sample import TickSample
@@ -28,6 +29,8 @@ class TickWorker(ServiceThread):
         self.warnings = RateLimitedLog(log, clock if clock is not None else SystemClock())
         super().__init__()
         self._pending: TickSample | None = None
+        #: the time of the newest sample fully processed (how far behind the ticks the device is)
+        self.processed_time: datetime | None = None
 
     def process(self, sample: TickSample) -> object:
         raise NotImplementedError
@@ -48,4 +51,5 @@ class TickWorker(ServiceThread):
                 except Exception:  # keep the worker alive whatever happens
                     self.warnings.log(logging.ERROR, "tick failed", "%s failed on a tick", self.thread_name,
                                       exc_info=True)
+                self.processed_time = sample.time
 

@@ -8,15 +8,15 @@ input.  So only complete, known commands are sent, and every reply is awaited wi
 
 When the daemon dies (EOF, broken pipe, refused connection) the connection is dropped and
 :class:`HamlibUnavailable` is raised at once; reconnection is attempted on a later call, no sooner
-than the back-off delay (doubling from ``backoff_initial_s`` to ``backoff_max_s``, 1.5 s by default so a
-returning daemon is found again within 2 s; measured on the
-injected clock), so a dead daemon never stalls the caller.  The connection's state is one
+than the back-off delay (doubling from ``backoff_initial_s`` to ``backoff_max_s``; measured on the injected
+clock; the station uses 0.2 s then 0.4 s), so a dead daemon never stalls the caller.  The connection's state is one
 :class:`~nfwserver.health.LinkHealth` (the station puts it on its board as ``rotctld``/``rigctld``):
 failing while the daemon cannot be reached or answers nonsense, cleared by the first whole reply.
 
 Every reply must arrive whole within ``reply_deadline_s`` real seconds (a daemon that trickles one
 byte at a time, each within the per-read timeout, would otherwise hold the caller for hours); past
-it the connection is dropped as for a dead daemon.
+it the connection is dropped as for a dead daemon.  A reply that arrives but took longer than
+:data:`SLOW_REPLY_S` keeps the link failing ("answers slowly") until a prompt one.
 
 A reply that makes no sense (a line over :data:`MAX_LINE_BYTES`, a value where ``RPRT`` was due, no
 value where one was due, or a value the backend finds non-finite or out of range and reports with
@@ -44,6 +44,9 @@ log = logging.getLogger(__name__)
 MAX_LINE_BYTES = 65536
 #: A whole reply must arrive within this many real seconds (rigctld behind a slow serial radio: ~0.3 s).
 REPLY_DEADLINE_S = 2.0
+#: A reply slower than this (real seconds) is answered but keeps the link failing ("answers slowly"): a daemon
+#: that trickles its replies must not look healthy between the ones that miss the deadline.
+SLOW_REPLY_S = 1.0
 
 
 class HamlibError(Exception):
@@ -121,6 +124,15 @@ class HamlibConnection:
         self.health.retry_now()
         return HamlibError(f"{self.name}: {why}")
 
+    def _answered(self, command: str, sent_at: float) -> None:
+        """A whole reply: the link is well unless it took longer than :data:`SLOW_REPLY_S`."""
+        took = time.monotonic() - sent_at
+        if took > SLOW_REPLY_S:
+            self.health.failed(f"{self.name} at {self.host}:{self.port} answers slowly ({took:.1f} s for "
+                               f"'{command.split()[0]}')", attempt=False)
+        else:
+            self.health.succeeded()
+
     def _read_line(self, sock: socket.socket, deadline: float) -> str:
         while b"\n" not in self._buffer:
             remaining = deadline - time.monotonic()
@@ -150,7 +162,8 @@ class HamlibConnection:
         if "\n" in command or "\r" in command:
             raise ValueError("a Hamlib command is one line")
         sock = self._connect()
-        deadline = time.monotonic() + self.reply_deadline_s
+        sent_at = time.monotonic()
+        deadline = sent_at + self.reply_deadline_s
         try:
             sock.sendall(command.encode("ascii") + b"\n")
             first = self._read_line(sock, deadline)
@@ -161,16 +174,16 @@ class HamlibConnection:
                 except ValueError:
                     raise self.fault(f"{first[:40]!r} is not an RPRT line") from None
                 if code < 0:
-                    self.health.succeeded()  # the daemon answered: reachable, whatever the device says
+                    self._answered(command, sent_at)  # the daemon answered: reachable, whatever the device says
                     raise HamlibError(f"{self.name}: '{command}' failed: {describe_rprt(code)} (RPRT {code})", code)
                 if reply_lines:
                     raise self.fault(f"{first!r} instead of a value to '{command}'")
-                self.health.succeeded()
+                self._answered(command, sent_at)
                 return []
             if reply_lines == 0:
                 raise self.fault(f"unexpected reply {first[:40]!r} to '{command}'")
             lines = [first] + [self._read_line(sock, deadline) for _ in range(reply_lines - 1)]
-            self.health.succeeded()
+            self._answered(command, sent_at)
             return lines
         except HamlibError:
             raise

@@ -77,3 +77,23 @@ def test_a_trickled_reply_is_cut_at_the_deadline_and_the_link_heals(peer: Trickl
     clock.advance(2.0)  # past the back-off
     assert conn.call(GET_POSITION) == ["180.000000", "45.000000"]
     assert conn.health.ok
+
+
+def test_a_reply_that_arrives_slowly_keeps_the_link_failing_until_a_prompt_one(monkeypatch) -> None:
+    """A daemon whose replies make the deadline but only just (the campaign's trickling rigctld: a set's
+    ``RPRT 0`` in 1.8 s of a 2 s deadline) looked healthy between the replies that missed it, while the
+    radio lagged: STATUS did not explain those ticks.  A reply slower than SLOW_REPLY_S is now a symptom."""
+    import nfwserver.hamlib.connection as connection
+
+    monkeypatch.setattr(connection, "SLOW_REPLY_S", 0.3)  # the peer takes 0.1 s a byte: 2.2 s a reply
+    slow = TricklingPeer(delay_s=0.02)  # 22 bytes: 0.44 s, within the deadline, over SLOW_REPLY_S
+    try:
+        clock = VirtualClock(datetime(2026, 5, 8, tzinfo=timezone.utc))
+        conn = HamlibConnection("127.0.0.1", slow.port, clock, name="rigctld", timeout_s=1.0, reply_deadline_s=2.0)
+        assert conn.call(GET_POSITION) == ["180.000000", "45.000000"]  # answered, so the value is used
+        assert not conn.health.ok and "answers slowly" in conn.health.describe()
+        slow.trickle.clear()
+        assert conn.call(GET_POSITION) == ["180.000000", "45.000000"]
+        assert conn.health.ok
+    finally:
+        slow.close()
