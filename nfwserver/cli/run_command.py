@@ -201,7 +201,7 @@ def serve(config: Any, plan: RunPlan, watch: str | None = None) -> int:
             station.start()
         except OSError as exc:
             station.stop()
-            raise CliError(f"cannot start the station: {exc}") from None
+            raise CliError(f"cannot start the station: {exc.strerror or exc}") from None
         requests.station = station
         try:
             file_handler = _serve_started(station, config, plan, watch, requests, file_handler)
