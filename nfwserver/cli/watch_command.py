@@ -9,13 +9,14 @@ the exact Nova string, and a poll cannot fall behind (a WATCH stream at 20 Hz wo
 On a terminal the status block is redrawn in place (``rich.live``); otherwise one plain line per update;
 ``--json`` prints one JSON object per update (:meth:`WatchUpdate.to_json`).  When the station does not answer
 the view says so ("not reachable yet" before the first answer, "lost" after) and tries again after 1, 2, 4,
-then every 8 seconds; Ctrl+C stops it (exit 0).  ``--count N`` stops after N answers (scripts, tests).
+then every 8 seconds; Ctrl+C or SIGTERM stops it (exit 0).  ``--count N`` stops after N answers (scripts, tests).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import signal
 import sys
 import threading
 from collections.abc import Callable
@@ -101,10 +102,36 @@ def _plain_printer(out: TextIO) -> Callable[[WatchUpdate], None]:
     return show
 
 
+class _Terminated(Exception):
+    """SIGTERM: leave the view as Ctrl+C does."""
+
+
+def _terminated(signum: int, frame: object) -> None:
+    raise _Terminated
+
+
+def _stop_on_signals() -> Callable[[], None]:
+    """Make Ctrl+C (SIGINT) and SIGTERM end the view cleanly, even when SIGINT was inherited as ignored (a
+    process started from a script or a service); returns what puts the previous handlers back.  Only on the
+    main thread, where Python runs signal handlers."""
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+    saved = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.signal(signal.SIGTERM, _terminated)
+
+    def restore() -> None:
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)
+
+    return restore
+
+
 def run(args: argparse.Namespace) -> int:
     host, port = station_address(args)
     count = int(args.count) if args.count is not None else None
     stop = threading.Event()
+    restore = _stop_on_signals()
     try:
         if args.json or not sys.stdout.isatty():
             show = _json_printer(sys.stdout) if args.json else _plain_printer(sys.stdout)
@@ -112,10 +139,12 @@ def run(args: argparse.Namespace) -> int:
                            stop=stop).run(count)
         else:
             _run_live(host, port, args, count, stop)
-    except KeyboardInterrupt:  # Ctrl+C: the normal way to leave a live view
+    except (KeyboardInterrupt, _Terminated):  # Ctrl+C: the normal way to leave a live view
         stop.set()
     except BrokenPipeError:  # the reader went away (e.g. piped into head)
         sys.stderr.close()
+    finally:
+        restore()
     return 0
 
 

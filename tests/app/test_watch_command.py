@@ -14,6 +14,8 @@ import time
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
+import pytest
+
 from nfwserver.app.station import Station
 from nfwserver.cli import main
 from nfwserver.cli.watch_command import StationWatcher
@@ -150,18 +152,21 @@ def test_poke_watch_points_at_nfwserver_watch(capsys) -> None:
     assert "`nfwserver watch`" in capsys.readouterr().err
 
 
-def test_watch_stops_cleanly_on_ctrl_c(tmp_path) -> None:
-    """A real SIGINT while the view waits for a station ends it with exit code 0 and no traceback."""
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_watch_stops_cleanly_on_ctrl_c_and_sigterm(tmp_path, sig) -> None:
+    """A real SIGINT (Ctrl+C) or SIGTERM while the view waits for a station: exit code 0, no traceback."""
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     closed = socket.socket()  # bound, never listening: its port refuses connections and no other test can take it
     closed.bind(("127.0.0.1", 0))
     port = closed.getsockname()[1]
+    # started with SIGINT ignored, as a background job of a script would be: the view must still stop on it
     proc = subprocess.Popen([sys.executable, "-m", "nfwserver", "watch", "--port", str(port), "--json"],
-                            cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
     try:
         first = json.loads(proc.stdout.readline())  # the first attempt failed: it is waiting to retry
         assert first["connected"] is False and first["ever_connected"] is False and first["retry_s"] == 1.0
-        proc.send_signal(signal.SIGINT)
+        proc.send_signal(sig)
         assert proc.wait(10) == 0
         assert "Traceback" not in proc.stderr.read()
     finally:
