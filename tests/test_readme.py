@@ -5,12 +5,15 @@ from __future__ import annotations
 import os
 import re
 import shlex
+import signal
 import stat
 import subprocess
+from pathlib import Path
 
 import pytest
 
 from nfwserver.cli import main
+from tests.app.test_element_presets import provider  # noqa: F401 - a fixture
 from tests.conftest import ROOT
 
 README = (ROOT / "README.md").read_text(encoding="utf-8")
@@ -78,3 +81,77 @@ def test_the_tcp_and_easycomm_examples_are_valid_configuration() -> None:
     assert config.server.satellite == 25544 and config.server.tune and config.server.track
     assert config.easycomm.enabled and config.easycomm.rate_hz == 2 and config.easycomm.uplink == "range-rate"
     assert f"$ nc 127.0.0.1 8090\n{GREETING}\n" in section
+
+
+def _journey() -> list[str]:
+    """The commands of the README's journey block, comments removed, in order."""
+    return [line.split("  #", 1)[0].strip() for line in _block_after("## Your station, from install").splitlines()
+            if line.strip()]
+
+
+def test_the_journey_is_on_the_first_screen_after_the_two_newcomer_commands() -> None:
+    first_screen = "\n".join(README.splitlines()[:45])
+    assert "pip install . && nfwserver run" in first_screen and "nfwserver elements update" in first_screen
+    assert first_screen.index("pip install . && nfwserver run") < first_screen.index("## Your station")
+    assert "nfwserver watch" in first_screen
+    assert [c.split()[:3] for c in _journey()] == [
+        ["pip", "install", "."], ["nfwserver", "config", "init"], ["nfwserver", "elements", "update"],
+        ["nfwserver", "passes"], ["nfwserver", "config", "set"], ["nfwserver", "run"], ["nfwserver", "watch"]]
+
+
+def test_the_journey_runs_as_written(provider, tmp_path, capsys) -> None:  # noqa: F811 - the imported fixture
+    """Each command of the journey, in order, on a fresh user (private configuration and data directories), with
+    the element presets pointed at a local HTTP server and the TCP port at a free one."""
+    from nfwserver.config import load_config
+    from tests.hamlib_daemons import free_port
+
+    base, state = provider
+    commands = _journey()
+    assert commands[0] == "pip install ."  # the package under test is installed already
+    station = None
+    try:
+        for command in commands[1:]:
+            argv = shlex.split(command)[1:]
+            if argv[:2] == ["elements", "update"]:  # offline here: the presets' host is the local server
+                assert main(["config", "set", "elements.preset_mirror", base]) == 0
+            if argv[0] == "run":
+                station = _start_station(argv)
+                continue
+            if argv[0] == "watch":
+                argv += ["--count", "2", "--interval", "0.1"]  # a script's way to stop it
+            capsys.readouterr()
+            assert main(argv) == 0, (command, capsys.readouterr().err)
+            out = capsys.readouterr().out
+            if argv[:2] == ["config", "init"]:
+                config = load_config()
+                assert config.observer_configured and config.path is not None
+                assert 'location = "JO01ab"' in Path(config.path).read_text()
+            if argv[:2] == ["elements", "update"]:
+                assert state.requests == ["/gp.php?GROUP=amateur&FORMAT=tle"]
+            if argv[0] == "passes":
+                assert out.startswith("sat ") and "aos (UTC)" in out.splitlines()[0] and len(out.splitlines()) > 3, out
+            if argv[:3] == ["config", "set", "tcp.enabled"]:
+                assert main(["config", "set", "tcp.port", str(free_port())]) == 0  # 8090 may be taken here
+            if argv[0] == "watch":
+                lines = out.splitlines()
+                assert len(lines) == 2 and all("tune=" in line and "status=0x" in line for line in lines), out
+    finally:
+        if station is not None:
+            station.send_signal(signal.SIGTERM)
+            assert station.wait(15) == 0
+    assert station is not None
+
+
+def _start_station(argv: list[str]) -> subprocess.Popen[bytes]:
+    """``nfwserver run`` as a process of its own (headless: its stdout is not a terminal), answering on TCP."""
+    import sys
+    import time
+
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen([sys.executable, "-m", "nfwserver", *argv], cwd=ROOT, env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 30.0
+    while main(["status", "--timeout", "1"]) != 0:
+        assert proc.poll() is None and time.monotonic() < deadline, proc.stderr.read() if proc.stderr else ""
+        time.sleep(0.2)
+    return proc

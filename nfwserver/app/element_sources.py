@@ -162,8 +162,9 @@ def parse_source(data: bytes, source: str, limits: SourceLimits = SourceLimits()
     if len(loaded.sets) > limits.max_sets:
         raise limits.too_many(source)
     if not loaded.sets:
-        why = f" (first problem: line {loaded.rejected[0].line_number}: {loaded.rejected[0].reason})" \
-            if loaded.rejected else ""
+        first = loaded.rejected[0] if loaded.rejected else None
+        at = f"line {first.line_number}: " if first is not None and first.line_number > 0 else ""
+        why = f" (first problem: {at}{first.reason})" if first is not None else ""
         raise SourceError(f"{source} holds no element sets{why}")
     return loaded
 

@@ -25,11 +25,32 @@ from nfwserver.cli.arguments import COMMANDS, command_word, join_negative_values
 COMMAND_MODULES: tuple[str, ...] = tuple(dict.fromkeys(module for _, module, _ in COMMANDS))
 
 
-__all__ = ["CliError", "build_parser", "main"]
+__all__ = ["CliError", "TerminalFormatter", "build_parser", "main", "say"]
 
 
 class CliError(Exception):
     """A runtime problem to report in one sentence (exit code 1)."""
+
+
+class TerminalFormatter(logging.Formatter):
+    """Log records on the terminal as the command's other diagnostics: ``nfwserver: warning: <message>`` (the
+    logger's name too with ``with_names``, for ``-vv``).  The handler writes each record whole, in one write, so
+    records from the station's threads never run into each other or into :func:`say`'s lines."""
+
+    def __init__(self, with_names: bool = False) -> None:
+        super().__init__()
+        self.with_names = with_names
+
+    def format(self, record: logging.LogRecord) -> str:
+        text = super().format(record)
+        where = f" ({record.name})" if self.with_names else ""
+        return f"nfwserver: {record.levelname.lower()}{where}: {text}"
+
+
+def say(text: str) -> None:
+    """One diagnostic line on stderr, ``nfwserver: <text>``, in a single write (threads may be logging)."""
+    sys.stderr.write(f"nfwserver: {text}\n")
+    sys.stderr.flush()
 
 
 def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
@@ -61,11 +82,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     args_list = join_negative_values(list(sys.argv[1:] if argv is None else argv))
     parser = build_parser(args_list)
     args = parser.parse_args(args_list)
-    logging.basicConfig(
-        level=logging.WARNING - 10 * min(args.verbose, 2),
-        format="%(levelname)s %(name)s: %(message)s",
-        stream=sys.stderr,
-    )
+    terminal = logging.StreamHandler(sys.stderr)
+    terminal.setFormatter(TerminalFormatter(with_names=args.verbose >= 2))
+    logging.basicConfig(level=logging.WARNING - 10 * min(args.verbose, 2), handlers=[terminal])
     func = getattr(args, "func", None)
     if func is None:
         parser.print_help(sys.stderr)

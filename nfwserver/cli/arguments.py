@@ -28,6 +28,7 @@ COMMANDS: tuple[tuple[str, str, str], ...] = (
     ("config", "config_command", "configuration file: path, init, show"),
     ("poke", "control_command", "send a Nova command to the running station (TCP)"),
     ("status", "control_command", "one line of the running station's state (TCP)"),
+    ("watch", "watch_command", "live view of the running station (TCP)"),
 )
 
 #: Top-level options that take no value (so the word after them is not their argument).

@@ -2,8 +2,8 @@
 
 Host and port come from the configuration's ``[tcp]`` section (``--config`` honoured; ``--host`` and
 ``--port`` override), so a second terminal or a cron job can switch a headless station:
-``nfwserver poke "TRACK ON"``.  The reply goes to stdout; ``ERROR ...`` replies and an unreachable
-station are one sentence on stderr with exit code 1.
+``nfwserver poke "TRACK ON"`` (``nfwserver watch``, :mod:`nfwserver.cli.watch_command`, shows it live).
+The reply goes to stdout; ``ERROR ...`` replies and an unreachable station are one sentence on stderr with exit code 1.
 """
 
 from __future__ import annotations
@@ -13,7 +13,8 @@ import argparse
 from nfwserver.cli.arguments import number_in
 
 
-def _common(p: argparse.ArgumentParser) -> None:
+def add_station_options(p: argparse.ArgumentParser) -> None:
+    """``--config``, ``--host``, ``--port`` and ``--timeout``: where the station is (``[tcp]``) and how long to wait."""
     p.add_argument("--config", metavar="FILE", help="configuration file giving [tcp] host and port")
     p.add_argument("--host", help="station address (default: [tcp] host, loopback for a wildcard)")
     p.add_argument("--port", type=number_in(1, 65535, integer=True), help="station TCP port (default: [tcp] port)")
@@ -29,25 +30,32 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
         description="Send one command to the running station over its TCP port and print the reply.",
         epilog=poke_epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("text", help='the command, e.g. "TRACK ON"')
-    _common(p)
+    add_station_options(p)
     p.set_defaults(func=poke)
     s = subparsers.add_parser("status", help="one line of the running station's state (TCP)",
                               description="Print the running station's STATUS line (key=value pairs).")
-    _common(s)
+    add_station_options(s)
     s.set_defaults(func=status)
 
 
-def _ask(args: argparse.Namespace, line: str, until: str | None = None) -> str:
+def station_address(args: argparse.Namespace) -> tuple[str, int]:
+    """Host and port of the station: ``--host``/``--port``, else the configuration's ``[tcp]``."""
     from nfwserver.cli import CliError
     from nfwserver.config import ConfigError, load_config
-    from nfwserver.tcp.client import StationUnreachable, ask, connect_host
+    from nfwserver.tcp.client import connect_host
 
     try:
         config = load_config(args.config)
     except ConfigError as exc:
         raise CliError(f"configuration refused: {exc}") from None
-    host = args.host or connect_host(config.tcp.host)
-    port = int(args.port or config.tcp.port)
+    return args.host or connect_host(config.tcp.host), int(args.port or config.tcp.port)
+
+
+def _ask(args: argparse.Namespace, line: str, until: str | None = None) -> str:
+    from nfwserver.cli import CliError
+    from nfwserver.tcp.client import StationUnreachable, ask
+
+    host, port = station_address(args)
     try:
         return ask(host, port, line, args.timeout, until)
     except StationUnreachable as exc:
@@ -66,8 +74,8 @@ def poke(args: argparse.Namespace) -> int:
         return 2
     word = text.split()[0].upper()
     if word == "WATCH":
-        print("nfwserver poke: WATCH streams until stopped; connect a TCP client to the port (e.g. nc 127.0.0.1 8090)",
-              file=sys.stderr)
+        print("nfwserver poke: WATCH streams until stopped: `nfwserver watch` shows the station live "
+              "(`nfwserver watch --json` for scripts)", file=sys.stderr)
         return 2
     reply = _ask(args, text, until="OK" if word == "HELP" else None)
     if reply.startswith("ERROR"):

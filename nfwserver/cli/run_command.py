@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from nfwserver.cli import say
 from nfwserver.cli.control_file import ControlFile, control_path
 from nfwserver.cli.signals import StationSignals, signal_actions
 from nfwserver.cli.station_runner import run_console, serve_headless, start_report
@@ -193,7 +194,7 @@ def serve(config: Any, plan: RunPlan, watch: str | None = None) -> int:
     try:
         if not plan.console:
             file_handler = _log_to_file(plan.log_file, clock)
-            print(f"nfwserver: logging to {plan.log_file}", file=sys.stderr)
+            say(f"logging to {plan.log_file}")
         station = Station(config, clock, transport=plan.transport)
         if file_handler is not None:
             file_handler.attach(station.core.health.link("log-file", LOG_BACKOFF))
@@ -201,7 +202,7 @@ def serve(config: Any, plan: RunPlan, watch: str | None = None) -> int:
             station.start()
         except OSError as exc:
             station.stop()
-            raise CliError(f"cannot start the station: {exc}") from None
+            raise CliError(f"cannot start the station: {exc.strerror or exc}") from None
         requests.station = station
         try:
             file_handler = _serve_started(station, config, plan, watch, requests, file_handler)
@@ -249,11 +250,11 @@ def _serve_started(station: Any, config: Any, plan: RunPlan, watch: str | None, 
         file_handler = _log_to_file(plan.log_file, clock)
         file_handler.attach(station.core.health.link("log-file", LOG_BACKOFF))
         log.error("the console stopped: %s: %s", type(failure).__name__, failure, exc_info=failure)
-        print(f"nfwserver: the console failed ({type(failure).__name__}: {failure}); the station keeps "
-              f"serving without it, logging to {plan.log_file}; stop it with Ctrl+C.", file=sys.stderr)
+        say(f"the console failed ({type(failure).__name__}: {failure}); the station keeps serving without it, "
+            f"logging to {plan.log_file}; stop it with Ctrl+C.")
     elif not plan.console:
         for note in notes:
-            print(f"nfwserver: {note}", file=sys.stderr)
+            say(note)
             log.info(note)
     for line in start_report(station):
         log.info(line)

@@ -7,7 +7,10 @@ for.  With ``--client`` (:mod:`nfwserver.cli.simulated_clients`) each transactio
 ``<time><TAB><kind><TAB><text>``, kind ``data``, ``notify``, ``reply`` or ``poke`` (``(empty)`` for an
 empty string).  ``--link`` watches any served item, the Orbitron, WXtrack and SatPC32 dialects
 included.  Pokes are scheduled with ``--poke 120:SAT=25544`` (sent 120 s in); ``TUNE ON`` is poked
-at the start only when no ``--poke`` holds a TUNE command.  The dialects take no pokes (their
+at the start unless the first TUNE command among the ``--poke`` options is ``TUNE ON`` or is sent at
+0 s (so ``--poke 60:"TUNE OFF"`` shows the feed stopping, and ``--poke 30:"TUNE ON"`` what a client
+gets before it).  Each ``--poke`` is checked with the command table as a DDE client's poke, and what
+it did is said on stderr (:mod:`nfwserver.cli.simulate_pokes`).  The dialects take no pokes (their
 clients never send any), so on a dialect link the commands go to the server directly.
 """
 
@@ -18,9 +21,11 @@ import logging
 import sys
 
 from nfwserver.cli.arguments import number_in, satellite_value, time_value
+from nfwserver.cli.simulate_pokes import MAX_DURATION_S, observe_poke, poke_value
 from nfwserver.cli.simulated_clients import CLIENTS, Link, SimulatedClient, parse_link
 from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs
 from nfwserver.clock import VirtualClock
+from nfwserver.commands.table import Face
 from nfwserver.core.publisher import run_virtual
 from nfwserver.core.state import MAX_RATE_HZ, MIN_RATE_HZ
 from nfwserver.core.station_core import StationCore
@@ -31,24 +36,8 @@ from nfwserver.dialects.satpc32 import SATPC32
 from nfwserver.dialects.wxtrack import WXTRACK
 from nfwserver.fake_dde import DdeError, FakeDdeSystem
 
-MAX_DURATION_S = 30 * 86400.0
 NOVA_LINK = Link("NFW32", "NFW_DATA", "NFW_SERVER")
 DIALECTS = {d.service.upper(): d for d in (ORBITRON, WXTRACK, SATPC32)}
-
-
-def poke_value(text: str) -> tuple[float, str]:
-    """``type=`` for ``--poke``: ``[SECONDS:]COMMAND`` with a non-negative offset."""
-    offset, sep, command = text.partition(":")
-    if not sep:
-        offset, command = "0", text
-    try:
-        seconds = float(offset)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: the offset before ':' must be seconds, e.g. 120:SAT=25544"
-                                         ) from None
-    if not 0 <= seconds <= MAX_DURATION_S or not command.strip():
-        raise argparse.ArgumentTypeError(f"{text!r}: give a command after an offset of 0 to {MAX_DURATION_S:.0f} s")
-    return seconds, command.strip()
 
 
 def link_value(text: str) -> Link:
@@ -63,8 +52,10 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
         "simulate", help="show what a DDE client receives, on virtual time",
         description="Run the server on the in-process DDE transport under a virtual clock with one client "
         "playing a real client's transaction pattern, and print what it receives. Defaults: the configured "
-        "observer, catalog and satellite, from now. TUNE ON is poked at the start unless a --poke holds a "
-        "TUNE command (so you can see what a client gets before TUNE ON).")
+        "observer, catalog and satellite, from now. TUNE ON is poked at the start unless the first TUNE "
+        "command among the --poke options is TUNE ON or is sent at 0 s (so you can see what a client gets before "
+        "TUNE ON). What each "
+        "--poke did is printed on stderr.")
     add_tracking_options(p, output_format=False)
     p.add_argument("--start", type=time_value, default="now",
                    help="'now' (default), relative (+2h, -30m) or ISO-8601 (UTC when no zone is given)")
@@ -75,8 +66,9 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     p.add_argument("--sat", type=satellite_value, metavar="CATNR|NAME",
                    help="initial AutoTracking satellite (default: [server] satellite)")
     p.add_argument("--poke", type=poke_value, action="append", default=[], metavar="[SECONDS:]COMMAND",
-                   help="poke sent by the client at that offset (default 0); repeatable. A TUNE command here "
-                        "replaces the automatic TUNE ON at the start")
+                   help="poke sent by the client at that offset (default 0), one of Nova's commands as a DDE client "
+                        "sends it; repeatable; what it did is printed on stderr. A first TUNE command that is "
+                        "TUNE ON, or is sent at 0 s, replaces the automatic TUNE ON at the start")
     p.add_argument("--client", choices=CLIENTS, default="hot",
                    help="transaction pattern: hot (hot advise, default), warm (warm advise), wisp (poke, request "
                         "every --poll s, re-poke when AH: is missing), delphi (warm link + request per "
@@ -90,8 +82,12 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     p.set_defaults(func=run, usage_error=p.error)
 
 
-def _has_tune(pokes: list[tuple[float, str]]) -> bool:
-    return any(command.upper().split()[:1] == ["TUNE"] for _, command in pokes)
+def _client_tunes(pokes: list[tuple[float, str]]) -> bool:
+    """True when the first TUNE command among ``pokes`` (sorted by offset) is TUNE ON or is sent at the start:
+    the user then decides when the feed starts, and no TUNE ON is poked for them."""
+    tunes = [(offset, command.upper().split()) for offset, command in pokes
+             if command.upper().split()[:1] == ["TUNE"]]
+    return bool(tunes) and (tunes[0][1][1:] == ["ON"] or tunes[0][0] == 0)
 
 
 def _has_sat(pokes: list[tuple[float, str]]) -> float | None:
@@ -128,13 +124,12 @@ def run(args: argparse.Namespace) -> int:
         elif sat_poke > 0:
             print(f"nfwserver: no satellite until the SAT= poke at {sat_poke:g} s: nothing is published before it",
                   file=sys.stderr)
-    if not _has_tune(pokes):
-        pokes.insert(0, (0.0, "TUNE ON"))
-    return _simulate(args, server, clock, pokes)
+    auto_tune = not _client_tunes(pokes)
+    return _simulate(args, server, clock, pokes, auto_tune)
 
 
 def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock,
-              pokes: list[tuple[float, str]]) -> int:
+              pokes: list[tuple[float, str]], auto_tune: bool) -> int:
     # Refusals are reported below with their time; keep the core's own warning out of the way
     # (restored on the way out: the logger is shared with anything else in this process).
     core_log = logging.getLogger("nfwserver.core.station_core")
@@ -157,11 +152,6 @@ def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock
         elif kind == "data":
             lines.append(f"{format_time(when)}\t{text}\n")
 
-    def refused(command: str, exc: DdeError) -> None:
-        refusal = server.events.recent(1)
-        reason = refusal[0].detail if refusal and refusal[0].detail else "refused"
-        print(f"nfwserver: poke {command!r} at {format_time(clock.now())} refused: {reason}", file=sys.stderr)
-
     try:
         conversation = system.connect(link.service, link.topic, client_name="simulate")
     except DdeError:
@@ -170,10 +160,18 @@ def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock
         served = "NFW32|NFW_DATA or NFW_SERVER|NFW_DATA, " + ", ".join(f"{d.service}|{d.topic}"
                                                                         for d in DIALECTS.values())
         args.usage_error(f"--link {link}: nothing serves that service and topic here (served: {served})")
-    client = SimulatedClient(args.client, conversation, link.item, emit, args.poll, refused)
-    pending = list(pokes)
+    client = SimulatedClient(args.client, conversation, link.item, emit, args.poll)
+    pending = [(0.0, "TUNE ON", False)] if auto_tune else []  # the automatic TUNE ON is not reported
+    pending += [(offset, command, True) for offset, command in pokes]
     started = False
     previous: list[float] = []  # the offset of the tick published last
+
+    def send(command: str) -> None:
+        if dialect is None:
+            client.poke(command)
+        else:  # the dialects take no pokes: their clients never send any; Nova's commands go to the core
+            result = server.command(command, source="simulate", face=Face.DDE)
+            emit("poke", f"{command} (to the server{'' if result.accepted else ', refused'})")
 
     def before_tick(offset: float) -> None:
         nonlocal started
@@ -184,15 +182,10 @@ def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock
             sys.stdout.write("".join(lines))
             lines.clear()
         while pending and pending[0][0] <= offset + 1e-9:
-            command = pending.pop(0)[1]
-            if dialect is None:
-                client.poke(command)
-            else:  # the dialects take no pokes: their clients never send any; Nova's commands go to the core
-                result = server.command(command, source="simulate")
-                emit("poke", f"{command} (to the server{'' if result.accepted else ', refused'})")
-                if not result.accepted:
-                    print(f"nfwserver: {command!r} at {format_time(clock.now())} refused: {result.note}",
-                          file=sys.stderr)
+            at, command, report = pending.pop(0)
+            outcome = observe_poke(server, round(max(at, offset), 3), command, send)
+            if report:  # what the poke did, among the diagnostics (stdout carries only what the client sees)
+                print(outcome.line(), file=sys.stderr)
         if not started:
             started = True
             try:

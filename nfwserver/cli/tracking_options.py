@@ -59,12 +59,19 @@ class TrackingInputs:
     def horizon(self) -> HorizonTable:
         """``--horizon``, else flat with ``--observer``, else the configured table."""
         from nfwserver.cli import CliError
-        from nfwserver.tracking.horizon import HorizonTable, load_horizon
+        from nfwserver.config.files import read_regular_file
+        from nfwserver.tracking.horizon import HorizonTable, parse_horizon
 
-        if getattr(self._args, "horizon", None):
-            try:
-                return load_horizon(self._args.horizon)
-            except (OSError, ValueError) as exc:
+        path = getattr(self._args, "horizon", None)
+        if path:
+            try:  # a regular file only: a FIFO or a terminal named by mistake would block for ever
+                return parse_horizon(read_regular_file(path, errors="replace"), source=str(path))
+            except FileNotFoundError:
+                raise CliError(f"--horizon: no such file: {path}") from None
+            except OSError as exc:
+                reason = (exc.strerror or type(exc).__name__).lower()
+                raise CliError(f"--horizon: cannot read {path} ({reason})") from None
+            except ValueError as exc:  # a bad line (named), or not a regular file
                 raise CliError(f"--horizon: {exc}") from None
         if self._given_observer is not None:
             return HorizonTable()

@@ -18,6 +18,7 @@ import threading
 from typing import Any
 
 from nfwserver.dialects.predict_protocol import END_OF_LISTING, PredictContext, PredictProtocol
+from nfwserver.listen_errors import bind_failure
 
 __all__ = ["DEFAULT_PORT", "PredictContext", "PredictUdpServer"]
 
@@ -47,8 +48,8 @@ class PredictUdpServer:
             sock.bind((self.host, self.port))
         except OSError as exc:
             sock.close()
-            raise OSError(exc.errno, f"PREDICT UDP cannot listen on {self.host}:{self.port} "
-                                     f"([dialects] predict_host/predict_port): {exc.strerror or exc}") from None
+            raise bind_failure(exc, "dialects", self.host, self.port, host_key="predict_host",
+                               port_key="predict_port", what="PREDICT UDP") from None
         sock.settimeout(0.2)
         self.sock = sock
         self.address = sock.getsockname()

@@ -7,9 +7,11 @@ command gets no reply at all and a command missing an argument makes the daemon 
 input.  So only complete, known commands are sent, and every reply is awaited with a timeout.
 
 When the daemon dies (EOF, broken pipe, refused connection) the connection is dropped and
-:class:`HamlibUnavailable` is raised at once; reconnection is attempted on a later call, no sooner
-than the back-off delay (doubling from ``backoff_initial_s`` to ``backoff_max_s``; measured on the injected
-clock; the station uses 0.2 s then 0.4 s), so a dead daemon never stalls the caller.  The connection's state is one
+:class:`HamlibUnavailable` is raised at once, saying "not reachable at HOST:PORT" until a first connection was
+made (a wrong port, a daemon not started) and "lost" after one; reconnection is attempted on a later call, no
+sooner than the back-off delay (doubling from ``backoff_initial_s`` to ``backoff_max_s``; measured on the
+injected clock; the station uses 0.2 s then 0.4 s), so a dead daemon never stalls the caller.  The connection's
+state is one
 :class:`~nfwserver.health.LinkHealth` (the station puts it on its board as ``rotctld``/``rigctld``):
 failing while the daemon cannot be reached or answers nonsense, cleared by the first whole reply.
 
@@ -49,6 +51,13 @@ REPLY_DEADLINE_S = 2.0
 SLOW_REPLY_S = 1.0
 
 
+def _reason(exc: BaseException) -> str:
+    """An OS error as words ("connection refused"), without ``[Errno n]``."""
+    if isinstance(exc, OSError) and exc.strerror:
+        return exc.strerror[:1].lower() + exc.strerror[1:]
+    return str(exc) or type(exc).__name__
+
+
 class HamlibError(Exception):
     """The daemon answered with an error (``code`` is the RPRT value) or with nonsense."""
 
@@ -76,6 +85,7 @@ class HamlibConnection:
         self._sock: socket.socket | None = None
         self._buffer = b""
         self.reconnects = 0
+        self.ever_connected = False  #: a connection was made once: a failure now is "lost", not "not reachable"
         self.faults = 0  #: replies rejected as nonsense (device faults), in total
         self.warnings = RateLimitedLog(log, clock, warn_interval_s)
 
@@ -89,15 +99,17 @@ class HamlibConnection:
         if not self.health.may_try():
             fault = self.health.fault
             wait = fault.retry_at - self.clock.monotonic() if fault is not None else 0.0
-            raise HamlibUnavailable(f"{self.name} at {self.host}:{self.port} is down; retrying in {wait:.1f} s")
+            raise HamlibUnavailable(f"{self._down()}; retrying in {wait:.1f} s")
         try:
             sock = socket.create_connection((self.host, self.port), timeout=self.timeout_s)
         except OSError as exc:
-            self._fail(f"cannot connect: {exc}")
-            raise HamlibUnavailable(f"{self.name} at {self.host}:{self.port}: cannot connect ({exc})") from None
+            message = self._down(_reason(exc))
+            self._fail(message)
+            raise HamlibUnavailable(message) from None
         sock.settimeout(self.timeout_s)
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)  # one short line per command
         self._sock, self._buffer = sock, b""
+        self.ever_connected = True
         if not self.health.ok:
             self.reconnects += 1
         return sock
@@ -111,9 +123,17 @@ class HamlibConnection:
                 pass
         self._sock, self._buffer = None, b""
 
-    def _fail(self, why: str) -> None:
+    def _down(self, why: str = "") -> str:
+        """Why the daemon cannot be used: "not reachable at HOST:PORT" until the first connection (a wrong port, a
+        daemon not started), "at HOST:PORT lost" once one was made (the daemon stopped or restarts)."""
+        detail = f" ({why})" if why else ""
+        if self.ever_connected:
+            return f"{self.name} at {self.host}:{self.port} lost{detail}"
+        return f"{self.name} not reachable at {self.host}:{self.port}{detail}"
+
+    def _fail(self, message: str) -> None:
         self._drop()
-        self.health.failed(f"{self.name} at {self.host}:{self.port}: {why}")
+        self.health.failed(message)
 
     def fault(self, why: str) -> HamlibError:
         """Count a nonsense reply, drop the connection (it may be out of step) and return the error to raise.
@@ -188,8 +208,9 @@ class HamlibConnection:
         except HamlibError:
             raise
         except (OSError, ValueError) as exc:  # timeout, reset, broken pipe, garbage numbers
-            self._fail(str(exc) or type(exc).__name__)
-            raise HamlibUnavailable(f"{self.name} at {self.host}:{self.port}: {exc or type(exc).__name__}") from None
+            message = self._down(_reason(exc))
+            self._fail(message)
+            raise HamlibUnavailable(message) from None
 
     def call(self, command: HamlibCommand, *args: object) -> list[str]:
         """Send one command from :mod:`nfwserver.hamlib.commands` and read its reply (see :meth:`transact`)."""

@@ -133,8 +133,9 @@ class LinkHealth:
             fault = Fault(reason, now if old is None else old.since, failures, retry_at)
             self._fault = fault
         if self.paced:
-            written = self._lines.log(level, self.name, "%s: %s; retrying in %.0f s", self.name, reason,
-                                      fault.retry_at - now)
+            wait = fault.retry_at - now  # "0.2 s" for a short back-off, never "0 s"
+            written = self._lines.log(level, self.name, "%s: %s; retrying in %s s", self.name, reason,
+                                      f"{round(wait, 1) if wait < 10 else round(wait):g}")
         else:
             written = self._lines.log(level, self.name, "%s: %s", self.name, reason)
         if old is None:

@@ -1,7 +1,8 @@
-"""A one-question client for Nova's TCP protocol: connect, check the greeting, send a line, read the reply.
+"""Clients for Nova's TCP protocol: connect, check the greeting, send a line, read the reply.
 
-Used by ``nfwserver poke`` and ``nfwserver status``; any script can do the same with three lines of
-socket code (README).  Timeouts are real seconds: this runs in a separate, short-lived process.
+:func:`ask` is the one-question client of ``nfwserver poke`` and ``nfwserver status``; :class:`StationLink` keeps
+one connection for many questions (``nfwserver watch``).  Any script can do the same with three lines of
+socket code (README).  Timeouts are real seconds: this runs in a separate process, never in the station.
 """
 
 from __future__ import annotations
@@ -33,6 +34,66 @@ def _read_line(stream: BinaryIO, where: str) -> str:
     return raw.decode("ascii", errors="replace").rstrip("\r\n")
 
 
+def _unreachable(where: str, exc: OSError) -> StationUnreachable:
+    reason = exc.strerror or str(exc) or type(exc).__name__
+    return StationUnreachable(f"no station answers on {where} ({reason}); is `nfwserver run` running "
+                              "with [tcp] enabled = true?")
+
+
+class StationLink:
+    """One open connection to the station at ``host``:``port`` (greeting checked), asked one line at a time.
+
+    Owned by one thread.  Every failure (refused, reset, closed, timed out after ``timeout_s`` real seconds, a
+    peer that is not Nova) raises :class:`StationUnreachable` with one sentence; the link is then closed."""
+
+    def __init__(self, host: str, port: int, timeout_s: float = 5.0) -> None:
+        self.where = f"{host} port {port}"
+        try:
+            self._sock = socket.create_connection((host, port), timeout=timeout_s)
+        except OSError as exc:
+            raise _unreachable(self.where, exc) from None
+        self._stream: BinaryIO = self._sock.makefile("rb")
+        self.greeted = False  #: the greeting was read: a closed connection now means the station went away
+        try:
+            greeting = self._line()
+            if greeting != GREETING:
+                raise StationUnreachable(f"{self.where} answered {greeting[:60]!r}, not Nova's greeting")
+            self.greeted = True
+        except StationUnreachable:
+            self.close()
+            raise
+
+    def _line(self) -> str:
+        try:
+            raw: bytes = self._stream.readline(4096)
+        except OSError as exc:
+            raise _unreachable(self.where, exc) from None
+        if not raw:
+            raise StationUnreachable(f"the station at {self.where} closed the connection" + (
+                " (stopped or restarting?)" if self.greeted else
+                " (is this machine's address in its [tcp] allow list?)"))
+        return raw.decode("ascii", errors="replace").rstrip("\r\n")
+
+    def ask(self, line: str) -> str:
+        """Send ``line`` and return the one-line reply."""
+        try:
+            self._sock.sendall(line.encode("ascii") + b"\r\n")
+            return self._line()
+        except OSError as exc:
+            self.close()
+            raise _unreachable(self.where, exc) from None
+        except StationUnreachable:
+            self.close()
+            raise
+
+    def close(self) -> None:
+        for part in (self._stream, self._sock):
+            try:
+                part.close()
+            except OSError:
+                pass
+
+
 def ask(host: str, port: int, line: str, timeout_s: float = 5.0, until: str | None = None) -> str:
     """Send ``line`` to the station at ``host``:``port`` and return its one-line reply (with ``until``:
     every line up to and without the one equal to ``until``, joined by newlines; ``HELP`` ends with OK)."""
@@ -50,6 +111,4 @@ def ask(host: str, port: int, line: str, timeout_s: float = 5.0, until: str | No
                 lines.append(reply)
             return "\n".join(lines) if reply == until else reply
     except OSError as exc:
-        reason = exc.strerror or str(exc) or type(exc).__name__
-        raise StationUnreachable(f"no station answers on {where} ({reason}); is `nfwserver run` running "
-                                 "with [tcp] enabled = true?") from None
+        raise _unreachable(where, exc) from None

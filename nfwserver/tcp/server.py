@@ -44,6 +44,7 @@ from nfwserver.core.events import Direction
 from nfwserver.core.sample import TickSample
 from nfwserver.core.station_core import StationCore
 from nfwserver.health.link_health import Backoff
+from nfwserver.listen_errors import bind_failure
 from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.tcp.connection import Connection, TcpStats, admission_refusal, bind_listener, peer_label
 from nfwserver.tcp.line_splitter import MAX_LINE_BYTES
@@ -111,7 +112,10 @@ class NovaTcpServer:
         """Bind ``[tcp] host``/``port`` and serve on thread ``nfw-tcp``; OSError when it cannot bind."""
         if self._thread is not None:
             return
-        listener = bind_listener(self.config.host, self.config.port)
+        try:
+            listener = bind_listener(self.config.host, self.config.port)
+        except OSError as exc:
+            raise bind_failure(exc, "tcp", self.config.host, self.config.port) from None
         self._listener = listener
         self.address = listener.getsockname()[:2]
         self._wake_r, self._wake_w = socket.socketpair()

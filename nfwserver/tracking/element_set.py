@@ -125,11 +125,15 @@ class Rejection:
     """A set that was not loaded: where it started and why."""
 
     source: str
-    line_number: int
+    line_number: int  #: 1-based; 0 for a problem of the whole file (it cannot be read), which names no line
     reason: str
 
+    def where(self) -> str:
+        """``source line N``, or only ``source`` for a whole-file problem."""
+        return f"{self.source} line {self.line_number}" if self.line_number > 0 else self.source
+
     def __str__(self) -> str:
-        return f"{self.source} line {self.line_number}: {self.reason}"
+        return f"{self.where()}: {self.reason}"
 
 
 @dataclass

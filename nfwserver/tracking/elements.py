@@ -302,11 +302,11 @@ def _load_json(text: str, source: str, result: LoadResult) -> Rejection | None:
         line = getattr(exc, "lineno", 1)
         return Rejection(source, line, f"not valid JSON ({getattr(exc, 'msg', exc)})")
     records = doc if isinstance(doc, list) else [doc]
-    for index, record in enumerate(records, start=1):
+    for index, record in enumerate(records, start=1):  # entries are named by number, not by a line (line 0)
         if not isinstance(record, dict):
-            result.rejected.append(Rejection(source, 1, f"JSON entry {index} is not an OMM object"))
+            result.rejected.append(Rejection(source, 0, f"JSON entry {index} is not an OMM object"))
             continue
-        _add_omm(record, source, index, result, what=f"JSON entry {index}")
+        _add_omm(record, source, 0, result, what=f"JSON entry {index}")
     return None
 
 
@@ -319,9 +319,11 @@ def _add_omm(record: dict[str, Any], source: str, line: int, result: LoadResult,
 
 
 def load_element_file(path: str | os.PathLike[str]) -> LoadResult:
-    """Load a file; an unreadable file gives one :class:`Rejection` (line 0), never an exception."""
+    """Load a file; an unreadable file gives one :class:`Rejection` of the whole file (line 0, shown without a
+    line), never an exception."""
     try:
         data = Path(path).read_bytes()
     except OSError as exc:
-        return LoadResult(rejected=[Rejection(str(path), 0, f"cannot read the file ({exc.strerror or exc})")])
+        reason = (exc.strerror or str(exc)).lower()
+        return LoadResult(rejected=[Rejection(str(path), 0, f"cannot read the file ({reason})")])
     return load_elements(data, source=str(path))

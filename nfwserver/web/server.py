@@ -35,6 +35,7 @@ from nfwserver.core.events import Direction
 from nfwserver.core.sample import TickSample
 from nfwserver.core.station_core import StationCore
 from nfwserver.easycomm.output import EasyCommOutput
+from nfwserver.listen_errors import bind_failure
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.rotor.coupling import RotorCoupling
@@ -140,9 +141,12 @@ class WebServer:
     def start(self) -> None:
         if self._httpd is not None:
             return
-        family, _, _, _, sockaddr = socket.getaddrinfo(self.config.host, self.config.port, type=socket.SOCK_STREAM,
-                                                       flags=socket.AI_PASSIVE)[0]
-        self._httpd = _HttpServer(sockaddr, self, family)
+        try:
+            family, _, _, _, sockaddr = socket.getaddrinfo(self.config.host, self.config.port,
+                                                           type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)[0]
+            self._httpd = _HttpServer(sockaddr, self, family)
+        except OSError as exc:
+            raise bind_failure(exc, "web", self.config.host, self.config.port) from None
         self.address = self._httpd.server_address[:2]  # type: ignore[assignment]
         self._stop.clear()
         self.hub.reopen()

@@ -42,7 +42,48 @@ def test_tune_on_is_poked_automatically_only_without_a_tune_poke(capsys) -> None
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].startswith("2026-05-08T00:00:00.000Z\tISS ") and len(lines) == 51
     help_text = " ".join(_help(capsys).split())
-    assert "TUNE ON is poked at the start unless a --poke holds a TUNE command" in help_text
+    assert "TUNE ON is poked at the start unless the first TUNE command among the --poke options is TUNE ON or " \
+        "is sent at 0 s" in help_text
+
+
+def test_each_poke_says_what_it_did_on_stderr(capsys) -> None:
+    """The poke goes to the core through the DDE client; its answer and the state change are one line each."""
+    assert main([*BASE, "--duration", "120", "--rate", "1", "--sat", "25544", "--poke", "60:TUNE OFF",
+                 "--poke", "70:SAT=99999", "--poke", "80:TRACK ON", "--poke", "90:ANTAZ=12.5",
+                 "--poke", "100:TUNE OFF"]) == 0
+    out, err = capsys.readouterr()
+    lines = out.splitlines()
+    assert lines[0].startswith("2026-05-08T00:00:00.000Z\tISS ")  # TUNE ON first: the first TUNE poke is OFF
+    assert lines[-1].startswith("2026-05-08T00:00:59.000Z\tISS ") and len(lines) == 60
+    assert err.splitlines() == [
+        "t+60 s  poke 'TUNE OFF': accepted; feed off",
+        "t+70 s  poke 'SAT=99999': refused: satellite 99999 is not in the catalog; keeping the current one; "
+        "nothing changed",
+        "t+80 s  poke 'TRACK ON': accepted; tracking on",
+        "t+90 s  poke 'ANTAZ=12.5': accepted; antenna azimuth 12.5 deg",
+        "t+100 s  poke 'TUNE OFF': accepted; no change",
+    ]
+
+
+def test_a_poke_on_a_dialect_link_is_reported_too(capsys) -> None:
+    assert main([*BASE, "--duration", "20", "--rate", "1", "--sat", "25544", "--link",
+                 "Orbitron|Tracking!TrackingDataEx", "--poke", "10:SAT=25544", "--poke", "15:TRACK ON"]) == 0
+    assert capsys.readouterr().err.splitlines() == ["t+10 s  poke 'SAT=25544': accepted; no change",
+                                                    "t+15 s  poke 'TRACK ON': accepted; tracking on"]
+
+
+@pytest.mark.parametrize(("poke", "reason"), [
+    ("60:STATUS", "not a Nova command (TUNE ON|OFF, TRACK ON|OFF, SAT=n, ANTAZ=deg, ANTEL=deg)"),
+    ("60:SAT=ISS", "SAT needs a catalog number, got 'ISS'"),
+    ("60:ANTEL=200", "ANTEL 200.0 is outside -90..180 degrees"),
+    ("60:TUNE", "TUNE needs ON or OFF"),
+])
+def test_a_poke_the_command_table_refuses_is_a_usage_error_with_its_reason(capsys, poke, reason) -> None:
+    with pytest.raises(SystemExit) as info:
+        main([*BASE, "--duration", "120", "--sat", "25544", "--poke", poke])
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert f"argument --poke: {poke!r}: {reason} (a DDE client's poke)" in err and "Traceback" not in err
 
 
 def _help(capsys) -> str:
@@ -83,7 +124,8 @@ def test_without_a_satellite_nothing_is_published_and_the_warning_matches_the_po
     assert "nothing is published until" not in err and "until the SAT= poke at 2 s" in err
     assert main([*base, "--poke", "SAT=25544"]) == 0
     out, err = capsys.readouterr()
-    assert out.startswith("2026-05-08T00:00:00.000Z\tISS ") and "SAT=" not in err and "nothing" not in err
+    assert out.startswith("2026-05-08T00:00:00.000Z\tISS ") and "nothing" not in err
+    assert err.endswith("\nt+0 s  poke 'SAT=25544': accepted; satellite none -> 25544 ISS\n")
 
 
 def test_start_defaults_to_now(capsys) -> None:

@@ -40,7 +40,7 @@ def _shape(rows: list[tuple[float, str, str]]) -> list[tuple[float, str, str]]:
 def test_wisp_polls_every_3_s_and_repokes_tune_on_when_ah_is_missing(capsys) -> None:
     rows = _run(capsys, "--client", "wisp", "--rate", "1", "--duration", "10", "--poke", "4:TUNE OFF")
     assert _shape(rows) == [
-        (0.0, "reply", "(empty)"), (1.0, "poke", "TUNE ON"),  # no automatic TUNE ON: WiSP's own re-poke
+        (0.0, "poke", "TUNE ON"), (0.0, "reply", "DATA"),  # TUNE ON first: the first TUNE poke is OFF, later
         (3.0, "reply", "DATA"), (4.0, "poke", "TUNE OFF"),
         (6.0, "reply", "(empty)"), (7.0, "poke", "TUNE ON"),
         (9.0, "reply", "DATA"),
