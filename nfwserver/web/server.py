@@ -86,7 +86,7 @@ class _HttpServer(ThreadingHTTPServer):
     allow_reuse_address = True
     request_queue_size = 64
 
-    def __init__(self, address: tuple, web: WebServer, family: int) -> None:
+    def __init__(self, address: tuple[Any, ...], web: WebServer, family: int) -> None:
         self.address_family = family
         self.web = web
         super().__init__(address, WebHandler)
