@@ -216,8 +216,11 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
     # -- DdeServerTransport ----------------------------------------------------------------
     def register_service(self, service: str, handler: DdeServerHandler) -> None:
         def do() -> None:
+            try:
+                hsz = self._string(service)  # DDEML makes no string handle for an empty name
+            except OSError as exc:
+                raise OSError(f"could not register {service!r}: {exc}") from None
             self._handlers[service.upper()] = handler
-            hsz = self._string(service)
             if not self.u.DdeNameService(self.inst, hsz, None, ddeml.DNS_REGISTER):
                 self._handlers.pop(service.upper(), None)
                 raise OSError(f"DdeNameService could not register {service} "

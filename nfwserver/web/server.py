@@ -32,6 +32,7 @@ from typing import Any
 
 from nfwserver.config.schema import WebConfig
 from nfwserver.core.events import Direction
+from nfwserver.core.faces import CountsClients, CountsConversations
 from nfwserver.core.sample import TickSample
 from nfwserver.core.station_core import StationCore
 from nfwserver.easycomm.output import EasyCommOutput
@@ -67,8 +68,8 @@ class StationParts:
     rotor: RotorCoupling | None = None
     radio: RadioCoupling | None = None
     easycomm: EasyCommOutput | None = None
-    tcp: Any = None  #: NovaTcpServer (client_count)
-    nova: Any = None  #: NovaDdeService (client_count: conversations, advise loops)
+    tcp: CountsClients | None = None  #: NovaTcpServer
+    nova: CountsConversations | None = None  #: NovaDdeService
     favourites: Callable[[], Sequence[int]] = field(default=lambda: ())
 
 
