@@ -221,7 +221,7 @@ class PassBoard:
             return None
 
     @staticmethod
-    def _ground_track(satrec: object, now: datetime, ut1_utc: float) -> list[list[float]]:
+    def _ground_track(satrec: Satrec, now: datetime, ut1_utc: float) -> list[list[float]]:
         out = []
         t = now - timedelta(seconds=GROUND_BEFORE_S)
         end = now + timedelta(seconds=GROUND_AFTER_S)

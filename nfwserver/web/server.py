@@ -144,6 +144,7 @@ class WebServer:
         family, _, _, _, sockaddr = socket.getaddrinfo(self.config.host, self.config.port, type=socket.SOCK_STREAM,
                                                        flags=socket.AI_PASSIVE)[0]
         self._httpd = _HttpServer(sockaddr, self, family)
+        # an AF_INET or AF_INET6 listener: its address starts with (host, port)
         self.address = self._httpd.server_address[:2]  # type: ignore[assignment]
         self._stop.clear()
         self.hub.reopen()
