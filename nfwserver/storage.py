@@ -105,7 +105,8 @@ def remove_stale_temporaries(path: str | os.PathLike[str], now: float | None = N
     except OSError:
         return removed
     for tmp in candidates:
-        pid_text = pattern.fullmatch(tmp.name).group(1)  # type: ignore[union-attr]
+        match = pattern.fullmatch(tmp.name)
+        pid_text = match.group(1) if match is not None else None
         running = _pid_running(int(pid_text)) if pid_text else None
         if running is None:
             try:

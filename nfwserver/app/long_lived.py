@@ -24,6 +24,7 @@ import gc
 import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
+from typing import Any
 
 _lock = threading.Lock()
 _depth = [0]  # how many blocks are running, in every thread
@@ -49,7 +50,7 @@ def building_long_lived() -> Iterator[None]:
                     gc.enable()
 
 
-def release(items: list) -> None:
+def release(items: list[Any]) -> None:
     """Empty ``items`` one element at a time, so that freeing what only it held never holds the lock long."""
     while items:
         items.pop()

@@ -106,10 +106,15 @@ def _written(path: str | None) -> dict[str, Any]:
     """The file's own TOML document (values as the user wrote them), or {} for the built-in defaults."""
     if path is None:
         return {}
-    from nfwserver.config.edit import tomllib
     from nfwserver.config.loader import read_config_text
 
-    return tomllib.loads(read_config_text(Path(path)).removeprefix("\ufeff"))
+    if sys.version_info >= (3, 11):
+        import tomllib
+    else:  # pragma: no cover - Python 3.10
+        import tomli as tomllib
+
+    document: dict[str, Any] = tomllib.loads(read_config_text(Path(path)).removeprefix("\ufeff"))
+    return document
 
 
 def _edited(text: str, section: str, key: str, value: Any, path: Path) -> str:

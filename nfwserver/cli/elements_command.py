@@ -12,13 +12,18 @@ import argparse
 import dataclasses
 import sys
 from datetime import datetime, timezone
+from typing import TYPE_CHECKING
 
 from nfwserver.cli.arguments import element_source_value, number_in
 from nfwserver.cli.tracking_options import config_file
 from nfwserver.config.element_presets import DEFAULT_PRESET, PRESETS
 
+if TYPE_CHECKING:
+    from nfwserver.app.element_store import ElementStore
+    from nfwserver.config import Config
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = subparsers.add_parser("elements", help="update, list or prune the stored element catalog",
                               description="Manage the stored element catalog (InstantTrack UPDATE, OLD and CRASH).")
     sub = p.add_subparsers(dest="elements_action", metavar="ACTION", required=True)
@@ -51,7 +56,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         action.add_argument("--config", metavar="FILE", help="configuration file (default: the user's)")
 
 
-def _config(args: argparse.Namespace):
+def _config(args: argparse.Namespace) -> Config:
     from nfwserver.cli import CliError
     from nfwserver.config import ConfigError, load_config
 
@@ -64,7 +69,7 @@ def _config(args: argparse.Namespace):
     return config
 
 
-def _store(config):
+def _store(config: Config) -> ElementStore:
     from nfwserver.app.station_catalog import configured_store
     from nfwserver.cli import CliError
 
@@ -80,7 +85,7 @@ def _say(message: str) -> None:
 
 def run_update(args: argparse.Namespace) -> int:
     from rich.console import Console
-    from rich.progress import BarColumn, DownloadColumn, Progress, TextColumn
+    from rich.progress import BarColumn, DownloadColumn, Progress, TaskID, TextColumn
 
     from nfwserver.app.element_sources import SourceError, read_source
     from nfwserver.app.station_catalog import source_limits
@@ -98,7 +103,7 @@ def run_update(args: argparse.Namespace) -> int:
         for source in sources:
             task = progress.add_task((labels[source] or source)[-40:], total=None, sets=0)
 
-            def moved(done: int, total: int | None, task=task) -> None:
+            def moved(done: int, total: int | None, task: TaskID = task) -> None:
                 progress.update(task, completed=done, total=total)
 
             try:
@@ -129,7 +134,7 @@ def run_update(args: argparse.Namespace) -> int:
     return 1 if failed else 0
 
 
-def _sources(given: list[str], config) -> dict[str, str]:
+def _sources(given: list[str], config: Config) -> dict[str, str]:
     """The sources to read, each mapped to its label (a preset's, or ``""``): the ones given (preset names
     become their URLs), else the configured ones, else the default preset (said on stderr)."""
     from nfwserver.app.station_catalog import configured_urls
@@ -203,7 +208,7 @@ def run_list(args: argparse.Namespace) -> int:
     return 0
 
 
-def _protected(config) -> dict[int, str]:
+def _protected(config: Config) -> dict[int, str]:
     """Catalog numbers prune keeps, with why: the selected satellite (saved state, [server] satellite) and
     the favourites."""
     from nfwserver.app.session_state import StateFile

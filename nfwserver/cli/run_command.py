@@ -25,7 +25,11 @@ from nfwserver.cli.station_runner import run_console, serve_headless, start_repo
 from nfwserver.clock import Clock, SystemClock
 
 if TYPE_CHECKING:
+    from nfwserver.app.station import Station
     from nfwserver.cli.log_file import StationLogFile
+    from nfwserver.config import Config
+    from nfwserver.console.app import NfwConsole
+    from nfwserver.dde.transport import DdeServerTransport
 
 log = logging.getLogger("nfwserver")
 
@@ -74,8 +78,9 @@ class RunPlan:
     log_file: Path
     duration_s: float | None = None
     clock: Clock | None = None
-    transport: Any = None  #: a DDE server transport (default: the platform's)
-    make_console: Callable[..., Any] | None = None  #: builds the console app (default: NfwConsole)
+    transport: DdeServerTransport | None = None  #: a DDE server transport (default: the platform's)
+    #: builds the console app from (station, config, hint) (default: NfwConsole)
+    make_console: Callable[[Station, Config, str], NfwConsole] | None = None
     console_options: dict[str, Any] | None = None  #: passed to the app's run() (tests: headless=True)
     stop: threading.Event | None = None  #: set to stop (default: signals and NFW_CONTROL_FILE; cli/signals.py)
 
@@ -97,7 +102,7 @@ def run(args: argparse.Namespace) -> int:
     return serve(config, plan, watch=args.config)
 
 
-def with_web(config: Any) -> Any:
+def with_web(config: Config) -> Config:
     """``config`` with the web dashboard on (``--web``), warned about as the file's ``[web] enabled`` would be."""
     from dataclasses import replace
 
@@ -111,14 +116,14 @@ def with_web(config: Any) -> Any:
     return config
 
 
-def _notes(station: Any, config: Any) -> tuple[list[str], str]:
+def _notes(station: Station, config: Config) -> tuple[list[str], str]:
     """Start-up notes for the terminal, and the console's hint (no observer, stale elements)."""
     from nfwserver.config import observer_hint
 
     source = config.path or config.source
     notes = [f"configuration: {source}", station.transport_note, f"{len(station.catalog)} satellites loaded",
              station.selection_note]
-    if getattr(station, "web", None) is not None and station.web.address is not None:
+    if station.web is not None and station.web.address is not None:
         notes.append(f"web dashboard: {station.web.url}")
     hints = [] if config.observer_configured else [observer_hint(config)]
     ages = [s.age_days(station.clock.now()) for s in station.catalog]
@@ -128,7 +133,7 @@ def _notes(station: Any, config: Any) -> tuple[list[str], str]:
     return [n for n in notes if n] + hints, " ".join(hints + [station.selection_note])
 
 
-def _make_console(station: Any, config: Any, hint: str) -> Any:
+def _make_console(station: Station, config: Config, hint: str) -> NfwConsole:
     from nfwserver.console.app import NfwConsole
 
     return NfwConsole(station.core, station.transport_note, hint, radio=station.radio, rotor=station.rotor,
@@ -138,7 +143,7 @@ def _make_console(station: Any, config: Any, hint: str) -> Any:
                       stale_days=config.elements.stale_days)
 
 
-def _exit_app(app: Any) -> None:
+def _exit_app(app: NfwConsole) -> None:
     try:
         app.call_from_thread(app.exit)
     except RuntimeError:  # not running (any more)
@@ -151,8 +156,8 @@ class _Requests:
 
     def __init__(self, stop: threading.Event) -> None:
         self.stop = stop
-        self.station: Any = None
-        self.app: Any = None
+        self.station: Station | None = None
+        self.app: NfwConsole | None = None
 
     def on_stop(self) -> None:
         self.stop.set()
@@ -177,7 +182,7 @@ def _listen(plan: RunPlan, requests: _Requests, clock: Clock) -> tuple[StationSi
     return signals, control
 
 
-def serve(config: Any, plan: RunPlan, watch: str | None = None) -> int:
+def serve(config: Config, plan: RunPlan, watch: str | None = None) -> int:
     """Start the station from ``config``, run it as ``plan`` says, stop it; the exit code.
 
     Without ``plan.stop``, signals and the control file stop it or reload its configuration
@@ -222,7 +227,7 @@ def serve(config: Any, plan: RunPlan, watch: str | None = None) -> int:
     return 0
 
 
-def _serve_started(station: Any, config: Any, plan: RunPlan, watch: str | None, requests: _Requests,
+def _serve_started(station: Station, config: Config, plan: RunPlan, watch: str | None, requests: _Requests,
                    file_handler: StationLogFile | None) -> StationLogFile | None:
     """Keep the started ``station`` serving until ``requests.stop`` or the duration; the log file in use."""
     from nfwserver.cli.log_file import LOG_BACKOFF

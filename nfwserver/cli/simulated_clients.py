@@ -89,7 +89,7 @@ class SimulatedClient:
         """Send the requests due by ``offset_s`` seconds into the run (once that tick is published)."""
         while self._next_request is not None and self._next_request <= offset_s + 1e-9:
             self.request()
-            self._next_request += self.poll_s  # type: ignore[operator]
+            self._next_request += self.poll_s  # type: ignore[operator]  # set only when poll_s is (start)
 
     def poke(self, command: str) -> bool:
         """Poke ``command`` to the item; reported as a ``poke`` transaction (and to ``on_refused``)."""

@@ -13,7 +13,11 @@ from __future__ import annotations
 
 import logging
 import threading
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from nfwserver.app.station import Station
+    from nfwserver.console.app import NfwConsole
 
 log = logging.getLogger("nfwserver")
 
@@ -21,12 +25,12 @@ log = logging.getLogger("nfwserver")
 STATUS_INTERVAL_S = 600.0
 
 
-def _satellite(station: Any) -> str:
+def _satellite(station: Station) -> str:
     sat = station.core.state.selected()
     return f"{sat.dde_name} ({sat.catalog_number})" if sat is not None else "none selected"
 
 
-def enabled_outputs(station: Any) -> list[str]:
+def enabled_outputs(station: Station) -> list[str]:
     """One phrase per output the station serves."""
     cfg = station.config
     srv = cfg.server
@@ -34,11 +38,11 @@ def enabled_outputs(station: Any) -> list[str]:
     outputs.extend(f"{d.dialect.name} DDE" for d in station.dialect_servers)
     if station.predict is not None:
         outputs.append(f"PREDICT UDP {cfg.dialects.predict_host}:{cfg.dialects.predict_port}")
-    if getattr(station, "tcp", None) is not None:
+    if station.tcp is not None:
         outputs.append(f"TCP {cfg.tcp.host}:{cfg.tcp.port}")
-    if getattr(station, "easycomm", None) is not None:
+    if station.easycomm is not None:
         outputs.append(f"EasyComm {cfg.easycomm.device}")
-    web = getattr(station, "web", None)
+    web = station.web
     if web is not None and web.address is not None:
         outputs.append(f"web dashboard {web.url} (control {'on' if web.control.enabled else 'off'})")
     if station.rotor is not None:
@@ -48,7 +52,7 @@ def enabled_outputs(station: Any) -> list[str]:
     return outputs
 
 
-def start_report(station: Any) -> list[str]:
+def start_report(station: Station) -> list[str]:
     """Observer, satellite and enabled outputs, one line each."""
     state = station.core.state
     observer = state.observer
@@ -57,7 +61,7 @@ def start_report(station: Any) -> list[str]:
             "outputs: " + ", ".join(enabled_outputs(station))]
 
 
-def status_line(station: Any) -> str:
+def status_line(station: Station) -> str:
     """``status: ISS (25544) AZ 123.4 EL 12.3 AH Y; TUNE ON TRACK OFF; DDE clients 2 (1 advise); ...``."""
     snap = station.core.snapshot()
     sample = snap.last_sample
@@ -70,14 +74,13 @@ def status_line(station: Any) -> str:
     parts = [f"status: {_satellite(station)} {where}",
              f"TUNE {'ON' if snap.state.dde_output else 'OFF'} TRACK {'ON' if snap.state.tracking else 'OFF'}",
              f"DDE clients {conversations} ({loops} advise)"]
-    tcp = getattr(station, "tcp", None)
-    if tcp is not None and callable(getattr(tcp, "client_count", None)):
-        parts.append(f"TCP clients {tcp.client_count()}")
+    if station.tcp is not None:
+        parts.append(f"TCP clients {station.tcp.client_count()}")
     parts.append(f"status word 0x{snap.status:04X}")
     return "; ".join(parts)
 
 
-def serve_headless(station: Any, stop: threading.Event, duration_s: float | None,
+def serve_headless(station: Station, stop: threading.Event, duration_s: float | None,
                    interval_s: float = STATUS_INTERVAL_S) -> None:
     """Wait on the station clock until ``stop`` is set or ``duration_s`` passed; status every ``interval_s``."""
     clock = station.clock
@@ -97,10 +100,10 @@ def serve_headless(station: Any, stop: threading.Event, duration_s: float | None
         clock.wait(stop, wait)
 
 
-def run_console(app: Any, **run_options: Any) -> BaseException | None:
+def run_console(app: NfwConsole, **run_options: Any) -> BaseException | None:
     """Run ``app`` (a :class:`~nfwserver.console.app.NfwConsole`); the exception that stopped it, or None."""
     try:
         app.run(**run_options)
     except Exception as exc:  # the terminal driver itself failed
         return exc
-    return getattr(app, "failure", None)
+    return app.failure

@@ -34,6 +34,7 @@ class Parsed:
 
     def poke(self) -> Poke:
         """The station command (only for entries whose target is the station)."""
+        # the entry's grammar checked the value, of the type Poke takes for that kind
         return Poke(PokeKind(self.command.word), self.value)  # type: ignore[arg-type]
 
 

@@ -55,6 +55,7 @@ from nfwserver.console.state_view import (
 )
 from nfwserver.console.time_display import TimeDisplay
 from nfwserver.core.events import Direction, Event
+from nfwserver.core.faces import CountsClients, WritesLines
 from nfwserver.core.nova_protocol import escape_for_log
 from nfwserver.core.station_core import StationCore
 from nfwserver.radio.coupling import RadioCoupling
@@ -97,7 +98,7 @@ class NfwConsole(App[None]):
     def __init__(self, core: StationCore, transport_note: str = "", hint: str = "",
                  radio: RadioCoupling | None = None, rotor: RotorCoupling | None = None,
                  favourites: tuple[int, ...] = (), clients: Callable[[], tuple[int, int]] | None = None, *,
-                 tcp: object | None = None, easycomm: object | None = None, config_file: str = "",
+                 tcp: CountsClients | None = None, easycomm: WritesLines | None = None, config_file: str = "",
                  schedules: Mapping[int, str] | None = None, local_zone: tzinfo | None = None,
                  stale_days: float = STALE_DAYS) -> None:
         super().__init__()

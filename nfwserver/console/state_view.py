@@ -20,6 +20,7 @@ from datetime import datetime
 from rich.text import Text
 
 from nfwserver.console.time_display import TimeDisplay
+from nfwserver.core.faces import CountsClients, WritesLines
 from nfwserver.core.station_core import CoreSnapshot, StationCore
 from nfwserver.core.status import describe
 from nfwserver.radio.coupling import RadioCoupling
@@ -151,17 +152,16 @@ def radio_line(radio: RadioCoupling | None, tuning_on: bool) -> Text:
     return Text(f"Radio: Doppler tuning {state}")
 
 
-def outputs_line(tcp: object | None, easycomm: object | None) -> Text | None:
+def outputs_line(tcp: CountsClients | None, easycomm: WritesLines | None) -> Text | None:
     """TCP clients and the last EasyComm line, when those outputs exist."""
     parts = Text()
     if tcp is not None:
-        count = getattr(tcp, "client_count", None)
-        parts.append(f"TCP clients {count() if callable(count) else '?'}")
+        parts.append(f"TCP clients {tcp.client_count()}")
     if easycomm is not None:
         if parts:
             parts.append("  ")
         parts.append("EasyComm ")
-        parts.append(str(getattr(easycomm, "last_line", None) or "-"))
+        parts.append(easycomm.last_line or "-")
     return parts if parts else None
 
 

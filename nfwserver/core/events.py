@@ -64,8 +64,10 @@ class EventLog:
         self._seq = itertools.count(1)
 
     def add(self, time: datetime, direction: Direction, kind: str, text: str, **fields: object) -> Event:
-        if isinstance(fields.get("detail"), str):
-            fields["detail"] = truncate_text(fields["detail"])  # type: ignore[arg-type]
+        detail = fields.get("detail")
+        if isinstance(detail, str):
+            fields["detail"] = truncate_text(detail)
+        # the keyword fields of Event (conversation, client, accepted, detail): Event checks them when called
         event = Event(next(self._seq), time, direction, kind, truncate_text(text), **fields)  # type: ignore[arg-type]
         with self._lock:
             self._events.append(event)

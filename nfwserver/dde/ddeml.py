@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import ctypes
 import sys
-from typing import Any
+from collections.abc import Callable
+from typing import Protocol, cast
 
 # Transaction classes and flags.
 XCLASS_BOOL = 0x1000
@@ -62,6 +63,7 @@ CP_WINANSI = 1004
 CP_WINUNICODE = 1200
 DMLERR_NO_ERROR = 0
 DMLERR_NOTPROCESSED = 0x4009
+DMLERR_POSTMSG_FAILED = 0x400C
 PM_REMOVE = 0x0001
 QS_ALLINPUT = 0x04FF
 TIMEOUT_ASYNC = 0xFFFFFFFF
@@ -98,7 +100,63 @@ class ConvInfo(ctypes.Structure):  # pragma: no cover - layout of ddeml.h's CONV
                 ("ConvCtxt", ctypes.c_uint32 * 9), ("hwnd", ctypes.c_void_p), ("hwndPartner", ctypes.c_void_p)]
 
 
-def load_user32() -> Any:  # pragma: no cover - Windows only
+#: A ctypes function whose result is a number (UINT, DWORD, BOOL, ATOM, LRESULT).
+Numeric = Callable[..., int]
+#: A ctypes function whose result is a handle (``c_void_p``): an int, or None for NULL.
+Handle = Callable[..., "int | None"]
+
+
+class User32(Protocol):
+    """The user32 functions :func:`load_user32` declares, as mypy sees them (arguments unchecked;
+    ctypes checks them against ``argtypes`` at the call)."""
+
+    DdeInitializeW: Numeric
+    DdeInitializeA: Numeric
+    DdeCreateStringHandleA: Handle
+    DdeQueryStringA: Numeric
+    DdeUninitialize: Numeric
+    DdeCreateStringHandleW: Handle
+    DdeFreeStringHandle: Numeric
+    DdeQueryStringW: Numeric
+    DdeNameService: Handle
+    DdeCreateDataHandle: Handle
+    DdeGetData: Numeric
+    DdeFreeDataHandle: Numeric
+    DdePostAdvise: Numeric
+    DdeGetLastError: Numeric
+    DdeConnect: Handle
+    DdeDisconnect: Numeric
+    DdeQueryConvInfo: Numeric
+    DdeClientTransaction: Handle
+    GetMessageW: Numeric
+    PeekMessageW: Numeric
+    TranslateMessage: Numeric
+    DispatchMessageW: Numeric
+    PostThreadMessageW: Numeric
+    MsgWaitForMultipleObjects: Numeric
+    GetWindowThreadProcessId: Numeric
+    IsWindow: Numeric
+
+
+class Kernel32(Protocol):
+    """The kernel32 functions :func:`load_kernel32` declares."""
+
+    GetCurrentThreadId: Numeric
+    GetCurrentProcessId: Numeric
+    GlobalAddAtomW: Numeric
+    GlobalAlloc: Handle
+    GlobalFree: Handle
+    GlobalSize: Numeric
+    GlobalLock: Handle
+    GlobalUnlock: Numeric
+
+
+def _declare(dll: object, name: str, restype: object, *argtypes: object) -> None:
+    fn = getattr(dll, name)
+    fn.restype, fn.argtypes = restype, list(argtypes)
+
+
+def load_user32() -> User32:  # pragma: no cover - Windows only
     """user32 with the DDEML prototypes set; raises OSError off Windows."""
     if sys.platform != "win32":
         raise OSError("DDEML exists only on Windows")
@@ -106,34 +164,48 @@ def load_user32() -> Any:  # pragma: no cover - Windows only
 
     u = ctypes.WinDLL("user32", use_last_error=True)
     DWORD, UINT, HANDLE, LPVOID = wintypes.DWORD, wintypes.UINT, ctypes.c_void_p, ctypes.c_void_p
+    _declare(u, "DdeInitializeW", UINT, ctypes.POINTER(DWORD), CALLBACK_TYPE, DWORD, DWORD)
+    _declare(u, "DdeInitializeA", UINT, ctypes.POINTER(DWORD), CALLBACK_TYPE, DWORD, DWORD)
+    _declare(u, "DdeCreateStringHandleA", HANDLE, DWORD, ctypes.c_char_p, ctypes.c_int)
+    _declare(u, "DdeQueryStringA", DWORD, DWORD, HANDLE, ctypes.c_char_p, DWORD, ctypes.c_int)
+    _declare(u, "DdeUninitialize", wintypes.BOOL, DWORD)
+    _declare(u, "DdeCreateStringHandleW", HANDLE, DWORD, wintypes.LPCWSTR, ctypes.c_int)
+    _declare(u, "DdeFreeStringHandle", wintypes.BOOL, DWORD, HANDLE)
+    _declare(u, "DdeQueryStringW", DWORD, DWORD, HANDLE, wintypes.LPWSTR, DWORD, ctypes.c_int)
+    _declare(u, "DdeNameService", HANDLE, DWORD, HANDLE, HANDLE, UINT)
+    _declare(u, "DdeCreateDataHandle", HANDLE, DWORD, LPVOID, DWORD, DWORD, HANDLE, UINT, UINT)
+    _declare(u, "DdeGetData", DWORD, HANDLE, LPVOID, DWORD, DWORD)
+    _declare(u, "DdeFreeDataHandle", wintypes.BOOL, HANDLE)
+    _declare(u, "DdePostAdvise", wintypes.BOOL, DWORD, HANDLE, HANDLE)
+    _declare(u, "DdeGetLastError", UINT, DWORD)
+    _declare(u, "DdeConnect", HANDLE, DWORD, HANDLE, HANDLE, LPVOID)
+    _declare(u, "DdeDisconnect", wintypes.BOOL, HANDLE)
+    _declare(u, "DdeQueryConvInfo", UINT, HANDLE, DWORD, ctypes.POINTER(ConvInfo))
+    _declare(u, "DdeClientTransaction", HANDLE, LPVOID, DWORD, HANDLE, HANDLE, UINT, UINT, DWORD, ctypes.POINTER(DWORD))
+    _declare(u, "GetMessageW", wintypes.BOOL, ctypes.POINTER(wintypes.MSG), wintypes.HWND, UINT, UINT)
+    _declare(u, "PeekMessageW", wintypes.BOOL, ctypes.POINTER(wintypes.MSG), wintypes.HWND, UINT, UINT, UINT)
+    _declare(u, "TranslateMessage", wintypes.BOOL, ctypes.POINTER(wintypes.MSG))
+    _declare(u, "DispatchMessageW", ctypes.c_ssize_t, ctypes.POINTER(wintypes.MSG))
+    _declare(u, "PostThreadMessageW", wintypes.BOOL, DWORD, UINT, wintypes.WPARAM, wintypes.LPARAM)
+    _declare(u, "MsgWaitForMultipleObjects", DWORD, DWORD, LPVOID, wintypes.BOOL, DWORD, DWORD)
+    _declare(u, "GetWindowThreadProcessId", DWORD, wintypes.HWND, ctypes.POINTER(DWORD))
+    _declare(u, "IsWindow", wintypes.BOOL, wintypes.HWND)
+    return cast(User32, u)
 
-    def proto(name, res, *args):
-        fn = getattr(u, name)
-        fn.restype, fn.argtypes = res, list(args)
-        return fn
 
-    proto("DdeInitializeW", UINT, ctypes.POINTER(DWORD), CALLBACK_TYPE, DWORD, DWORD)
-    proto("DdeInitializeA", UINT, ctypes.POINTER(DWORD), CALLBACK_TYPE, DWORD, DWORD)
-    proto("DdeCreateStringHandleA", HANDLE, DWORD, ctypes.c_char_p, ctypes.c_int)
-    proto("DdeQueryStringA", DWORD, DWORD, HANDLE, ctypes.c_char_p, DWORD, ctypes.c_int)
-    proto("DdeUninitialize", wintypes.BOOL, DWORD)
-    proto("DdeCreateStringHandleW", HANDLE, DWORD, wintypes.LPCWSTR, ctypes.c_int)
-    proto("DdeFreeStringHandle", wintypes.BOOL, DWORD, HANDLE)
-    proto("DdeQueryStringW", DWORD, DWORD, HANDLE, wintypes.LPWSTR, DWORD, ctypes.c_int)
-    proto("DdeNameService", HANDLE, DWORD, HANDLE, HANDLE, UINT)
-    proto("DdeCreateDataHandle", HANDLE, DWORD, LPVOID, DWORD, DWORD, HANDLE, UINT, UINT)
-    proto("DdeGetData", DWORD, HANDLE, LPVOID, DWORD, DWORD)
-    proto("DdeFreeDataHandle", wintypes.BOOL, HANDLE)
-    proto("DdePostAdvise", wintypes.BOOL, DWORD, HANDLE, HANDLE)
-    proto("DdeGetLastError", UINT, DWORD)
-    proto("DdeConnect", HANDLE, DWORD, HANDLE, HANDLE, LPVOID)
-    proto("DdeDisconnect", wintypes.BOOL, HANDLE)
-    proto("DdeQueryConvInfo", UINT, HANDLE, DWORD, ctypes.POINTER(ConvInfo))
-    proto("DdeClientTransaction", HANDLE, LPVOID, DWORD, HANDLE, HANDLE, UINT, UINT, DWORD, ctypes.POINTER(DWORD))
-    proto("GetMessageW", wintypes.BOOL, ctypes.POINTER(wintypes.MSG), wintypes.HWND, UINT, UINT)
-    proto("PeekMessageW", wintypes.BOOL, ctypes.POINTER(wintypes.MSG), wintypes.HWND, UINT, UINT, UINT)
-    proto("TranslateMessage", wintypes.BOOL, ctypes.POINTER(wintypes.MSG))
-    proto("DispatchMessageW", ctypes.c_ssize_t, ctypes.POINTER(wintypes.MSG))
-    proto("PostThreadMessageW", wintypes.BOOL, DWORD, UINT, wintypes.WPARAM, wintypes.LPARAM)
-    proto("MsgWaitForMultipleObjects", DWORD, DWORD, LPVOID, wintypes.BOOL, DWORD, DWORD)
-    return u
+def load_kernel32() -> Kernel32:  # pragma: no cover - Windows only
+    """kernel32 with the prototypes of the calls the transport makes; raises OSError off Windows."""
+    if sys.platform != "win32":
+        raise OSError("kernel32 exists only on Windows")
+    from ctypes import wintypes
+
+    k = ctypes.WinDLL("kernel32")
+    _declare(k, "GetCurrentThreadId", wintypes.DWORD)
+    _declare(k, "GetCurrentProcessId", wintypes.DWORD)
+    _declare(k, "GlobalAddAtomW", wintypes.ATOM, wintypes.LPCWSTR)
+    _declare(k, "GlobalAlloc", ctypes.c_void_p, wintypes.UINT, ctypes.c_size_t)
+    _declare(k, "GlobalFree", ctypes.c_void_p, ctypes.c_void_p)
+    _declare(k, "GlobalSize", ctypes.c_size_t, ctypes.c_void_p)
+    _declare(k, "GlobalLock", ctypes.c_void_p, ctypes.c_void_p)
+    _declare(k, "GlobalUnlock", wintypes.BOOL, ctypes.c_void_p)
+    return cast(Kernel32, k)

@@ -20,7 +20,6 @@ step, so the client pumps messages for ``settle_s`` seconds before each transact
 from __future__ import annotations
 
 import ctypes
-import sys
 import time
 from collections import Counter
 from collections.abc import Callable
@@ -41,11 +40,9 @@ class DdemlClient:  # pragma: no cover - Windows only
     """One DDEML client instance; ``ansi`` selects DdeInitializeA and ANSI string handles."""
 
     def __init__(self, ansi: bool = False, settle_s: float = 0.02) -> None:
-        if sys.platform != "win32":
-            raise OSError("DDEML exists only on Windows")
         from ctypes import wintypes
 
-        self.u = ddeml.load_user32()
+        self.u = ddeml.load_user32()  # OSError off Windows
         self._wintypes = wintypes
         self.ansi = ansi
         self.settle_s = settle_s
@@ -72,6 +69,8 @@ class DdemlClient:  # pragma: no cover - Windows only
                 handle = self.u.DdeCreateStringHandleA(self.inst, text.encode(ANSI_CODEPAGE), ddeml.CP_WINANSI)
             else:
                 handle = self.u.DdeCreateStringHandleW(self.inst, text, ddeml.CP_WINUNICODE)
+            if not handle:
+                raise self._error(f"DdeCreateStringHandle for {text!r}")
             self._strings[text] = handle
         return self._strings[text]
 
@@ -92,12 +91,13 @@ class DdemlClient:  # pragma: no cover - Windows only
         self.u.DdeGetData(hdata, buf, n, 0)
         return buf.raw[:n]
 
-    def _on_callback(self, utype, fmt, hconv, hsz1, hsz2, hdata, data1, data2):
+    def _on_callback(self, utype: int, fmt: int, hconv: int | None, hsz1: int | None, hsz2: int | None,
+                     hdata: int | None, data1: int, data2: int) -> int | None:
         try:
             if utype == ddeml.XTYP_ADVDATA:
                 self.advise_counts[hconv or 0] += 1
                 if self.keep_data:
-                    self.received.append((self._query(hsz2), self._read(hdata) if hdata else None))
+                    self.received.append((self._query(hsz2 or 0), self._read(hdata) if hdata else None))
                 return ddeml.DDE_FACK
             if utype == ddeml.XTYP_DISCONNECT:
                 self.disconnected.add(hconv or 0)

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Protocol
 
 from nfwserver.dde import ddeml
@@ -58,6 +59,16 @@ def execute_command(data: bytes, unicode_instance: bool = True) -> bytes:
     return data
 
 
+@dataclass(frozen=True)
+class _Conversation:
+    """A conversation DDEML confirmed: our id for it, its handler, and the names the client used."""
+
+    conv: ConversationId
+    handler: DdeServerHandler
+    service: str
+    topic: str
+
+
 class DdemlDispatcher:
     """The DDEML callback's body.  ``lookup(service)`` returns the handler registered for a service."""
 
@@ -66,12 +77,29 @@ class DdemlDispatcher:
         self.lookup = lookup
         self.api = api
         self.unicode_instance = unicode_instance  #: the instance was made with DdeInitializeW
-        self._conversations: dict[int, tuple[ConversationId, DdeServerHandler]] = {}
+        self._conversations: dict[int, _Conversation] = {}  #: by DDEML conversation handle
         self._links: set[tuple[int, str, int]] = set()  #: advise links DDEML holds: (hconv, ITEM, format)
         self._next_id = 1
 
     def conversation_count(self) -> int:
         return len(self._conversations)
+
+    def handles(self) -> list[int]:
+        """The DDEML handles (HCONV) of the open conversations."""
+        return list(self._conversations)
+
+    def describe(self, hconv: int) -> str:
+        """``conversation 3 (NFW32/NFW_DATA)`` for the log; ``conversation handle 0x..`` if unknown."""
+        entry = self._conversations.get(hconv)
+        if entry is None:
+            return f"conversation handle 0x{hconv:X}"
+        return f"conversation {entry.conv} ({entry.service}/{entry.topic})"
+
+    def drop(self, hconv: int) -> None:
+        """Forget a conversation whose client is gone without ending it, as if ``XTYP_DISCONNECT``
+        had come: its advise links end and its handler hears ``on_disconnect``.  A later callback
+        for the handle is refused (an ``XTYP_ADVREQ`` gets no data, so DDEML posts nothing to it)."""
+        self._dispatch(ddeml.XTYP_DISCONNECT, 0, hconv, 0, 0, 0)
 
     def advise_links(self, item: str) -> int:
         """Advise links DDEML holds on ``item`` (any conversation, topic or format; names compare
@@ -99,19 +127,20 @@ class DdemlDispatcher:
                 return 0
             conv = self._next_id
             self._next_id += 1
-            self._conversations[hconv] = (conv, handler)
-            handler.on_connect_confirm(conv, service, self.api.query_string(hsz1))
+            topic = self.api.query_string(hsz1)
+            self._conversations[hconv] = _Conversation(conv, handler, service, topic)
+            handler.on_connect_confirm(conv, service, topic)
             return 0
         entry = self._conversations.get(hconv)
         if utype == ddeml.XTYP_DISCONNECT:
             self._links = {link for link in self._links if link[0] != hconv}
             if entry is not None:
                 del self._conversations[hconv]
-                entry[1].on_disconnect(entry[0])
+                entry.handler.on_disconnect(entry.conv)
             return 0
         if entry is None:  # a transaction on a conversation we never confirmed
             return ddeml.DDE_FNOTPROCESSED if utype in (ddeml.XTYP_POKE, ddeml.XTYP_EXECUTE) else 0
-        conv, handler = entry
+        conv, handler = entry.conv, entry.handler
         topic = self.api.query_string(hsz1)
         if utype in (ddeml.XTYP_REQUEST, ddeml.XTYP_ADVREQ):
             item = self.api.query_string(hsz2)

@@ -13,6 +13,15 @@ DDEML rules that shape this module (Microsoft's documentation, in our words):
 - ``DdePostAdvise(topic, item)`` makes DDEML send ``XTYP_ADVREQ`` to our callback for every advise
   loop on the item; data handles we return from the callback belong to DDEML.
 
+How ``DdePostAdvise`` is called is the one platform seam: an
+:class:`~nfwserver.dde.advise_posting.AdvisePoster` chosen once when the DDE thread starts (plain on
+Windows; Wine 8.0's workarounds only under Wine, :mod:`nfwserver.dde.wine_posting`).
+
+A client program that exits without ending its conversations (killed, crashed) leaves DDEML a
+conversation whose window is gone: ``DdePostAdvise`` then fails (``DMLERR_POSTMSG_FAILED``; Wine
+also stops at that link, so links after it get nothing).  The transport drops such conversations
+with one log line each, as if the client had disconnected (:meth:`WindowsDdeTransport._drop_vanished`).
+
 Everything that is not a user32 call is in :mod:`nfwserver.dde.ddeml_dispatch` and is tested on
 every platform.  On other operating systems constructing :class:`WindowsDdeTransport` raises
 :class:`OSError`.
@@ -23,13 +32,13 @@ from __future__ import annotations
 import ctypes
 import logging
 import queue
-import struct
 import sys
 import threading
 import time
 from collections.abc import Callable
 
 from nfwserver.dde import ddeml
+from nfwserver.dde.advise_posting import AdvisePoster, choose_poster
 from nfwserver.dde.ddeml_dispatch import DdemlDispatcher
 from nfwserver.dde.post_advise_stats import PostAdviseStats
 from nfwserver.dde.transport import DdeServerHandler
@@ -37,16 +46,13 @@ from nfwserver.dde.transport import DdeServerHandler
 log = logging.getLogger(__name__)
 
 _WAKE = ddeml.WM_APP + 0x4E
-_GMEM_MOVEABLE = 0x0002
 
 
 class _User32Api:  # pragma: no cover - Windows only
     """The DdemlApi over user32 for one DDEML instance."""
 
-    def __init__(self, user32, inst: int) -> None:
+    def __init__(self, user32: ddeml.User32, inst: int) -> None:
         self.u, self.inst = user32, inst
-        #: when a set: what Wine's DdePostAdvise copies of each handle made look like (_WineAdviseCopies)
-        self.wine_copies: set[bytes] | None = None
 
     def query_string(self, hsz: int) -> str:
         if not hsz:
@@ -66,73 +72,13 @@ class _User32Api:  # pragma: no cover - Windows only
 
     def create_data(self, data: bytes, hsz_item: int, fmt: int) -> int:
         buf = ctypes.create_string_buffer(data, len(data))
-        if self.wine_copies is not None:  # WINE_DDEHEAD: no flags, the format; then the data
-            self.wine_copies.add(struct.pack("<HH", 0, fmt) + data)
         return self.u.DdeCreateDataHandle(self.inst, buf, len(data), 0, hsz_item, fmt, 0) or 0
-
-
-class _WineAdviseCopies:  # pragma: no cover - Windows (Wine) only
-    """Frees the copies of advise data that Wine 8.0's ``DdePostAdvise`` leaves behind.
-
-    For every hot link Wine's ``DdePostAdvise`` copies our data handle into a new moveable global
-    block (``WDML_DataHandle2Global``: a 4-byte ``WINE_DDEHEAD`` with no flags set, then the data)
-    and posts it.  To another process the message carries a copy of the block's bytes, and nobody
-    frees the block; kernelbase has 65,536 moveable handles per process, so after that many posts
-    every ``GlobalAlloc(GMEM_MOVEABLE)`` fails and the links get ``WM_DDE_DATA`` without data
-    (100 links at 10 Hz: about 65 s; docs/PLATFORMS.md).  Windows' DDEML leaves no such block.
-
-    kernelbase hands out free handles last-freed-first.  :meth:`reserve` takes ``count`` handles and
-    frees them in reverse, so they are the next ones given out (our data handle for each link
-    takes the first and gives it back, its copy takes the next); after the post, :meth:`release`
-    frees those of them that now hold exactly a copy of data we returned for the post.  Copies
-    posted to a conversation in this process are the very block the client reads: the transport
-    does not call this while any conversation's client is in its own process.
-    """
-
-    def __init__(self, kernel32) -> None:
-        from ctypes import wintypes
-
-        self.k = kernel32
-        self.k.GlobalAlloc.restype, self.k.GlobalAlloc.argtypes = ctypes.c_void_p, [wintypes.UINT, ctypes.c_size_t]
-        self.k.GlobalFree.restype, self.k.GlobalFree.argtypes = ctypes.c_void_p, [ctypes.c_void_p]
-        self.k.GlobalSize.restype, self.k.GlobalSize.argtypes = ctypes.c_size_t, [ctypes.c_void_p]
-        self.k.GlobalLock.restype, self.k.GlobalLock.argtypes = ctypes.c_void_p, [ctypes.c_void_p]
-        self.k.GlobalUnlock.restype, self.k.GlobalUnlock.argtypes = wintypes.BOOL, [ctypes.c_void_p]
-        self.freed = 0  #: copies freed so far
-
-    def reserve(self, count: int) -> list[int]:
-        handles = []
-        for _ in range(count):
-            handle = self.k.GlobalAlloc(_GMEM_MOVEABLE, 1)
-            if not handle:
-                break
-            handles.append(handle)
-        for handle in reversed(handles):
-            self.k.GlobalFree(handle)
-        return handles
-
-    def release(self, handles: list[int], copies: set[bytes]) -> None:
-        sizes = {len(copy) for copy in copies}
-        for handle in handles:
-            size = self.k.GlobalSize(handle)  # 0 for a handle that is free again
-            if size not in sizes:
-                continue
-            ptr = self.k.GlobalLock(handle)
-            if not ptr:
-                continue
-            block = ctypes.string_at(ptr, size)
-            self.k.GlobalUnlock(handle)
-            if block in copies:
-                self.k.GlobalFree(handle)
-                self.freed += 1
 
 
 class WindowsDdeTransport:  # pragma: no cover - Windows only
     """A :class:`~nfwserver.dde.transport.DdeServerTransport` over real DDEML."""
 
     def __init__(self, start_timeout_s: float = 10.0) -> None:
-        if sys.platform != "win32":
-            raise OSError("the Windows DDE transport needs Windows")
         self._handlers: dict[str, DdeServerHandler] = {}
         self._calls: queue.Queue[Callable[[], None]] = queue.Queue()
         self._ready = threading.Event()
@@ -143,10 +89,12 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
         self._failures = 0
         #: DdePostAdvise calls on the DDE thread (each runs one XTYP_ADVREQ per advise loop)
         self.post_advise_stats = PostAdviseStats()
-        self._wine_atoms = False  #: set on the DDE thread when running under Wine (see post_advise)
-        self._wine_copies: _WineAdviseCopies | None = None  #: under Wine: frees DdePostAdvise's leftovers
-        self._local_convs: set[int] = set()  #: conversations whose client is in this process
+        self.dropped = 0  #: conversations dropped because their client vanished without disconnecting
+        self._dispatcher: DdemlDispatcher | None = None
+        self._poster: AdvisePoster | None = None  #: chosen on the DDE thread at start (module docstring)
         self._thread = threading.Thread(target=self._run, name="nfw-ddeml", daemon=True)
+        if sys.platform != "win32":
+            raise OSError("the Windows DDE transport needs Windows")
         self._thread.start()
         if not self._ready.wait(start_timeout_s) or self._error is not None:
             raise OSError(f"DDEML did not start: {self._error}")
@@ -157,24 +105,17 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
             from ctypes import wintypes
 
             self.u = ddeml.load_user32()
-            self._kernel32 = ctypes.WinDLL("kernel32")
-            self._kernel32.GlobalAddAtomW.argtypes = [wintypes.LPCWSTR]
-            self._kernel32.GlobalAddAtomW.restype = wintypes.ATOM
-            self._wine_atoms = ddeml.running_under_wine()
-            if self._wine_atoms:
-                self._wine_copies = _WineAdviseCopies(self._kernel32)
-            self.u.GetWindowThreadProcessId.restype = wintypes.DWORD
-            self.u.GetWindowThreadProcessId.argtypes = [wintypes.HWND, ctypes.POINTER(wintypes.DWORD)]
-            self._thread_id = ctypes.windll.kernel32.GetCurrentThreadId()
+            self._kernel32 = ddeml.load_kernel32()
+            self._poster = choose_poster(self.u, self._kernel32)
+            self._thread_id = self._kernel32.GetCurrentThreadId()
             inst = wintypes.DWORD(0)
-            self._dispatcher: DdemlDispatcher | None = None
             self._callback = ddeml.CALLBACK_TYPE(self._on_callback)  # kept alive as long as the instance
             flags = ddeml.APPCLASS_STANDARD | ddeml.CBF_SKIP_REGISTRATIONS | ddeml.CBF_SKIP_UNREGISTRATIONS
             err = self.u.DdeInitializeW(ctypes.byref(inst), self._callback, flags, 0)
             if err != ddeml.DMLERR_NO_ERROR:
                 raise OSError(f"DdeInitializeW failed with DMLERR 0x{err:04X}")
             self.inst = inst.value
-            self._dispatcher = DdemlDispatcher(self._lookup, _User32Api(self.u, self.inst))
+            self._dispatcher = DdemlDispatcher(self._lookup, self._poster.wrap_api(_User32Api(self.u, self.inst)))
             msg = wintypes.MSG()
             # Make sure this thread has a message queue before anyone posts to it.
             self.u.PeekMessageW(ctypes.byref(msg), None, 0, 0, 0)
@@ -196,26 +137,15 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
             self.u.DispatchMessageW(ctypes.byref(msg))
         self._shutdown()
 
-    def _on_callback(self, utype, fmt, hconv, hsz1, hsz2, hdata, data1, data2):
-        if self._dispatcher is None:
+    def _on_callback(self, utype: int, fmt: int, hconv: int | None, hsz1: int | None, hsz2: int | None,
+                     hdata: int | None, data1: int, data2: int) -> int | None:
+        if self._dispatcher is None or self._poster is None:
             return 0
-        if utype == ddeml.XTYP_CONNECT_CONFIRM and self._client_is_local(hconv or 0):
-            self._local_convs.add(hconv or 0)
+        if utype == ddeml.XTYP_CONNECT_CONFIRM:
+            self._poster.conversation_confirmed(hconv or 0)
         elif utype == ddeml.XTYP_DISCONNECT:
-            self._local_convs.discard(hconv or 0)
+            self._poster.conversation_ended(hconv or 0)
         return self._dispatcher(utype, fmt, hconv or 0, hsz1 or 0, hsz2 or 0, hdata or 0, data1, data2) or None
-
-    def _client_is_local(self, hconv: int) -> bool:
-        """Whether the conversation's client window belongs to this process (True if unknown)."""
-        from ctypes import wintypes
-
-        info = ddeml.ConvInfo()
-        info.cb = ctypes.sizeof(ddeml.ConvInfo)
-        pid = wintypes.DWORD(0)
-        if not self.u.DdeQueryConvInfo(hconv, ddeml.QID_SYNC, ctypes.byref(info)) or not info.hwndPartner:
-            return True
-        self.u.GetWindowThreadProcessId(info.hwndPartner, ctypes.byref(pid))
-        return pid.value in (0, self._kernel32.GetCurrentProcessId())
 
     def _lookup(self, service: str) -> DdeServerHandler | None:
         return self._handlers.get(service.upper())
@@ -223,7 +153,11 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
     def _string(self, text: str) -> int:
         key = text.upper()
         if key not in self._hsz:
-            self._hsz[key] = self.u.DdeCreateStringHandleW(self.inst, text, ddeml.CP_WINUNICODE)
+            hsz = self.u.DdeCreateStringHandleW(self.inst, text, ddeml.CP_WINUNICODE)
+            if not hsz:
+                raise OSError(f"DdeCreateStringHandleW could not make a handle for {text!r} "
+                              f"(DMLERR 0x{self.u.DdeGetLastError(self.inst):04X})")
+            self._hsz[key] = hsz
         return self._hsz[key]
 
     def _drain(self) -> None:
@@ -234,10 +168,13 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
                 return
             try:
                 call()
-            except Exception:  # only calls nobody waits for get here (see _call); rate-limited
+            except Exception as exc:  # only calls nobody waits for get here (see _call); rate-limited
                 self._failures += 1
                 if self._failures == 1 or self._failures % 600 == 0:
-                    log.exception("DDE transport call failed (%d failures so far)", self._failures)
+                    if isinstance(exc, OSError):  # a DDEML call that failed: its message says which
+                        log.warning("%s (%d DDE transport failures so far)", exc, self._failures)
+                    else:
+                        log.exception("DDE transport call failed (%d failures so far)", self._failures)
 
     def _shutdown(self) -> None:
         for service in list(self._registered):
@@ -279,8 +216,11 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
     # -- DdeServerTransport ----------------------------------------------------------------
     def register_service(self, service: str, handler: DdeServerHandler) -> None:
         def do() -> None:
+            try:
+                hsz = self._string(service)  # DDEML makes no string handle for an empty name
+            except OSError as exc:
+                raise OSError(f"could not register {service!r}: {exc}") from None
             self._handlers[service.upper()] = handler
-            hsz = self._string(service)
             if not self.u.DdeNameService(self.inst, hsz, None, ddeml.DNS_REGISTER):
                 self._handlers.pop(service.upper(), None)
                 raise OSError(f"DdeNameService could not register {service} "
@@ -301,38 +241,62 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
 
     def post_advise(self, topic: str, item: str) -> None:
         def do() -> None:
+            dispatcher, poster = self._dispatcher, self._poster
+            if dispatcher is None or poster is None:  # DDEML never started
+                return
             start = time.perf_counter()
-            links = self._dispatcher.advise_links(item) if self._dispatcher is not None else -1
+            links = dispatcher.advise_links(item)
             if links == 0:
                 # Nobody advises on the item: DDEML would post nothing.  Skipping the call also keeps
                 # Wine's DdePostAdvise from taking an item-atom reference that nobody releases.
                 self.post_advise_stats.add(time.perf_counter() - start, 0)
                 return
-            if self._wine_atoms:
-                # Wine's DdePostAdvise takes one reference on the item's global atom for all the
-                # WM_DDE_DATA it posts, while every client releases one: after the first client the
-                # atom is gone and the others drop their data.  Add the references Windows would.
-                for _ in range(links - 1):
-                    self._kernel32.GlobalAddAtomW(item)
-            api = self._dispatcher.api if self._dispatcher is not None else None
-            copies = self._wine_copies if not self._local_convs and isinstance(api, _User32Api) else None
-            if copies is None:
-                ok = self.u.DdePostAdvise(self.inst, self._string(topic), self._string(item))
-            else:  # under Wine: free the copies its DdePostAdvise leaves (_WineAdviseCopies)
-                assert isinstance(api, _User32Api)
-                reserved = copies.reserve(links + 4)
-                api.wine_copies = made = set()
-                try:
-                    ok = self.u.DdePostAdvise(self.inst, self._string(topic), self._string(item))
-                finally:
-                    api.wine_copies = None
-                    copies.release(reserved, made)
+            hsz_topic, hsz_item = self._string(topic), self._string(item)
+            ok = poster.post(item, links, lambda: bool(self.u.DdePostAdvise(self.inst, hsz_topic, hsz_item)))
             self.post_advise_stats.add(time.perf_counter() - start, links)
             if not ok:
                 err = self.u.DdeGetLastError(self.inst)
-                raise OSError(f"DdePostAdvise {topic}/{item} failed with DMLERR 0x{err:04X}")
+                if not self._drop_vanished(err):
+                    raise OSError(f"DdePostAdvise {topic}/{item} failed with DMLERR 0x{err:04X}")
 
         self._call(do, wait=False)
+
+    def _drop_vanished(self, err: int) -> int:
+        """After a failed ``DdePostAdvise``: drop every conversation whose client window is gone (the
+        program exited without disconnecting), one log line each; return how many were dropped.
+
+        DDEML keeps such a conversation and its advise links: every later post fails on it, and
+        Wine's stops at it, so the links after it get nothing.  Dropped, the conversation is ended
+        for the station as by ``XTYP_DISCONNECT``; ``DdeDisconnect`` lets DDEML free it (Wine 8.0
+        ignores that call on a server's conversation, but then asks us for the link's data, gets
+        none and posts nothing)."""
+        dispatcher, poster = self._dispatcher, self._poster
+        if dispatcher is None or poster is None:
+            return 0
+        dropped = 0
+        for hconv in dispatcher.handles():
+            if not self._client_vanished(hconv):
+                continue
+            name = dispatcher.describe(hconv)
+            self.u.DdeDisconnect(hconv)
+            poster.conversation_ended(hconv)
+            dispatcher.drop(hconv)
+            dropped += 1
+            self.dropped += 1
+            log.warning("DDE client of %s is gone without disconnecting (DdePostAdvise: DMLERR 0x%04X): "
+                        "conversation dropped", name, err)
+        return dropped
+
+    def _client_vanished(self, hconv: int) -> bool:
+        """DDEML no longer knows ``hconv``, or no longer counts it connected, or its client's window
+        is gone."""
+        info = ddeml.ConvInfo()
+        info.cb = ctypes.sizeof(ddeml.ConvInfo)
+        if not self.u.DdeQueryConvInfo(hconv, ddeml.QID_SYNC, ctypes.byref(info)):
+            return True
+        if not info.wStatus & ddeml.ST_CONNECTED:
+            return True
+        return bool(info.hwndPartner) and not self.u.IsWindow(info.hwndPartner)
 
     def close(self) -> None:
         if self._closed:
@@ -344,5 +308,6 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
         self._call(do, wait=False)
         self._thread.join(5.0)
         log.info("%s", self.post_advise_stats.summary())  # the DDE thread has stopped adding
-        if self._wine_copies is not None:
-            log.info("Wine: freed %d advise data copies DdePostAdvise left behind", self._wine_copies.freed)
+        summary = self._poster.summary() if self._poster is not None else None
+        if summary is not None:
+            log.info("%s", summary)

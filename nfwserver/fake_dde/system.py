@@ -197,7 +197,7 @@ class FakeDdeSystem:
             data = self._call(conv, "request", lambda: conv.handler.on_request(conv_id, conv.topic, item, fmt))
             if data is None:
                 raise DdeError(DMLERR_NOTPROCESSED, f"the server refused the request for {item!r}")
-            reply: bytes = bytes(data)  # type: ignore[call-overload]
+            reply: bytes = bytes(data)  # type: ignore[call-overload]  # on_request's bytes, through _call
             conv.client._deliver(Received(next(self._seq), "reply", item, fmt, reply))
             return reply
 
@@ -377,4 +377,5 @@ class ClientConversation:
 
     def texts(self, kinds: tuple[str, ...] = ("data",)) -> list[str]:
         """Decoded texts of everything received of the given kinds, in order."""
+        # r.data is not None, so r.text is a str
         return [r.text for r in self.received if r.kind in kinds and r.data is not None]  # type: ignore[misc]

@@ -98,8 +98,8 @@ class DopplerTuner:
                 self.backend.set_rx_frequency(rx_hz)
                 self._last_rx = rx_hz
             sent_tx = tx_hz is not None and (self._last_tx is None or abs(tx_hz - self._last_tx) >= self.step_hz)
-            if sent_tx:
-                self.backend.set_tx_frequency(tx_hz)  # type: ignore[arg-type]
+            if sent_tx and tx_hz is not None:
+                self.backend.set_tx_frequency(tx_hz)
                 self._last_tx = tx_hz
         except RadioUnavailable as exc:
             if self.available:

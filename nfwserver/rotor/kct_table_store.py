@@ -103,9 +103,10 @@ class TimeTargetTable:
             return ADD_FULL
         self.entries.append(entry)
         if isinstance(entry, NormalEntry):
+            # every entry has the table's one kind (checked above): here all are NormalEntry
             self.entries.sort(key=lambda e: e.time)  # type: ignore[union-attr]
         else:
-            self.entries.sort(key=lambda e: e.start_minute)  # type: ignore[union-attr]
+            self.entries.sort(key=lambda e: e.start_minute)  # type: ignore[union-attr]  # all RepetitiveEntry
         return ADD_OK
 
     def set_mode(self, mode: TableMode, cycle_minutes: int, now: datetime) -> bool:

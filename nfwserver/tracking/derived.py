@@ -16,10 +16,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from datetime import datetime
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from nfwserver.tracking.bodies import sun_view
+
+if TYPE_CHECKING:
+    from sgp4.api import Satrec
 from nfwserver.tracking.constants import (
     PREDICT_EARTH_RADIUS_KM,
     PREDICT_FOOTPRINT_FACTOR_KM,
@@ -67,12 +71,12 @@ def geodetic_from_itrs(x: float, y: float, z: float) -> tuple[float, float, floa
     return math.degrees(lat), math.degrees(lon), height
 
 
-def sub_satellite_point(satrec: object, when: datetime, ut1_utc: float = 0.0) -> tuple[float, float, float] | None:
+def sub_satellite_point(satrec: Satrec, when: datetime, ut1_utc: float = 0.0) -> tuple[float, float, float] | None:
     """(geodetic latitude deg, east longitude deg -180..180, altitude km) under the satellite, or None when
     SGP4 fails.  SGP4's TEME position taken to the ITRS by the one rotation of :mod:`~nfwserver.tracking.frames`
     (GMST 1982 at UT1), polar motion neglected (metres)."""
     jd, fr = julian_date(when)
-    err, r, _ = satrec.sgp4(jd, fr)  # type: ignore[attr-defined]
+    err, r, _ = satrec.sgp4(jd, fr)
     if err:
         return None
     pos, _ = teme_to_itrs(np.asarray(r, dtype=float), None, jd, fr, ut1_utc)

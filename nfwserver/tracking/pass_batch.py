@@ -14,7 +14,7 @@ Times are seconds after each satellite's own reference instant (the start of its
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -43,7 +43,7 @@ class Layout:
         return keys
 
     def search(self, key_sat: np.ndarray, keys: np.ndarray, q_sat: np.ndarray, q_keys: np.ndarray,
-               side: str) -> np.ndarray:
+               side: Literal["left", "right"]) -> np.ndarray:
         """``np.searchsorted`` of the queries among ``keys`` (of pairs sorted by satellite, then time), each
         query among the keys of its own chunk (positions into the whole of ``keys``)."""
         out = np.empty(len(q_keys), dtype=np.intp)
@@ -52,7 +52,7 @@ class Layout:
         for c in np.unique(q_chunk).tolist():
             mine = q_chunk == c
             lo, hi = bounds[c], bounds[c + 1]
-            out[mine] = lo + np.searchsorted(keys[lo:hi], q_keys[mine], side=side)  # type: ignore[call-overload]
+            out[mine] = lo + np.searchsorted(keys[lo:hi], q_keys[mine], side=side)
         return out
 
 

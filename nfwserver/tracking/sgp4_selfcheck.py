@@ -56,13 +56,13 @@ class Sgp4Choice:
     detail: str
 
 
-def reference_error_km(twoline2rv: Callable[[str, str], object]) -> float:
+def reference_error_km(twoline2rv: Callable[[str, str], sgp4.api.Satrec]) -> float:
     """Largest position error (km) of ``twoline2rv(line1, line2)`` against the reference; inf on failure."""
     try:
         satrec = twoline2rv(REFERENCE_LINE1, REFERENCE_LINE2)
         worst = 0.0
         for minutes, expected in REFERENCE_POSITIONS_KM.items():
-            err, position, _ = satrec.sgp4_tsince(minutes)  # type: ignore[attr-defined]
+            err, position, _ = satrec.sgp4_tsince(minutes)
             if err != 0:
                 return math.inf
             worst = max(worst, math.dist(position, expected))

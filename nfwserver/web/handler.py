@@ -58,7 +58,7 @@ class WebHandler(BaseHTTPRequestHandler):
     protocol_version = "HTTP/1.0"  # one request per connection: the event stream ends with the connection
 
     def setup(self) -> None:
-        web = self.server.web  # type: ignore[attr-defined]
+        web = self.server.web  # type: ignore[attr-defined]  # our _HttpServer, typed as socketserver's BaseServer
         self.timeout = web.io_timeout_s  # type: ignore[misc]  # socketserver reads it per instance
         super().setup()
         if web.send_buffer_bytes:
@@ -66,7 +66,7 @@ class WebHandler(BaseHTTPRequestHandler):
 
     @property
     def web(self) -> Any:
-        return self.server.web  # type: ignore[attr-defined]
+        return self.server.web  # type: ignore[attr-defined]  # our _HttpServer (see setup)
 
     @property
     def peer(self) -> str:

@@ -24,15 +24,21 @@ import logging
 import threading
 from collections.abc import Callable, Sequence
 from datetime import datetime, timedelta
+from typing import TYPE_CHECKING
 
 from nfwserver.clock import Clock
-from nfwserver.core.state import StationState
+from nfwserver.core.state import StateSnapshot, StationState
 from nfwserver.rotor.coupling import RotorCoupling
 from nfwserver.rotor.flip import plan_pass
+from nfwserver.tracking.catalog import Satellite
 from nfwserver.tracking.derived import sub_satellite_point
 from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError
+from nfwserver.tracking.observer import Observer
 from nfwserver.tracking.passes import Pass, find_passes
 from nfwserver.web.state_view import iso
+
+if TYPE_CHECKING:
+    from sgp4.api import Satrec
 
 log = logging.getLogger(__name__)
 
@@ -46,22 +52,22 @@ REFRESH_S = 120.0
 MAX_PASSES = 12
 
 
-def _track(calc: LookAngleCalculator, satrec: object, p: Pass, now: datetime) -> list[tuple[float, float]]:
+def _track(calc: LookAngleCalculator, satrec: Satrec, p: Pass, now: datetime) -> list[tuple[float, float]]:
     start = p.aos or now
     end = p.los or (start + timedelta(minutes=20))
     out: list[tuple[float, float]] = []
     t = start
     while t <= end and len(out) < 2000:
-        la = calc.compute(satrec, t)  # type: ignore[arg-type]
+        la = calc.compute(satrec, t)
         out.append((round(la.azimuth_deg, 2), round(la.elevation_deg, 2)))
         t += timedelta(seconds=TRACK_STEP_S)
     return out
 
 
-def _point(calc: LookAngleCalculator, satrec: object, when: datetime | None) -> dict[str, object] | None:
+def _point(calc: LookAngleCalculator, satrec: Satrec, when: datetime | None) -> dict[str, object] | None:
     if when is None:
         return None
-    la = calc.compute(satrec, when)  # type: ignore[arg-type]
+    la = calc.compute(satrec, when)
     return {"time": iso(when), "az": round(la.azimuth_deg, 2), "el": round(la.elevation_deg, 2)}
 
 
@@ -183,20 +189,20 @@ class PassBoard:
         except ValueError:
             return None
 
-    def _row(self, p: Pass, sat: object, calc: LookAngleCalculator, now: datetime) -> dict[str, object]:
+    def _row(self, p: Pass, sat: Satellite | None, calc: LookAngleCalculator, now: datetime) -> dict[str, object]:
         flipped = None
         if sat is not None and self.rotor is not None:
             try:
-                flipped = self._flipped(_track(calc, sat.satrec, p, now))  # type: ignore[attr-defined]
+                flipped = self._flipped(_track(calc, sat.satrec, p, now))
             except PropagationError:
                 flipped = None
-        return {"catalog_number": p.catalog_number, "name": getattr(sat, "dde_name", str(p.catalog_number)),
+        return {"catalog_number": p.catalog_number, "name": sat.dde_name if sat is not None else str(p.catalog_number),
                 "aos": iso(p.aos), "tca": iso(p.tca), "los": iso(p.los),
                 "max_el": round(p.max_elevation_deg, 1), "duration_s": p.duration_s,
                 "in_progress": p.aos is None or p.aos <= now, "flipped": flipped}
 
-    def _selected_track(self, sat, found: list[Pass], observer, snap, calc: LookAngleCalculator,
-                        now: datetime) -> dict[str, object] | None:
+    def _selected_track(self, sat: Satellite, found: list[Pass], observer: Observer, snap: StateSnapshot,
+                        calc: LookAngleCalculator, now: datetime) -> dict[str, object] | None:
         own = [p for p in found if p.catalog_number == sat.catalog_number]
         if not own:
             own = [p for p in find_passes([sat], observer, now, now + timedelta(hours=NEXT_PASS_HOURS),
@@ -215,7 +221,7 @@ class PassBoard:
             return None
 
     @staticmethod
-    def _ground_track(satrec: object, now: datetime, ut1_utc: float) -> list[list[float]]:
+    def _ground_track(satrec: Satrec, now: datetime, ut1_utc: float) -> list[list[float]]:
         out = []
         t = now - timedelta(seconds=GROUND_BEFORE_S)
         end = now + timedelta(seconds=GROUND_AFTER_S)

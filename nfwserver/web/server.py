@@ -32,6 +32,7 @@ from typing import Any
 
 from nfwserver.config.schema import WebConfig
 from nfwserver.core.events import Direction
+from nfwserver.core.faces import CountsClients, CountsConversations
 from nfwserver.core.sample import TickSample
 from nfwserver.core.station_core import StationCore
 from nfwserver.easycomm.output import EasyCommOutput
@@ -68,8 +69,8 @@ class StationParts:
     rotor: RotorCoupling | None = None
     radio: RadioCoupling | None = None
     easycomm: EasyCommOutput | None = None
-    tcp: Any = None  #: NovaTcpServer (client_count)
-    nova: Any = None  #: NovaDdeService (client_count: conversations, advise loops)
+    tcp: CountsClients | None = None  #: NovaTcpServer
+    nova: CountsConversations | None = None  #: NovaDdeService
     favourites: Callable[[], Sequence[int]] = field(default=lambda: ())
 
 
@@ -87,7 +88,7 @@ class _HttpServer(ThreadingHTTPServer):
     allow_reuse_address = True
     request_queue_size = 64
 
-    def __init__(self, address: tuple, web: WebServer, family: int) -> None:
+    def __init__(self, address: tuple[Any, ...], web: WebServer, family: int) -> None:
         self.address_family = family
         self.web = web
         super().__init__(address, WebHandler)
@@ -147,6 +148,7 @@ class WebServer:
             self._httpd = _HttpServer(sockaddr, self, family)
         except OSError as exc:
             raise bind_failure(exc, "web", self.config.host, self.config.port) from None
+        # an AF_INET or AF_INET6 listener: its address starts with (host, port)
         self.address = self._httpd.server_address[:2]  # type: ignore[assignment]
         self._stop.clear()
         self.hub.reopen()

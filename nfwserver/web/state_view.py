@@ -51,7 +51,8 @@ def position_part(sample: TickSample | None) -> dict[str, object] | None:
             "above_horizon": sample.above_horizon}
 
 
-def realtime_part(core: StationCore, sample: TickSample | None) -> tuple[dict | None, dict | None]:
+def realtime_part(core: StationCore,
+                  sample: TickSample | None) -> tuple[dict[str, object] | None, dict[str, object] | None]:
     """(sub-satellite point and footprint, Doppler of the satellite's channel) for the tick's instant."""
     state = core.state.snapshot()
     sat = state.satellite

@@ -157,3 +157,26 @@ def test_post_advise_stats_line_counts_links_like_ddeml_and_reads_back() -> None
                                   "steady_mean_ms": 3.0, "steady_max_ms": 4.0, "idle_count": 2,
                                   "idle_mean_ms": 2.0, "idle_max_ms": 3.0}
     assert parse_summary("no such line") is None
+
+
+def test_a_dropped_conversation_ends_its_links_and_gets_no_more_advise_data() -> None:
+    """What the transport does for a client that vanished without disconnecting (windows_transport's
+    _drop_vanished): the conversation ends for the station as by XTYP_DISCONNECT, and the XTYP_ADVREQ
+    DDEML still sends for its stale link gets no data, so DDEML posts nothing to the dead window."""
+    server, api, dispatch = _setup()
+    assert _connect(api, dispatch, "NFW32", hconv=77) and _connect(api, dispatch, "NFW_SERVER", hconv=78)
+    topic, item = api.hsz("NFW_DATA"), api.hsz("NFW_SERVER")
+    for hconv in (77, 78):
+        assert dispatch(ddeml.XTYP_ADVSTART, CF_TEXT, hconv, topic, item, 0) == 1
+    server.core.tick()
+    assert dispatch.advise_links("nfw_server") == 2 and server.client_count() == (2, 2)
+    assert dispatch.describe(78) == "conversation 2 (NFW_SERVER/NFW_DATA)"
+    assert sorted(dispatch.handles()) == [77, 78]
+    dispatch.drop(78)
+    assert dispatch.handles() == [77] and dispatch.advise_links("NFW_SERVER") == 1
+    assert server.client_count() == (1, 1)
+    assert dispatch(ddeml.XTYP_ADVREQ, CF_TEXT, 78, topic, item, 0) == 0
+    assert dispatch(ddeml.XTYP_ADVREQ, CF_TEXT, 77, topic, item, 0) != 0
+    assert dispatch.describe(78) == "conversation handle 0x4E"
+    dispatch.drop(78)  # twice: nothing more happens
+    assert server.client_count() == (1, 1)
