@@ -148,16 +148,22 @@ def _stop_process(rig: FaultRig) -> None:
         time.sleep(0.001)
 
 
-def _tcp_junk(rig: FaultRig) -> None:
+def _tcp_send(rig: FaultRig, data: bytes, replies: int) -> bytes:
+    """Send ``data`` to the station's TCP port and read the greeting and ``replies`` lines after it."""
     assert rig.station.tcp is not None
     with socket.create_connection(rig.station.tcp.address, timeout=2.0) as s:
-        s.sendall(b"\x0b\r\n\x0c\r\n\x1c\x1d\x1e\x1f\r\n" * 50 + b"SUMMARY\r\n")
-        data = b""
-        while data.count(b"\r\n") < 2:
+        s.sendall(data)
+        got = b""
+        while got.count(b"\r\n") < 1 + replies:
             chunk = s.recv(65536)
             if not chunk:
                 break
-            data += chunk
+            got += chunk
+    return got
+
+
+def _tcp_junk(rig: FaultRig) -> None:
+    _tcp_send(rig, b"\x0b\r\n\x0c\r\n\x1c\x1d\x1e\x1f\r\n" * 50 + b"SUMMARY\r\n", 1)
 
 
 def _nothing(rig: FaultRig) -> None:
@@ -203,15 +209,7 @@ def tcp_served(rig: FaultRig, record: TickRecord) -> bool:
 
 def _foreign_digits(rig: FaultRig) -> None:
     """Pokes with other scripts' digits (SAT=², ANTAZ=٣) over TCP and DDE: refused, nothing else changes."""
-    assert rig.station.tcp is not None
-    with socket.create_connection(rig.station.tcp.address, timeout=2.0) as s:
-        s.sendall("SAT=²\r\nANTAZ=٣\r\nSAT=２５５４４\r\n".encode())
-        data = b""
-        while data.count(b"\r\n") < 4:
-            chunk = s.recv(65536)
-            if not chunk:
-                break
-            data += chunk
+    _tcp_send(rig, "SAT=²\r\nANTAZ=٣\r\nSAT=２５５４４\r\n".encode(), 3)
     conv = rig.system.connect("NFW32", "NFW_DATA", client_name="digits")
     for text in ("SAT=²", "ANTEL=١"):
         try:
