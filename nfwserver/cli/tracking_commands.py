@@ -222,8 +222,6 @@ def run_passes(args: argparse.Namespace) -> int:
 def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str], dict[int, str]]:
     """The passes the options ask for, and the name and the DDE name (at most 12 characters) to show for each
     satellite that has one (by catalog number)."""
-    import numpy as np
-
     from nfwserver.cli.tracking_options import TrackingInputs
     from nfwserver.tracking.passes import find_passes
 
@@ -234,7 +232,7 @@ def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str], di
     sets = _screen(sets, catalog, observer, ut1_utc, start, _stale_days(inputs))
     passes = find_passes(sets, observer, start, start + timedelta(hours=args.hours), horizon=horizon,
                          ut1_utc=ut1_utc, workers=args.workers)
-    numbers = np.unique(passes.columns["catalog_number"]).tolist()
+    numbers = sorted(set(passes.columns["catalog_number"].tolist()))  # (np.unique would import numpy.ma)
     return (passes, dict(zip(numbers, _display_names(numbers, sets, catalog))),
             {n: _dde_name(catalog, n) for n in numbers})
 

@@ -49,7 +49,7 @@ class Layout:
         out = np.empty(len(q_keys), dtype=np.intp)
         bounds = np.searchsorted(key_sat, self.chunk_starts).tolist() + [len(keys)]
         q_chunk = np.searchsorted(self.chunk_starts, q_sat, side="right") - 1
-        for c in np.unique(q_chunk).tolist():
+        for c in sorted(set(q_chunk.tolist())):  # (np.unique would import numpy.ma: 6 ms, 1.3 MiB)
             mine = q_chunk == c
             lo, hi = bounds[c], bounds[c + 1]
             out[mine] = lo + np.searchsorted(keys[lo:hi], q_keys[mine], side=side)  # type: ignore[call-overload]
