@@ -232,7 +232,7 @@ def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str], di
     sets = _screen(sets, catalog, observer, ut1_utc, start, _stale_days(inputs))
     passes = find_passes(sets, observer, start, start + timedelta(hours=args.hours), horizon=horizon,
                          ut1_utc=ut1_utc, workers=args.workers)
-    numbers = sorted(set(passes.columns["catalog_number"].tolist()))  # (np.unique would import numpy.ma)
+    numbers = passes.catalog_numbers()
     return (passes, dict(zip(numbers, _display_names(numbers, sets, catalog))),
             {n: _dde_name(catalog, n) for n in numbers})
 

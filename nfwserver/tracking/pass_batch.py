@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from nfwserver.tracking.pass_records import distinct
 from nfwserver.tracking.pass_screen import Brackets, Intervals
 
 #: Key spacing per satellite when sorting (sat, t) pairs as one float (s; far above any span).
@@ -49,7 +50,7 @@ class Layout:
         out = np.empty(len(q_keys), dtype=np.intp)
         bounds = np.searchsorted(key_sat, self.chunk_starts).tolist() + [len(keys)]
         q_chunk = np.searchsorted(self.chunk_starts, q_sat, side="right") - 1
-        for c in sorted(set(q_chunk.tolist())):  # (np.unique would import numpy.ma: 6 ms, 1.3 MiB)
+        for c in distinct(q_chunk).tolist():
             mine = q_chunk == c
             lo, hi = bounds[c], bounds[c + 1]
             out[mine] = lo + np.searchsorted(keys[lo:hi], q_keys[mine], side=side)  # type: ignore[call-overload]
