@@ -20,8 +20,6 @@ from nfwserver.cli.arguments import number_in, satellite_value, time_value
 from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs, warn
 
 if TYPE_CHECKING:
-    from collections.abc import Iterable
-
     from nfwserver.cli.tracking_options import TrackingInputs
     from nfwserver.tracking.catalog import Catalog, Satellite
     from nfwserver.tracking.observer import Observer
@@ -125,18 +123,20 @@ def _stale_days(inputs: TrackingInputs) -> float:
 
 def _dde_names(sats: list[Any], catalog: Catalog) -> str:
     """The DDE names of satellites or element sets (those of the catalog's satellites), comma-separated."""
-    return ", ".join(s.dde_name if hasattr(s, "dde_name") else _dde_name(catalog, s.catalog_number) for s in sats)
+    unnamed = [s.catalog_number for s in sats if not hasattr(s, "dde_name")]
+    made = iter(catalog.dde_names_of(unnamed) if unnamed else ())
+    return ", ".join(s.dde_name if hasattr(s, "dde_name") else next(made) for s in sats)
 
 
-def _dde_name(catalog: Catalog, catalog_number: int) -> str:
-    sat = catalog.get(catalog_number)
-    return sat.dde_name if sat is not None else str(catalog_number)
-
-
-def _display_names(numbers: Iterable[int], sets: list[Any], catalog: Catalog) -> list[str]:
+def _display_names(numbers: list[int], sets: list[Any], catalog: Catalog) -> list[str]:
     """The name shown for each catalog number: the element set's name, else the satellite's DDE name."""
-    by_number = {es.catalog_number: es for es in sets}
-    return [by_number[n].name or _dde_name(catalog, n) for n in numbers]
+    by_number = {es.catalog_number: es.name for es in sets}
+    names = [by_number[n] for n in numbers]
+    unnamed = [n for n, name in zip(numbers, names) if not name]
+    if unnamed:
+        made = dict(zip(unnamed, catalog.dde_names_of(unnamed)))
+        names = [name or made[n] for n, name in zip(numbers, names)]
+    return names
 
 
 def run_ephemeris(args: argparse.Namespace) -> int:
@@ -220,8 +220,8 @@ def run_passes(args: argparse.Namespace) -> int:
 
 
 def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str], dict[int, str]]:
-    """The passes the options ask for, and the name and the DDE name (at most 12 characters) to show for each
-    satellite that has one (by catalog number)."""
+    """The passes the options ask for, and the name and the DDE name (at most 12 characters; only for the
+    compact table, which alone shows them) to show for each satellite that has one (by catalog number)."""
     from nfwserver.cli.tracking_options import TrackingInputs
     from nfwserver.tracking.passes import find_passes
 
@@ -233,8 +233,9 @@ def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str], di
     passes = find_passes(sets, observer, start, start + timedelta(hours=args.hours), horizon=horizon,
                          ut1_utc=ut1_utc, workers=args.workers)
     numbers = passes.catalog_numbers()
+    compact = args.format == "table" and not args.wide  # the only output that shows DDE names
     return (passes, dict(zip(numbers, _display_names(numbers, sets, catalog))),
-            {n: _dde_name(catalog, n) for n in numbers})
+            dict(zip(numbers, catalog.dde_names_of(numbers))) if compact else {})
 
 
 def _chosen_sets(args: argparse.Namespace, inputs: TrackingInputs, catalog: Catalog) -> list[Any]:
