@@ -96,7 +96,8 @@ def _classify(sat: np.ndarray, t: np.ndarray, f: np.ndarray, f_rate: np.ndarray,
     With the height above the horizontal plane ``up`` (km) and its rate (km/s) at the samples (a
     flat horizon at 0 deg, where a crossing is a root of ``up``), crossings get a first guess; with a
     bound on the fourth derivative of ``up`` at each sample's satellite too (``up_jerk_rate``, km/s^4),
-    hidden peaks that provably stay below the horizon are dropped (:func:`_can_rise`).
+    hidden peaks that provably stay below the horizon are dropped and the others get a first guess
+    (:func:`_can_rise`).
     """
     i = np.flatnonzero(link)
     j = i + 1
@@ -104,9 +105,12 @@ def _classify(sat: np.ndarray, t: np.ndarray, f: np.ndarray, f_rate: np.ndarray,
     cross = np.isfinite(fa) & np.isfinite(fb) & ((fa > 0.0) != (fb > 0.0))
     turn = (f_rate[i] >= 0.0) & (f_rate[j] <= 0.0)
     peak = turn & (fa <= 0.0) & (fb <= 0.0) & kept[i] & np.isfinite(fa) & np.isfinite(fb)
+    peak_guess = None
     if up is not None and up_rate is not None and up_jerk_rate is not None and peak.any():
         k = i[peak]
-        peak[peak] = _can_rise(t[k], t[k + 1], up[k], up[k + 1], up_rate[k], up_rate[k + 1], up_jerk_rate[k])
+        rise, top_at = _can_rise(t[k], t[k + 1], up[k], up[k + 1], up_rate[k], up_rate[k + 1], up_jerk_rate[k])
+        peak[peak] = rise
+        peak_guess = top_at[rise]
     culm = (el_rate[i] >= 0.0) & (el_rate[j] <= 0.0) & ((fa > 0.0) | (fb > 0.0))
 
     def pick(mask: np.ndarray, values: np.ndarray, guess: np.ndarray | None = None) -> Intervals:
@@ -118,32 +122,38 @@ def _classify(sat: np.ndarray, t: np.ndarray, f: np.ndarray, f_rate: np.ndarray,
     if up is not None and up_rate is not None:
         k = i[cross]
         guess = _hermite_root(t[k], t[k + 1], up[k], up[k + 1], up_rate[k], up_rate[k + 1])
-    return Brackets(pick(cross, f, guess), pick(peak, f_rate), pick(culm, el_rate))
+    return Brackets(pick(cross, f, guess), pick(peak, f_rate, peak_guess), pick(culm, el_rate))
 
 
 def _can_rise(a: np.ndarray, b: np.ndarray, ya: np.ndarray, yb: np.ndarray, da: np.ndarray, db: np.ndarray,
-              m4: np.ndarray) -> np.ndarray:
+              m4: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Whether the height above the horizontal plane (values ``y`` in km and rates ``d`` in km/s at the ends
     of ``[a, b]``, s) may reach 0 inside: the maximum of its cubic Hermite interpolant plus the
     interpolation error bound ``m4 h^4 / 384`` (``m4``: a bound on the fourth derivative, km/s^4).  A
     hidden peak that cannot rise is dropped here, before any SGP4 call (most hidden peaks are orbits
-    passing far from the observer; the refinement would spend two or three evaluations on each)."""
+    passing far from the observer; the refinement would spend two or three evaluations on each).
+
+    Also returns where the interpolant peaks (s): the first guess of the elevation's maximum (the two peak
+    within seconds of each other, and the guess saves the refinement about two evaluations a peak)."""
     h = b - a
     p0, p1, m0, m1 = ya, yb, da * h, db * h
     c1 = m0
     c2 = -3.0 * p0 - 2.0 * m0 + 3.0 * p1 - m1
     c3 = 2.0 * p0 + m0 - 2.0 * p1 + m1
     top = np.maximum(p0, p1)
+    at = np.where(p0 > p1, 0.0, 1.0)
     with np.errstate(invalid="ignore", divide="ignore"):
         # Stationary points of the cubic on [0, 1]: roots of c1 + 2 c2 x + 3 c3 x^2.
         disc = c2 * c2 - 3.0 * c3 * c1
         root = np.sqrt(np.maximum(disc, 0.0))
         for x in ((-c2 + root) / (3.0 * c3), (-c2 - root) / (3.0 * c3), -c1 / (2.0 * c2)):
             x = np.clip(np.nan_to_num(x, nan=0.0, posinf=0.0, neginf=0.0), 0.0, 1.0)
-            top = np.maximum(top, p0 + x * (c1 + x * (c2 + x * c3)))
+            y = p0 + x * (c1 + x * (c2 + x * c3))
+            at = np.where(y > top, x, at)
+            top = np.maximum(top, y)
     h2 = h * h
     reach: np.ndarray = ~(top + m4 * h2 * h2 / 384.0 < 0.0)  # NaN: kept
-    return reach
+    return reach, a + at * h
 
 
 def _up_jerk_bound(satrecs: list[Any]) -> np.ndarray:
