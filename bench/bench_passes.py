@@ -82,23 +82,29 @@ def _median(runs: list[tuple[float, float, int]], fmt: str = "csv") -> tuple[flo
             runs[0][2] - (2 if fmt == "json" else 1))
 
 
-def _startup() -> list[tuple[str, float]]:
+def _startup() -> list[tuple[str, float, float]]:
+    """Median wall time and largest peak RSS (MiB) of short whole processes: the interpreter's floor, numpy's,
+    and commands that must start at once."""
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         closed = str(s.getsockname()[1])
     rows = []
     for label, cmd in (("bare interpreter (`python -c pass`)", ["-c", "pass"]),
+                       ("interpreter and numpy (`python -c 'import numpy'`)", ["-c", "import numpy"]),
                        ("`nfwserver --version`", ["-m", "nfwserver", "--version"]),
                        ("`nfwserver status` (no station: refused at once)",
                         ["-m", "nfwserver", "status", "--port", closed]),
                        ("`nfwserver passes --help`", ["-m", "nfwserver", "passes", "--help"]),
                        ("`nfwserver config path`", ["-m", "nfwserver", "config", "path"])):
-        times = []
+        times, peaks = [], []
         for _ in range(7):
             started = time.perf_counter()
-            subprocess.run([sys.executable, *cmd], cwd=ROOT, capture_output=True)
+            proc = subprocess.Popen([sys.executable, *cmd], cwd=ROOT, stdout=subprocess.DEVNULL,
+                                    stderr=subprocess.DEVNULL)
+            _, _, usage = os.wait4(proc.pid, 0)
             times.append(time.perf_counter() - started)
-        rows.append((label, statistics.median(times)))
+            peaks.append(usage.ru_maxrss / 1024.0)
+        rows.append((label, statistics.median(times), max(peaks)))
     return rows
 
 
@@ -166,10 +172,10 @@ def main() -> None:
           "process; a clear speed-up with `--workers 2` on 2 cores. Accuracy is a test, not a benchmark: "
           "tests/tracking/test_pass_accuracy.py checks AOS/LOS to 10 ms and maximum elevations to 0.001 deg "
           "against skyfield's geometry sampled densely.\n")
-    print("| start-up (whole process) | median of 7 |")
-    print("|---|---|")
-    for label, seconds in startup:
-        print(f"| {label} | {seconds * 1e3:.0f} ms |")
+    print("| start-up (whole process) | median of 7 | peak RSS |")
+    print("|---|---|---|")
+    for label, seconds, peak in startup:
+        print(f"| {label} | {seconds * 1e3:.0f} ms | {peak:.0f} MiB |")
     print()
 
 
