@@ -86,7 +86,8 @@ class Batch:
 
     def merged(self) -> tuple[list[Any], np.ndarray, np.ndarray, Layout, Brackets]:
         """The batch's models, per-satellite reference instants (jd0, fr0), layout, and the brackets of
-        every chunk with batch satellite indices."""
+        every chunk with batch satellite indices.  Empties the batch: the chunks' own brackets are freed
+        while the merged ones are refined."""
         counts = [len(c.models) for c in self.chunks]
         starts = np.concatenate(([0], np.cumsum(counts)[:-1])).astype(np.intp)
 
@@ -105,5 +106,7 @@ class Batch:
                 part.sat = part.sat + first
                 parts[kind].append(part)
         brackets = Brackets(*(Intervals.concat(parts[kind]) for kind in kinds))
-        return (models, per_sat([c.jd0 for c in self.chunks]), per_sat([c.fr0 for c in self.chunks]), layout,
-                brackets)
+        jd0, fr0 = per_sat([c.jd0 for c in self.chunks]), per_sat([c.fr0 for c in self.chunks])
+        del parts
+        self.chunks, self.size = [], 0
+        return models, jd0, fr0, layout, brackets
