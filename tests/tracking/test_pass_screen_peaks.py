@@ -92,3 +92,21 @@ def test_a_one_process_search_leaves_numpy_ma_and_multiprocessing_unimported(tmp
             "print('numpy.ma' in sys.modules, 'multiprocessing' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split()[-2:] == ["False", "False"]
+
+
+@pytest.mark.parametrize("shape", [[], ["--wide"], ["--format", "csv"], ["--format", "json"]])
+def test_stale_sets_are_named_in_every_output(capsys, tmp_path, shape) -> None:
+    """The warning about stale sets names them by DDE name whatever the output (the compact table names them
+    after the search, with its own satellites), before any row."""
+    from nfwserver.cli import main
+
+    lines = (DATA / "active.txt").read_text().splitlines()
+    picked = [k for k in range(0, len(lines), 3) if lines[k].startswith(("USA 270", "USA 271", "ISS (ZARYA)"))]
+    elements = tmp_path / "some.txt"
+    elements.write_text("\n".join(line for k in picked for line in lines[k : k + 3]) + "\n")
+    assert main(["passes", "--elements", str(elements), "--observer", "52.2,0.12,20", "--start",
+                 "2026-05-08T00:00:00Z", *shape]) == 0
+    out, err = capsys.readouterr()
+    assert "2 element set(s) are more than 14 days older than 2026-05-08T00:00:00.000Z" in err
+    assert "(USA-270, USA-271)" in err
+    assert "ISS" in out
