@@ -83,11 +83,15 @@ def _median(runs: list[tuple[float, float, int]], fmt: str = "csv") -> tuple[flo
 
 
 def _startup() -> list[tuple[str, float]]:
+    """Median wall time of short whole processes: the interpreter's floor, numpy's, and commands that must start
+    at once.  (No peak RSS here: a child's ``wait4`` maximum includes the pages it shared with this process
+    before its ``exec``, about 22 MiB, more than these processes use.)"""
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         closed = str(s.getsockname()[1])
     rows = []
     for label, cmd in (("bare interpreter (`python -c pass`)", ["-c", "pass"]),
+                       ("interpreter and numpy (`python -c 'import numpy'`)", ["-c", "import numpy"]),
                        ("`nfwserver --version`", ["-m", "nfwserver", "--version"]),
                        ("`nfwserver status` (no station: refused at once)",
                         ["-m", "nfwserver", "status", "--port", closed]),

@@ -31,11 +31,12 @@ def _justify(cells: Cells, width: int) -> np.ndarray:
     """The cells padded with blanks to ``width``: right-aligned where ``cells.right``, else left-aligned."""
     codes = cells.codes
     out = np.zeros((len(codes), width), dtype=codes.dtype)
-    # Each row's content moves right by its shift; rows sharing a shift move together (a column has few).
+    # Each row's content moves right by its shift; rows sharing a shift move together (a column has few;
+    # a set, not np.unique, which would import numpy.ma).
     shift = np.where(cells.right, width - cells.lengths, 0) - cells.offsets
     first = int(shift[0]) if len(shift) else 0
     groups = [(first, slice(None))] if (shift == first).all() else [
-        (value, np.flatnonzero(shift == value)) for value in np.unique(shift).tolist()]
+        (value, np.flatnonzero(shift == value)) for value in sorted(set(shift.tolist()))]
     for value, rows in groups:
         lo, hi = max(0, -value), min(codes.shape[1], width - value)  # source columns that stay inside
         out[rows, lo + value : hi + value] = codes[rows, lo:hi]

@@ -20,8 +20,6 @@ from nfwserver.cli.arguments import number_in, satellite_value, time_value
 from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs, warn
 
 if TYPE_CHECKING:
-    from collections.abc import Iterable
-
     from nfwserver.cli.tracking_options import TrackingInputs
     from nfwserver.tracking.catalog import Catalog, Satellite
     from nfwserver.tracking.observer import Observer
@@ -98,9 +96,10 @@ def _pick(catalog: Catalog, text: str) -> Satellite:
 
 
 def _screen(sats: list[Any], catalog: Catalog, observer: Observer, ut1_utc: float, at: datetime,
-            stale_days: float) -> list[Any]:
-    """The satellites (or element sets) whose positions at ``at`` are usable; the rest and sets older than
-    ``stale_days`` (``[elements] stale_days``) are reported (by DDE name)."""
+            stale_days: float, report_stale: bool = True) -> list[Any]:
+    """The satellites (or element sets) whose positions at ``at`` are usable; the rest and (unless
+    ``report_stale`` is false) sets older than ``stale_days`` (``[elements] stale_days``) are reported (by DDE
+    name)."""
     from nfwserver.tracking.screening import stale_satellites, usable_mask
 
     usable = usable_mask(sats, observer, at, ut1_utc).tolist()
@@ -110,12 +109,25 @@ def _screen(sats: list[Any], catalog: Catalog, observer: Observer, ut1_utc: floa
         warn(f"skipped {len(unusable)} object(s) whose position at {format_time(at)} cannot be computed "
              f"or is implausibly far (decayed or elements far outside their validity): {names}")
         sats = [s for s, ok in zip(sats, usable) if ok]
-    stale = stale_satellites(sats, at, stale_days)
-    if stale:
-        names = _dde_names(stale[:5], catalog) + (", ..." if len(stale) > 5 else "")
-        warn(f"{len(stale)} element set(s) are more than {stale_days:g} days older than {format_time(at)}, "
-             f"so their positions drift ({names}); `nfwserver elements update` fetches newer ones")
+    if report_stale:
+        _report_stale(stale_satellites(sats, at, stale_days), catalog, at, stale_days)
     return sats
+
+
+def _report_stale(stale: list[Any], catalog: Catalog, at: datetime, stale_days: float,
+                  named: dict[int, str] | None = None) -> None:
+    """Warn of the sets older than ``stale_days`` before ``at``, naming up to five by DDE name (from ``named``
+    when it has them)."""
+    if not stale:
+        return
+    shown = stale[:5]
+    if named is not None and all(s.catalog_number in named for s in shown):
+        names = ", ".join(named[s.catalog_number] for s in shown)
+    else:
+        names = _dde_names(shown, catalog)
+    names += ", ..." if len(stale) > 5 else ""
+    warn(f"{len(stale)} element set(s) are more than {stale_days:g} days older than {format_time(at)}, "
+         f"so their positions drift ({names}); `nfwserver elements update` fetches newer ones")
 
 
 def _stale_days(inputs: TrackingInputs) -> float:
@@ -125,18 +137,20 @@ def _stale_days(inputs: TrackingInputs) -> float:
 
 def _dde_names(sats: list[Any], catalog: Catalog) -> str:
     """The DDE names of satellites or element sets (those of the catalog's satellites), comma-separated."""
-    return ", ".join(s.dde_name if hasattr(s, "dde_name") else _dde_name(catalog, s.catalog_number) for s in sats)
+    unnamed = [s.catalog_number for s in sats if not hasattr(s, "dde_name")]
+    made = iter(catalog.dde_names_of(unnamed) if unnamed else ())
+    return ", ".join(s.dde_name if hasattr(s, "dde_name") else next(made) for s in sats)
 
 
-def _dde_name(catalog: Catalog, catalog_number: int) -> str:
-    sat = catalog.get(catalog_number)
-    return sat.dde_name if sat is not None else str(catalog_number)
-
-
-def _display_names(numbers: Iterable[int], sets: list[Any], catalog: Catalog) -> list[str]:
+def _display_names(numbers: list[int], sets: list[Any], catalog: Catalog) -> list[str]:
     """The name shown for each catalog number: the element set's name, else the satellite's DDE name."""
-    by_number = {es.catalog_number: es for es in sets}
-    return [by_number[n].name or _dde_name(catalog, n) for n in numbers]
+    by_number = {es.catalog_number: es.name for es in sets}
+    names = [by_number[n] for n in numbers]
+    unnamed = [n for n, name in zip(numbers, names) if not name]
+    if unnamed:
+        made = dict(zip(unnamed, catalog.dde_names_of(unnamed)))
+        names = [name or made[n] for n, name in zip(numbers, names)]
+    return names
 
 
 def run_ephemeris(args: argparse.Namespace) -> int:
@@ -220,23 +234,31 @@ def run_passes(args: argparse.Namespace) -> int:
 
 
 def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str], dict[int, str]]:
-    """The passes the options ask for, and the name and the DDE name (at most 12 characters) to show for each
-    satellite that has one (by catalog number)."""
-    import numpy as np
-
+    """The passes the options ask for, and the name and the DDE name (at most 12 characters; only for the
+    compact table, which alone shows them) to show for each satellite that has one (by catalog number)."""
     from nfwserver.cli.tracking_options import TrackingInputs
     from nfwserver.tracking.passes import find_passes
+    from nfwserver.tracking.screening import stale_satellites
 
     start = args.start
     inputs = TrackingInputs(args)  # the configuration only if an option leaves a value to it
     horizon, observer, ut1_utc, catalog = inputs.horizon, inputs.observer, inputs.ut1_utc, inputs.catalog
     sets = _chosen_sets(args, inputs, catalog)
-    sets = _screen(sets, catalog, observer, ut1_utc, start, _stale_days(inputs))
+    compact = args.format == "table" and not args.wide  # the only output that shows DDE names
+    stale_days = _stale_days(inputs)
+    # The compact table names its satellites after the search: the stale sets are named then, in the same go.
+    sets = _screen(sets, catalog, observer, ut1_utc, start, stale_days, report_stale=not compact)
+    stale = stale_satellites(sets, start, stale_days) if compact else []
     passes = find_passes(sets, observer, start, start + timedelta(hours=args.hours), horizon=horizon,
                          ut1_utc=ut1_utc, workers=args.workers)
-    numbers = np.unique(passes.columns["catalog_number"]).tolist()
+    numbers = passes.catalog_numbers()
+    named: dict[int, str] = {}
+    if compact:
+        wanted = numbers + [s.catalog_number for s in stale[:5]]
+        named = dict(zip(wanted, catalog.dde_names_of(wanted)))
+        _report_stale(stale, catalog, start, stale_days, named)
     return (passes, dict(zip(numbers, _display_names(numbers, sets, catalog))),
-            {n: _dde_name(catalog, n) for n in numbers})
+            {n: named[n] for n in numbers} if compact else {})
 
 
 def _chosen_sets(args: argparse.Namespace, inputs: TrackingInputs, catalog: Catalog) -> list[Any]:

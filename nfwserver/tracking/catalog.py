@@ -154,6 +154,19 @@ class Catalog:
     def get(self, catalog_number: int) -> Satellite | None:
         return self._named().get(catalog_number)
 
+    def dde_names_of(self, catalog_numbers: Iterable[int]) -> list[str]:
+        """The DDE names of ``catalog_numbers`` (the number itself for one not in the catalog).  Until a reader
+        has asked for satellites, the names are made for this call and not kept (a command naming a few
+        satellites of a large catalog keeps no name for the others)."""
+        satellites = self._satellites
+        if satellites is not None:
+            return [sat.dde_name if (sat := satellites.get(n)) is not None else str(n) for n in catalog_numbers]
+        with self._lock:
+            elements, overrides = self._elements, self._overrides
+        names = assign_dde_names({k: v.name for k, v in elements.items()},
+                                 {k: v for k, v in overrides.items() if k in elements})
+        return [names.get(n, str(n)) for n in catalog_numbers]
+
     def __contains__(self, catalog_number: object) -> bool:
         return catalog_number in self._elements
 

@@ -29,11 +29,15 @@ after an element update.  Only a user's override comes before them.
 from __future__ import annotations
 
 import re
+from collections.abc import Iterator
 
 MAX_LENGTH = 12
 _ALLOWED = re.compile(r"[^A-Za-z0-9_.+/-]")
 _AMATEUR = re.compile(r"^[A-Z]{1,3}-?\d{1,3}[A-Z]?$")
 _PAREN = re.compile(r"\(([^)]*)\)")
+_BLANKS = re.compile(r"\s+")
+_DASHES = re.compile(r"-{2,}")
+_WORD_END = re.compile(r"[\s&/]+")
 
 
 def sanitize(text: str) -> str:
@@ -42,9 +46,9 @@ def sanitize(text: str) -> str:
     A long name that ends in a number keeps the number whole and shortens what precedes it
     (``STARLINK-1008`` -> ``STARLIN-1008``); other long names are cut.
     """
-    text = re.sub(r"\s+", "-", text.strip())
+    text = _BLANKS.sub("-", text.strip())
     text = _ALLOWED.sub("", text)
-    text = re.sub(r"-{2,}", "-", text).strip("-")
+    text = _DASHES.sub("-", text).strip("-")
     if len(text) > MAX_LENGTH:
         head, sep, tail = text.rpartition("-")
         if sep and head and any(c.isdigit() for c in tail) and len(tail) <= MAX_LENGTH - 4:
@@ -76,30 +80,40 @@ def validate_dde_name(name: str) -> str:
 
 def name_candidates(element_name: str, catalog_number: int) -> list[str]:
     """Candidate DDE names for a satellite, best first (see the module docstring)."""
+    return list(_candidates(element_name, catalog_number))
+
+
+def _candidates(element_name: str, catalog_number: int) -> Iterator[str]:
+    """The candidates of :func:`name_candidates`, each made when asked for (a catalog's satellites mostly
+    take their first)."""
     name = element_name.strip()
     if name.startswith("0 "):
         name = name[2:]
     inner = [p.strip() for p in _PAREN.findall(name)]
     main = _PAREN.sub(" ", name).strip()
-    out: list[str] = []
+    given: set[str] = {""}
+
+    def fresh(cand: str) -> bool:
+        if cand in given:
+            return False
+        given.add(cand)
+        return True
+
     for part in inner:
-        if _AMATEUR.match(part.upper()):
-            out.append(sanitize(part))
-    first_word = re.split(r"[\s&/]+", main, maxsplit=1)[0] if main else ""
-    if first_word != main and _AMATEUR.match(first_word.upper()):
-        out.append(sanitize(first_word))
+        if _AMATEUR.match(part.upper()) and fresh(cand := sanitize(part)):
+            yield cand
+    first_word = _WORD_END.split(main, maxsplit=1)[0] if main else ""
+    if first_word != main and _AMATEUR.match(first_word.upper()) and fresh(cand := sanitize(first_word)):
+        yield cand
     if main:
-        out.append(sanitize(main))
-        if inner:
-            out.append(sanitize(main + "-" + "-".join(inner)))
+        if fresh(cand := sanitize(main)):
+            yield cand
+        if inner and fresh(cand := sanitize(main + "-" + "-".join(inner))):
+            yield cand
     number = str(catalog_number)
     base = sanitize(main or name)[: MAX_LENGTH - len(number) - 1].rstrip("-")
-    out.append(f"{base}-{number}" if base else number)
-    unique = []
-    for cand in out:
-        if cand and cand not in unique:
-            unique.append(cand)
-    return unique
+    if fresh(cand := f"{base}-{number}" if base else number):
+        yield cand
 
 
 def dde_name_for(element_name: str, catalog_number: int) -> str:
@@ -121,7 +135,7 @@ def assign_dde_names(names: dict[int, str], overrides: dict[int, str] | None = N
     for catnr in sorted(names):
         if catnr in result:
             continue
-        for cand in name_candidates(names[catnr], catnr):
+        for cand in _candidates(names[catnr], catnr):
             if cand.upper() not in taken:
                 break
         else:  # pragma: no cover - the last candidate holds the unique catalog number

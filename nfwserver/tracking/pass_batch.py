@@ -18,6 +18,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from nfwserver.tracking.pass_records import distinct
 from nfwserver.tracking.pass_screen import Brackets, Intervals
 
 #: Key spacing per satellite when sorting (sat, t) pairs as one float (s; far above any span).
@@ -49,7 +50,7 @@ class Layout:
         out = np.empty(len(q_keys), dtype=np.intp)
         bounds = np.searchsorted(key_sat, self.chunk_starts).tolist() + [len(keys)]
         q_chunk = np.searchsorted(self.chunk_starts, q_sat, side="right") - 1
-        for c in np.unique(q_chunk).tolist():
+        for c in distinct(q_chunk).tolist():
             mine = q_chunk == c
             lo, hi = bounds[c], bounds[c + 1]
             out[mine] = lo + np.searchsorted(keys[lo:hi], q_keys[mine], side=side)
@@ -85,7 +86,8 @@ class Batch:
 
     def merged(self) -> tuple[list[Any], np.ndarray, np.ndarray, Layout, Brackets]:
         """The batch's models, per-satellite reference instants (jd0, fr0), layout, and the brackets of
-        every chunk with batch satellite indices."""
+        every chunk with batch satellite indices.  Empties the batch: the chunks' own brackets are freed
+        while the merged ones are refined."""
         counts = [len(c.models) for c in self.chunks]
         starts = np.concatenate(([0], np.cumsum(counts)[:-1])).astype(np.intp)
 
@@ -104,5 +106,7 @@ class Batch:
                 part.sat = part.sat + first
                 parts[kind].append(part)
         brackets = Brackets(*(Intervals.concat(parts[kind]) for kind in kinds))
-        return (models, per_sat([c.jd0 for c in self.chunks]), per_sat([c.fr0 for c in self.chunks]), layout,
-                brackets)
+        jd0, fr0 = per_sat([c.jd0 for c in self.chunks]), per_sat([c.fr0 for c in self.chunks])
+        del parts
+        self.chunks, self.size = [], 0
+        return models, jd0, fr0, layout, brackets

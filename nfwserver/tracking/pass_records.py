@@ -91,6 +91,11 @@ class PassList(Sequence[Pass]):
     def __len__(self) -> int:
         return len(self.columns["tca_s"])
 
+    def catalog_numbers(self) -> list[int]:
+        """The catalog numbers that have passes, ascending, each once."""
+        numbers: list[int] = distinct(self.columns["catalog_number"]).tolist()
+        return numbers
+
     def _make(self, rows: np.ndarray) -> list[Pass]:
         cols = [self.columns[name][rows].tolist() for name, _ in COLUMNS]
         start, window = self.start, self.window_s
@@ -130,3 +135,12 @@ class PassList(Sequence[Pass]):
 
     def __repr__(self) -> str:
         return f"PassList({len(self)} passes from {self.start.isoformat()})"
+
+
+def distinct(values: np.ndarray) -> np.ndarray:
+    """The distinct values of ``values``, ascending (``np.unique``, which imports numpy.ma: 6 ms and 1.3 MiB)."""
+    ordered = np.sort(values)
+    first = np.ones(len(ordered), dtype=bool)
+    first[1:] = ordered[1:] != ordered[:-1]
+    picked: np.ndarray = ordered[first]
+    return picked

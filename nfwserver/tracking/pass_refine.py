@@ -94,7 +94,7 @@ class _Live:
     """The unfinished brackets (arrays of one length, in satellite order): what each carries from round to
     round."""
 
-    idx: np.ndarray  #: index among all the brackets
+    idx: np.ndarray  #: index among all the brackets (in the order given to :func:`solve`)
     sat: np.ndarray
     cross: np.ndarray  #: a crossing (else a maximum)
     top: np.ndarray  #: a maximum of the elevation (else of f, or a crossing)
@@ -135,12 +135,13 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
     n = len(sat)
     # Work in satellite order, so every round's batch is already grouped by satellite.
     perm = np.argsort(sat, kind="stable")
-    undo = np.empty_like(perm)
-    undo[perm] = np.arange(n)
     live = _start(sat[perm], kind[perm], a[perm], b[perm], ga[perm], gb[perm],
                   np.zeros(n, dtype=bool) if hidden is None else hidden[perm],
                   None if guess is None else guess[perm])
-    out = _Outputs(n, live.c)
+    live.idx = perm  # each bracket's place in the given order: the outputs are written there
+    first = np.empty(n)
+    first[perm] = live.c
+    out = _Outputs(n, first)
     rounds = 0
     while len(live.idx) and rounds < _MAX_ROUNDS:
         rounds += 1
@@ -149,7 +150,7 @@ def solve(ev: PairEvaluator, sat: np.ndarray, a: np.ndarray, b: np.ndarray, ga: 
                                for s0 in range(0, len(live.idx), _SLICE)])
         if done.any():
             live = live.part(~done)
-    t, el, az, f_end, el_rate, best_f, best_t, best_up, best_up_accel, f_accel = (col[undo] for col in out.columns)
+    t, el, az, f_end, el_rate, best_f, best_t, best_up, best_up_accel, f_accel = out.columns
     return Solution(t, el, az, f_end, el_rate, best_f, best_t, best_up, best_up_accel, f_accel, rounds)
 
 

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 from sgp4.api import SatrecArray
 
-from nfwserver.tracking.constants import SECONDS_PER_DAY
+from nfwserver.tracking.constants import SECONDS_PER_DAY, WGS72_MU_KM3_S2
 from nfwserver.tracking.frames import TopocentricFrame
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.pass_kinematics import PairEvaluator
@@ -47,6 +47,8 @@ _LEO_RATE = 1.2e-3
 _FLAT_STEP_S = 1200.0
 #: Sat-time pairs per compiled screen call (bounds the screen's memory).
 _SCREEN_PAIRS = 10000
+#: The Earth's rotation rate (rad/s), generously rounded up.
+_EARTH_RATE = 7.3e-5
 
 
 INTERVAL_FIELDS = ("sat", "a", "b", "ga", "gb", "guess")
@@ -88,11 +90,14 @@ class Brackets:
 
 def _classify(sat: np.ndarray, t: np.ndarray, f: np.ndarray, f_rate: np.ndarray, el_rate: np.ndarray,
               link: np.ndarray, kept: np.ndarray, up: np.ndarray | None = None,
-              up_rate: np.ndarray | None = None) -> Brackets:
+              up_rate: np.ndarray | None = None, up_jerk_rate: np.ndarray | None = None) -> Brackets:
     """Brackets between samples ``i`` and ``i + 1`` wherever ``link[i]`` (same satellite, adjacent).
 
     With the height above the horizontal plane ``up`` (km) and its rate (km/s) at the samples (a
-    flat horizon at 0 deg, where a crossing is a root of ``up``), crossings get a first guess.
+    flat horizon at 0 deg, where a crossing is a root of ``up``), crossings get a first guess; with a
+    bound on the fourth derivative of ``up`` at each sample's satellite too (``up_jerk_rate``, km/s^4),
+    hidden peaks that provably stay below the horizon are dropped and the others get a first guess
+    (:func:`_can_rise`).
     """
     i = np.flatnonzero(link)
     j = i + 1
@@ -100,6 +105,12 @@ def _classify(sat: np.ndarray, t: np.ndarray, f: np.ndarray, f_rate: np.ndarray,
     cross = np.isfinite(fa) & np.isfinite(fb) & ((fa > 0.0) != (fb > 0.0))
     turn = (f_rate[i] >= 0.0) & (f_rate[j] <= 0.0)
     peak = turn & (fa <= 0.0) & (fb <= 0.0) & kept[i] & np.isfinite(fa) & np.isfinite(fb)
+    peak_guess = None
+    if up is not None and up_rate is not None and up_jerk_rate is not None and peak.any():
+        k = i[peak]
+        rise, top_at = _can_rise(t[k], t[k + 1], up[k], up[k + 1], up_rate[k], up_rate[k + 1], up_jerk_rate[k])
+        peak[peak] = rise
+        peak_guess = top_at[rise]
     culm = (el_rate[i] >= 0.0) & (el_rate[j] <= 0.0) & ((fa > 0.0) | (fb > 0.0))
 
     def pick(mask: np.ndarray, values: np.ndarray, guess: np.ndarray | None = None) -> Intervals:
@@ -111,7 +122,53 @@ def _classify(sat: np.ndarray, t: np.ndarray, f: np.ndarray, f_rate: np.ndarray,
     if up is not None and up_rate is not None:
         k = i[cross]
         guess = _hermite_root(t[k], t[k + 1], up[k], up[k + 1], up_rate[k], up_rate[k + 1])
-    return Brackets(pick(cross, f, guess), pick(peak, f_rate), pick(culm, el_rate))
+    return Brackets(pick(cross, f, guess), pick(peak, f_rate, peak_guess), pick(culm, el_rate))
+
+
+def _can_rise(a: np.ndarray, b: np.ndarray, ya: np.ndarray, yb: np.ndarray, da: np.ndarray, db: np.ndarray,
+              m4: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Whether the height above the horizontal plane (values ``y`` in km and rates ``d`` in km/s at the ends
+    of ``[a, b]``, s) may reach 0 inside: the maximum of its cubic Hermite interpolant plus the
+    interpolation error bound ``m4 h^4 / 384`` (``m4``: a bound on the fourth derivative, km/s^4).  A
+    hidden peak that cannot rise is dropped here, before any SGP4 call (most hidden peaks are orbits
+    passing far from the observer; the refinement would spend two or three evaluations on each).
+
+    Also returns where the interpolant peaks (s): the first guess of the elevation's maximum (the two peak
+    within seconds of each other, and the guess saves the refinement about two evaluations a peak)."""
+    h = b - a
+    p0, p1, m0, m1 = ya, yb, da * h, db * h
+    c1 = m0
+    c2 = -3.0 * p0 - 2.0 * m0 + 3.0 * p1 - m1
+    c3 = 2.0 * p0 + m0 - 2.0 * p1 + m1
+    top = np.maximum(p0, p1)
+    at = np.where(p0 > p1, 0.0, 1.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        # Stationary points of the cubic on [0, 1]: roots of c1 + 2 c2 x + 3 c3 x^2.
+        disc = c2 * c2 - 3.0 * c3 * c1
+        root = np.sqrt(np.maximum(disc, 0.0))
+        for x in ((-c2 + root) / (3.0 * c3), (-c2 - root) / (3.0 * c3), -c1 / (2.0 * c2)):
+            x = np.clip(np.nan_to_num(x, nan=0.0, posinf=0.0, neginf=0.0), 0.0, 1.0)
+            y = p0 + x * (c1 + x * (c2 + x * c3))
+            at = np.where(y > top, x, at)
+            top = np.maximum(top, y)
+    h2 = h * h
+    reach: np.ndarray = ~(top + m4 * h2 * h2 / 384.0 < 0.0)  # NaN: kept
+    return reach, a + at * h
+
+
+def _up_jerk_bound(satrecs: list[Any]) -> np.ndarray:
+    """A bound (km/s^4) on the fourth time derivative of a satellite's height above any observer's horizontal
+    plane: twice that of a Kepler orbit seen from the rotating Earth, ``a (1 + e) (n' + omega)^4`` with the
+    mean motion raised to the largest angular rate (perigee) ``n' = n (1 + e)^2 / (1 - e^2)^1.5``; infinite
+    (nothing dropped) for orbits with ``e >= 0.1``.  The factor 2 covers SGP4's perturbations (J2's
+    short-period terms are ~1e-3 of the motion)."""
+    no = np.array([sr.no_kozai for sr in satrecs]) / 60.0  # rad/s
+    ecc = np.array([sr.ecco for sr in satrecs])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        a = (WGS72_MU_KM3_S2 / (no * no)) ** (1.0 / 3.0)
+        rate = no * (1.0 + ecc) ** 2 / (1.0 - ecc * ecc) ** 1.5 + _EARTH_RATE
+        bound = 2.0 * a * (1.0 + ecc) * rate ** 4
+    return np.where((ecc < 0.1) & np.isfinite(bound), bound, np.inf)
 
 
 def _hermite_root(a: np.ndarray, b: np.ndarray, ya: np.ndarray, yb: np.ndarray, da: np.ndarray,
@@ -161,13 +218,14 @@ def screen(satrecs: list[Any], frame: TopocentricFrame, horizon: HorizonTable, j
         wanted = base * np.clip(_LEO_RATE / np.maximum(bound, 1e-9), 1.0, max(coarse_step_s / base, 1.0))
         per_sat = np.maximum(1, np.round(coarse_step_s / wanted)).astype(np.intp)
         coarse_only = per_sat == 1
+        jerk = _up_jerk_bound(part)
         if coarse_only.all():
-            parts.append(_classify_grid(i0, grid, kept, *_coarse_kinematics(frame, horizon, pos, vel, err)))
+            parts.append(_classify_grid(i0, grid, kept, *_coarse_kinematics(frame, horizon, pos, vel, err), jerk))
         elif coarse_only.any():
             sel = np.flatnonzero(coarse_only)
             coarse = _coarse_kinematics(frame, horizon, tuple(c[sel] for c in pos), tuple(c[sel] for c in vel),
                                         err[sel])
-            parts.append(_classify_grid(sel + i0, grid, kept[sel], *coarse))
+            parts.append(_classify_grid(sel + i0, grid, kept[sel], *coarse, jerk[sel]))
         fine = np.flatnonzero(~coarse_only)
         if len(fine):
             parts.append(_fine_samples(fine + i0, kept[fine], per_sat[fine], grid, coarse_step_s, evaluator))
@@ -263,9 +321,11 @@ def _coarse_kinematics(frame: TopocentricFrame, horizon: HorizonTable, pos: tupl
 
 
 def _classify_grid(sats: int | np.ndarray, grid: np.ndarray, kept: np.ndarray, f: np.ndarray, f_rate: np.ndarray,
-                   el_rate: np.ndarray, up: np.ndarray | None, up_rate: np.ndarray | None) -> Brackets:
+                   el_rate: np.ndarray, up: np.ndarray | None, up_rate: np.ndarray | None,
+                   up_jerk: np.ndarray) -> Brackets:
     """Brackets between consecutive coarse points (arrays (sats, times)); ``sats``: the satellite index of
-    each row, or of the first row (the rows are then consecutive satellites)."""
+    each row, or of the first row (the rows are then consecutive satellites); ``up_jerk``: each row's bound
+    on the fourth derivative of ``up`` (km/s^4, :func:`_up_jerk_bound`)."""
     rows, m = f.shape
     sat_ids = np.repeat(np.arange(sats, sats + rows) if isinstance(sats, int) else sats, m)
     kept_full = np.zeros((rows, m), dtype=bool)
@@ -275,7 +335,7 @@ def _classify_grid(sats: int | np.ndarray, grid: np.ndarray, kept: np.ndarray, f
     flat_up = None if up is None else up.ravel()
     flat_up_rate = None if up_rate is None else up_rate.ravel()
     return _classify(sat_ids, np.tile(grid, rows), f.ravel(), f_rate.ravel(), el_rate.ravel(), link.ravel(),
-                     kept_full.ravel(), flat_up, flat_up_rate)
+                     kept_full.ravel(), flat_up, flat_up_rate, np.repeat(up_jerk, m))
 
 
 def _fine_samples(sats: np.ndarray, kept: np.ndarray, per_sat: np.ndarray, grid: np.ndarray,
