@@ -12,11 +12,8 @@ almost always the wrong file or an error page.
 from __future__ import annotations
 
 import contextlib
-import http.client
 import os
 import socket
-import urllib.error
-import urllib.request
 from collections.abc import Callable, Mapping
 from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
@@ -75,6 +72,8 @@ def bundled_elements() -> FetchResult:
 
 
 def _network_reason(exc: BaseException, timeout_s: float) -> str:
+    import urllib.error
+
     if isinstance(exc, urllib.error.HTTPError):
         return f"the server answered HTTP {exc.code} {exc.reason}".rstrip()
     if isinstance(exc, urllib.error.URLError):
@@ -94,6 +93,10 @@ def fetch_url(url: str, timeout_s: float = 20.0, progress: ProgressCallback | No
     scheme = url.partition("://")[0].lower()
     if scheme not in ("http", "https"):
         raise SourceError(f"{url}: unsupported scheme {scheme}:// (element sources are files or http(s) URLs)")
+    import http.client  # the network modules (and ssl) load only when a URL is fetched: 3 MiB for `passes`
+    import urllib.error
+    import urllib.request
+
     request = urllib.request.Request(url, headers={"User-Agent": "nfwserver"})
     chunks: list[bytes] = []
     size = 0
