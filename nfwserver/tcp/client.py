@@ -26,14 +26,6 @@ def connect_host(listen_host: str) -> str:
     return listen_host
 
 
-def _read_line(stream: BinaryIO, where: str) -> str:
-    raw: bytes = stream.readline(4096)
-    if not raw:
-        raise StationUnreachable(f"the station at {where} closed the connection "
-                                 "(is this machine's address in its [tcp] allow list?)")
-    return raw.decode("ascii", errors="replace").rstrip("\r\n")
-
-
 def _unreachable(where: str, exc: OSError) -> StationUnreachable:
     reason = exc.strerror or str(exc) or type(exc).__name__
     return StationUnreachable(f"no station answers on {where} ({reason}); is `nfwserver run` running "
@@ -78,10 +70,15 @@ class StationLink:
         """Send ``line`` and return the one-line reply."""
         try:
             self._sock.sendall(line.encode("ascii") + b"\r\n")
-            return self._line()
         except OSError as exc:
             self.close()
             raise _unreachable(self.where, exc) from None
+        return self.reply()
+
+    def reply(self) -> str:
+        """The next line the station sends (a reply of several lines, e.g. HELP's)."""
+        try:
+            return self._line()
         except StationUnreachable:
             self.close()
             raise
@@ -97,18 +94,15 @@ class StationLink:
 def ask(host: str, port: int, line: str, timeout_s: float = 5.0, until: str | None = None) -> str:
     """Send ``line`` to the station at ``host``:``port`` and return its one-line reply (with ``until``:
     every line up to and without the one equal to ``until``, joined by newlines; ``HELP`` ends with OK)."""
-    where = f"{host} port {port}"
+    link = StationLink(host, port, timeout_s)
     try:
-        with socket.create_connection((host, port), timeout=timeout_s) as sock, sock.makefile("rb") as stream:
-            greeting = _read_line(stream, where)
-            if greeting != GREETING:
-                raise StationUnreachable(f"{where} answered {greeting[:60]!r}, not Nova's greeting")
-            sock.sendall(line.encode("ascii") + b"\r\n")
-            if until is None:
-                return _read_line(stream, where)
-            lines: list[str] = []
-            while (reply := _read_line(stream, where)) != until and not reply.startswith("ERROR"):
-                lines.append(reply)
-            return "\n".join(lines) if reply == until else reply
-    except OSError as exc:
-        raise _unreachable(where, exc) from None
+        reply = link.ask(line)
+        if until is None:
+            return reply
+        lines: list[str] = []
+        while reply != until and not reply.startswith("ERROR"):
+            lines.append(reply)
+            reply = link.reply()
+        return "\n".join(lines) if reply == until else reply
+    finally:
+        link.close()
