@@ -17,6 +17,7 @@ from __future__ import annotations
 import logging
 import os
 import shutil
+import socket
 import tempfile
 import time
 from dataclasses import dataclass, field
@@ -114,6 +115,7 @@ class FaultRig:
         #: pace ticks at real time (the real rotctld turns its dummy rotor in real time: rotor faults need it)
         self.real_time = False
         self.rotor_distance = float("inf")  #: last seen distance (deg) of the real rotor from its target
+        self.held_connections: list[socket.socket] = []  #: the slow-loris fault's open connections
         self._last_tick = time.monotonic()
 
     def _config_text(self) -> str:

@@ -170,10 +170,6 @@ def _nothing(rig: FaultRig) -> None:
     return None
 
 
-#: connections of the slow-loris fault (one address, trickling bytes, never a whole line)
-_LORIS: list[socket.socket] = []
-
-
 def _slow_loris(rig: FaultRig) -> None:
     """Forty connections from 127.0.0.1, each sending a byte now and then and never a line: more than the
     per-address cap, so the later ones are refused with a line; the station's other clients must not notice."""
@@ -181,12 +177,12 @@ def _slow_loris(rig: FaultRig) -> None:
     for _ in range(40):
         s = socket.create_connection(rig.station.tcp.address, timeout=2.0)
         s.sendall(b"S")
-        _LORIS.append(s)
+        rig.held_connections.append(s)
 
 
 def _loris_gone(rig: FaultRig) -> None:
-    while _LORIS:
-        _LORIS.pop().close()
+    while rig.held_connections:
+        rig.held_connections.pop().close()
 
 
 def tcp_served(rig: FaultRig, record: TickRecord) -> bool:

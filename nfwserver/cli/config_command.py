@@ -106,15 +106,9 @@ def _written(path: str | None) -> dict[str, Any]:
     """The file's own TOML document (values as the user wrote them), or {} for the built-in defaults."""
     if path is None:
         return {}
-    from nfwserver.config.loader import read_config_text
+    from nfwserver.config.loader import read_config_text, toml_document
 
-    if sys.version_info >= (3, 11):
-        import tomllib
-    else:  # pragma: no cover - Python 3.10
-        import tomli as tomllib
-
-    document: dict[str, Any] = tomllib.loads(read_config_text(Path(path)).removeprefix("\ufeff"))
-    return document
+    return toml_document(read_config_text(Path(path)))
 
 
 def _edited(text: str, section: str, key: str, value: Any, path: Path) -> str:

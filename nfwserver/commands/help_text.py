@@ -11,7 +11,7 @@ import textwrap
 
 from nfwserver.commands.table import Face, Target, commands_for
 
-__all__ = ["console_help", "help_lines", "markdown", "poke_epilog"]
+__all__ = ["help_lines", "markdown", "poke_epilog"]
 
 _FACE_NAMES = ((Face.DDE, "DDE"), (Face.TCP, "TCP"), (Face.CONSOLE, "console"))
 _TARGET_NAMES = {Target.STATION: "station", Target.SESSION: "connection", Target.ROTOR: "rotor",
@@ -23,11 +23,6 @@ def help_lines(face: Face) -> tuple[str, ...]:
     entries = commands_for(face)
     width = max(len(c.usage) for c in entries)
     return tuple(f"{c.usage:<{width}}  {c.summary}" for c in entries)
-
-
-def console_help() -> str:
-    """The console's one-line reminder of what its input line takes."""
-    return "Commands: " + ", ".join(c.usage for c in commands_for(Face.CONSOLE)) + " (any case)"
 
 
 def poke_epilog(width: int = 79) -> str:

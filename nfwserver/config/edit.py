@@ -10,18 +10,12 @@ from __future__ import annotations
 
 import difflib
 import re
-import sys
 from pathlib import Path
 from typing import Any
 
 import tomlkit
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
-
-from nfwserver.config.loader import parse_config
+from nfwserver.config.loader import TomlError, parse_config, toml_document
 from nfwserver.config.table import SECTIONS, keys_of
 
 __all__ = ["parse_value", "set_key", "split_key"]
@@ -42,15 +36,15 @@ def parse_value(text: str) -> Any:
     """The value ``text`` stands for: a TOML value when it is one (``true``, ``12.5``, ``[25544, 7530]``,
     ``"quoted"``), else the text itself as a string (``JO01ab``, ``/dev/ttyUSB0``)."""
     try:
-        return tomllib.loads(f"v = {text}")["v"]
-    except tomllib.TOMLDecodeError:
+        return toml_document(f"v = {text}")["v"]
+    except TomlError:
         return text
 
 
 def set_key(text: str, section: str, key: str, value: Any, source: str, base_dir: Path) -> str:
     """``text`` (a configuration file's content) with ``[section] key = value``; raises
     :class:`ConfigError` when the result is not a valid configuration (the problem named)."""
-    doc = tomlkit.parse(text.removeprefix("\ufeff"))
+    doc = tomlkit.parse(text.removeprefix("\ufeff"))  # a BOM, as toml_document skips it
     table = doc.get(section)
     if table is None:
         table = tomlkit.table()

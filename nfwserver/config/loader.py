@@ -40,6 +40,16 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
+#: What :func:`toml_document` raises for text that is not TOML.
+TomlError = tomllib.TOMLDecodeError
+
+
+def toml_document(text: str) -> dict[str, Any]:
+    """``text`` as a TOML document; a UTF-8 BOM (Windows editors write one) is skipped.  Raises TomlError."""
+    document: dict[str, Any] = tomllib.loads(text.removeprefix("\ufeff"))
+    return document
+
+
 APP_NAME = "nfwserver"
 #: Config fields holding a section record, by field name.
 _RECORDS = {"elements": ElementsConfig, "server": ServerConfig, "radio": RadioConfig, "rotor": RotorConfig,
@@ -194,8 +204,8 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
     files they name must exist.
     """
     try:
-        doc = tomllib.loads(text.removeprefix("\ufeff"))  # Windows editors start UTF-8 files with a BOM
-    except tomllib.TOMLDecodeError as exc:
+        doc = toml_document(text)
+    except TomlError as exc:
         raise ConfigError(source, [f"not valid TOML ({exc})"]) from None
     reading = _Reading(doc, base_dir or Path("."))
     observer = reading.observer()
@@ -240,8 +250,8 @@ def has_settings(text: str) -> bool:
 
     Text that is not TOML at all counts as having settings: :func:`parse_config` then names the problem."""
     try:
-        return bool(tomllib.loads(text.lstrip("\ufeff")))
-    except tomllib.TOMLDecodeError:
+        return bool(toml_document(text))
+    except TomlError:
         return True
 
 
