@@ -108,7 +108,8 @@ class RotorCoupling(TickWorker):
         self._lock = threading.Lock()
         self._retry_asked = False  # an operator's action asked for a stalled rotor to be tried at once
         self._park_asked = False  # PARK asked for; done at the next tick
-        self._parked = False  # parked by PARK: samples still marked tracking are not followed
+        #: when PARK was asked for: samples computed until then, still marked tracking, are not followed
+        self._parked_at: datetime | None = None
         driver.table_load_listeners.append(self._table_loaded)
         driver.annunciator.listeners.append(self._announced)
 
@@ -151,6 +152,7 @@ class RotorCoupling(TickWorker):
         followed, so the rotor stays parked until a later ``TRACK ON``."""
         with self._lock:
             self._park_asked = True
+            self._parked_at = self.driver.clock.now()
         self._event("parking: tracking off, rotor to its park position")
 
     def set_flip_mode(self, mode: str) -> None:
@@ -229,7 +231,6 @@ class RotorCoupling(TickWorker):
     def _park_now(self) -> None:
         self.plan = None
         self._sent = None
-        self._parked = True
         self.driver.stop_parking_timer()
         params = self.driver.parking_parameters()
         self.driver.set_target(azimuth_deg=params.azimuth_deg, elevation_deg=params.elevation_deg)
@@ -244,11 +245,10 @@ class RotorCoupling(TickWorker):
             self.driver.retry_now()
         if park:
             self._park_now()
-        if self._parked:
-            if sample.tracking:  # computed before TRACK OFF reached the state: not followed
-                sample = replace(sample, tracking=False)
-            else:
-                self._parked = False  # from here on a TRACK ON is a new one
+        with self._lock:
+            parked_at = self._parked_at
+        if parked_at is not None and sample.time <= parked_at and sample.tracking:
+            sample = replace(sample, tracking=False)  # computed before PARK's TRACK OFF: not followed
         if sample.tracking and not self._track_on_seen:
             self.resume()  # a new TRACK ON enables autotracking again
         self._track_on_seen = sample.tracking

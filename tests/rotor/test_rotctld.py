@@ -174,3 +174,19 @@ def test_an_outage_of_rotctld_is_not_taken_for_a_stall() -> None:
         clock.advance(0.2)
         driver.service()
         assert not driver.stalled
+
+
+def test_track_on_at_once_after_park_is_followed() -> None:
+    """PARK then TRACK ON before the rotor's worker saw a sample with tracking off: the new TRACK ON is
+    followed (PARK ignores only samples computed before it, it is no latch)."""
+    geometry = RotorGeometry(-180.0, 450.0, 0.0, 90.0)
+    with HamlibDaemon("rotctld") as daemon:
+        clock, core, driver, coupling = _tracking(daemon, geometry, CROSSING.tca, max_lead_s=0.0)
+        assert driver.set_parking(0, 180, 10)
+        run_virtual(core, clock, 1.0)
+        core.set_track(False, "test")
+        coupling.request_park()
+        core.set_track(True, "test")
+        run_virtual(core, clock, 1.0)
+        target_el, target_az = driver.positions()[2:]
+        assert (target_el, target_az) != (10, 180) and target_el is not None and target_el > 10
