@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import selectors
 import socket
 from collections import deque
@@ -9,9 +10,10 @@ from dataclasses import dataclass
 from typing import Any
 
 from nfwserver.config.schema import TcpConfig
+from nfwserver.health.link_health import LinkHealth
 from nfwserver.tcp.line_splitter import MAX_LINE_BYTES, LineSplitter
 
-__all__ = ["Connection", "TcpStats", "admission_refusal", "bind_listener", "peer_label"]
+__all__ = ["Connection", "ListenerRest", "TcpStats", "admission_refusal", "bind_listener", "peer_label"]
 
 
 @dataclass
@@ -78,3 +80,37 @@ def bind_listener(host: str, port: int) -> socket.socket:
         listener.close()
         raise
     return listener
+
+
+class ListenerRest:
+    """Out of descriptors or memory, the listener is set aside for a back-off instead of spinning on a socket
+    it cannot accept; ``health`` (the ``tcp-accept`` link) shows it meanwhile.  At the end of the back-off a
+    spare descriptor is looked for: found, the fault clears and the listener is back, whether or not a peer is
+    waiting; not found, it rests again."""
+
+    def __init__(self, health: LinkHealth) -> None:
+        self.health = health
+        self.resting = False
+
+    def rest(self, selector: selectors.BaseSelector, listener: socket.socket, exc: OSError) -> None:
+        self.health.failed(f"cannot accept connections: {exc.strerror or exc}")
+        if not self.resting:
+            selector.unregister(listener)
+            self.resting = True
+
+    def resume_at(self) -> float | None:
+        """Clock monotonic seconds when the resting listener is tried again; None when it is not resting."""
+        fault = self.health.fault
+        return fault.retry_at if self.resting and fault is not None else None
+
+    def maybe_resume(self, selector: selectors.BaseSelector, listener: socket.socket) -> None:
+        if not self.resting or not self.health.may_try():
+            return
+        try:
+            os.close(os.dup(listener.fileno()))
+        except OSError as exc:
+            self.health.failed(f"cannot accept connections: {exc.strerror or exc}")
+            return
+        self.health.succeeded()
+        selector.register(listener, selectors.EVENT_READ, "listen")
+        self.resting = False

@@ -13,7 +13,7 @@ so many clients cost no thread each.  The loop waits in ``select`` until the nex
   ``max_clients`` in all (the connection over a cap gets one ``ERROR`` line, then is closed); a
   connection that completes no line for ``idle_timeout_s`` is closed (a ``WATCH`` subscriber never is).
 - Out of file descriptors (EMFILE and kin), the listener rests for a back-off (0.1 s doubling to 5 s)
-  instead of spinning: the ``tcp-accept`` link shows it in STATUS; the first good accept clears it.
+  instead of spinning: the ``tcp-accept`` link shows it in STATUS until a spare descriptor is found.
 - Refused commands are logged once a minute per peer *address* (reconnecting does not reset it).
 - Lines: :mod:`nfwserver.tcp.protocol`, split by :mod:`nfwserver.tcp.line_splitter` (CR, LF, CR LF
   or NUL; at most 1 KiB kept; longer lines refused).  The line ending a ``WATCH`` gets ``OK`` and is
@@ -46,7 +46,14 @@ from nfwserver.core.station_core import StationCore
 from nfwserver.health.link_health import Backoff
 from nfwserver.listen_errors import bind_failure
 from nfwserver.ratelimited_log import RateLimitedLog
-from nfwserver.tcp.connection import Connection, TcpStats, admission_refusal, bind_listener, peer_label
+from nfwserver.tcp.connection import (
+    Connection,
+    ListenerRest,
+    TcpStats,
+    admission_refusal,
+    bind_listener,
+    peer_label,
+)
 from nfwserver.tcp.line_splitter import MAX_LINE_BYTES
 from nfwserver.tcp.protocol import GREETING, Action, NovaTcpProtocol, Reply, StatusFields
 
@@ -77,8 +84,7 @@ class NovaTcpServer:
         self.send_buffer_bytes = send_buffer_bytes
         self.max_clients = max_clients if max_clients is not None else config.max_clients
         self._per_address: Counter[str] = Counter()
-        self._accept_health = core.health.link("tcp-accept", ACCEPT_BACKOFF)
-        self._accept_resting = False
+        self._rest = ListenerRest(core.health.link("tcp-accept", ACCEPT_BACKOFF))
         self.stats = TcpStats()
         self.address: tuple[str, int] | None = None
         self._clients: set[Connection] = set()
@@ -192,9 +198,8 @@ class NovaTcpServer:
         back-off), at least 50 ms; None when nothing is."""
         now = self.core.clock.monotonic()
         due = [c.last_line + self.config.idle_timeout_s for c in self._clients if not c.watching]
-        fault = self._accept_health.fault
-        if self._accept_resting and fault is not None:
-            due.append(fault.retry_at)
+        if (resume_at := self._rest.resume_at()) is not None:
+            due.append(resume_at)
         if not due:
             return None
         return min(max(min(due) - now, 0.05), 60.0)
@@ -206,17 +211,8 @@ class NovaTcpServer:
             if now - client.last_line >= self.config.idle_timeout_s:
                 self.stats.idle_closed += 1
                 self._close(client, f"idle for {self.config.idle_timeout_s:g} s without a complete line")
-        if self._accept_resting and self._accept_health.may_try() and self._listener is not None \
-                and self._selector is not None:
-            self._selector.register(self._listener, selectors.EVENT_READ, "listen")
-            self._accept_resting = False
-
-    def _rest_listener(self, exc: OSError) -> None:
-        """accept() is out of descriptors or memory: stop listening until the back-off has run out."""
-        self._accept_health.failed(f"cannot accept connections: {exc.strerror or exc}")
-        if not self._accept_resting and self._selector is not None and self._listener is not None:
-            self._selector.unregister(self._listener)
-            self._accept_resting = True
+        if self._selector is not None and self._listener is not None:
+            self._rest.maybe_resume(self._selector, self._listener)
 
     def _drain_wake(self) -> None:
         # Drain first, then clear the flag: a tick that sets the flag and sends its byte during the drain
@@ -237,11 +233,12 @@ class NovaTcpServer:
                 return
             except OSError as exc:
                 if exc.errno in _RESOURCE_ERRNOS:
-                    self._rest_listener(exc)
+                    if self._selector is not None:
+                        self._rest.rest(self._selector, self._listener, exc)
                 else:  # the peer gave up between connect and accept (ECONNABORTED ...): the next one
                     self._refusals.warning("accept", "TCP accept failed: %s", exc)
                 return
-            self._accept_health.succeeded()
+            self._rest.health.succeeded()
             peer = peer_label(address)
             key = TcpConfig.peer_key(address[0])
             refusal = admission_refusal(self.config, self._per_address[key], len(self._clients),

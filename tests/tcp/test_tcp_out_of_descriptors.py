@@ -63,6 +63,14 @@ def test_out_of_descriptors_rests_the_listener_and_recovers() -> None:
         for c in clients:
             c.close()
         clients.clear()
+        deadline = time.monotonic() + 10.0  # the fault clears at the end of its back-off (<= 5 s), with no
+        while True:                          # peer waiting: the server finds a spare descriptor itself
+            child.stdin.write("status\n")
+            child.stdin.flush()
+            if "faults=none" in child.stdout.readline():
+                break
+            assert time.monotonic() < deadline, "tcp-accept still shown with descriptors free"
+            time.sleep(0.2)
         late = LineClient(("127.0.0.1", port))
         clients.append(late)
         assert late.read_line(timeout=10.0) == b"Hello, this is Nova for Windows.\r\n"
