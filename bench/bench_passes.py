@@ -62,7 +62,8 @@ def _run(cmd: list[str]) -> tuple[float, float, int]:
 
 def _ours(path: Path, fmt: str, workers: int = 1) -> list[str]:
     return [sys.executable, "-m", "nfwserver", "passes", "--elements", str(path), "--observer", WHERE, "--start",
-            START, "--hours", HOURS, "--format", fmt, "--workers", str(workers)]
+            START, "--hours", HOURS, "--format", fmt, "--workers", str(workers),
+            *(["--wide"] if fmt == "table" else [])]  # the table with every column, as skyfield's rows have
 
 
 def _skyfield(path: Path, fmt: str) -> list[str]:
@@ -134,7 +135,8 @@ def main() -> None:
     print("The command a user runs, as whole processes writing every pass to a file: `nfwserver passes "
           f"--elements FILE --observer {WHERE} --start {START} --hours {HOURS} --format F` (`python -m nfwserver` "
           "from the checkout, byte-compiled as `pip install` leaves it) against bench/skyfield_passes.py, which "
-          "finds the same passes with skyfield's `find_events` (0 deg) and writes the same rows. Both print the "
+          "finds the same passes with skyfield's `find_events` (0 deg) and writes the same rows (for the table, "
+          "`--wide`: the default 80-column table leaves columns out, so it would be less work). Both print the "
           "header and one row per pass with the columns catalog_number, name, aos_utc, tca_utc, los_utc, "
           "max_elevation_deg, aos_azimuth_deg, los_azimuth_deg, duration_s, in_progress: times ISO-8601 UTC "
           "with milliseconds and Z, numbers with 1 decimal in the table (duration 0) and 6 in CSV and JSON, "
