@@ -16,7 +16,6 @@ from __future__ import annotations
 import contextlib
 import os
 import re
-import secrets
 import stat
 import sys
 import time
@@ -27,7 +26,9 @@ STALE_AFTER_S = 600.0
 
 
 def _temporary_name(target: Path) -> Path:
-    return target.with_name(f".{target.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
+    """A fresh name beside ``target``: pid and 8 random hex digits (``os.urandom``: the ``secrets`` module
+    would load OpenSSL's libcrypto, 3.5 MiB in every command that writes or reads a state file)."""
+    return target.with_name(f".{target.name}.{os.getpid()}.{os.urandom(4).hex()}.tmp")
 
 
 def _create_like(tmp: Path, target: Path) -> int:

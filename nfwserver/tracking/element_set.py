@@ -16,7 +16,7 @@ from sgp4.api import WGS72, Satrec
 
 from nfwserver.tracking import amsat
 from nfwserver.tracking.element_names import sanitize_element_name
-from nfwserver.tracking.tle import TleFields, epoch_from_tle, format_tle
+from nfwserver.tracking.tle import TleFields, epoch_from_tle, exponent_field, format_tle
 
 # A line that claims to be a TLE line: line number, blank, 5-character catalog field.
 TLE_LIKE = re.compile(r"^[12] [0-9A-Z ]{4}[0-9]")
@@ -38,6 +38,13 @@ def is_csv_header(line: str) -> bool:
 class ElementSet:
     """One satellite's mean elements at an epoch, with its SGP4 model (slots: catalogs hold tens of thousands).
 
+    The set holds its canonical TLE lines and reads every other value from them when asked (the
+    ``*_deg``, ``eccentricity``, ``mean_motion_rev_per_day``, ``bstar``, ``rev_number`` and
+    ``international_designator`` properties, parsed as :func:`~nfwserver.tracking.tle.parse_tle` parses
+    them): the lines are what SGP4 and the stored catalog use, so the values always agree with them, and a
+    loaded catalog keeps about 400 bytes a set instead of twice that.  Only the name, catalog number and
+    epoch, which catalogs compare and sort by, are kept as values.
+
     The SGP4 model (:attr:`satrec`) of a set read from canonical TLE lines is initialised when first
     used: a station propagates a handful of a catalog's satellites, and the model is most of a set's
     loading time (about 3 us) and memory (about 1 KiB).  Sets from AMSAT, OMM or irregular TLE text
@@ -45,21 +52,53 @@ class ElementSet:
 
     name: str  #: name as given ("ISS (ZARYA)"), sanitised (element_names); "" when the set had none
     catalog_number: int
-    international_designator: str
-    epoch: datetime  #: aware UTC
-    inclination_deg: float
-    raan_deg: float
-    eccentricity: float
-    arg_perigee_deg: float
-    mean_anomaly_deg: float
-    mean_motion_rev_per_day: float
-    bstar: float  #: 1/earth radii
-    rev_number: int  #: revolution number at epoch
+    epoch: datetime  #: aware UTC, on the TLE's 1e-8-day grid (as line 1 holds it)
     line1: str  #: canonical TLE line 1 (generated for AMSAT and OMM input)
     line2: str
     source: str = ""
     line_number: int = 0  #: 1-based line where the set started in ``source``
     _satrec: Satrec | None = field(default=None, compare=False, repr=False)
+
+    @property
+    def international_designator(self) -> str:
+        """International designator as line 1 holds it (``98067A``), "" when blank."""
+        return self.line1[9:17].strip()
+
+    @property
+    def inclination_deg(self) -> float:
+        return float(self.line2[8:16])
+
+    @property
+    def raan_deg(self) -> float:
+        """Right ascension of the ascending node (deg)."""
+        return float(self.line2[17:25])
+
+    @property
+    def eccentricity(self) -> float:
+        digits = self.line2[26:33].strip()
+        return float(int(digits) / 10 ** len(digits))  # as parse_tle reads it
+
+    @property
+    def arg_perigee_deg(self) -> float:
+        return float(self.line2[34:42])
+
+    @property
+    def mean_anomaly_deg(self) -> float:
+        return float(self.line2[43:51])
+
+    @property
+    def mean_motion_rev_per_day(self) -> float:
+        return float(self.line2[52:63])
+
+    @property
+    def bstar(self) -> float:
+        """Drag term (1/earth radii)."""
+        return exponent_field(self.line1[53:61], "BSTAR")
+
+    @property
+    def rev_number(self) -> int:
+        """Revolution number at epoch (0 when blank)."""
+        return int(self.line2[63:68].strip() or 0)
 
     @property
     def satrec(self) -> Satrec:
@@ -80,23 +119,17 @@ class ElementSet:
                     lines: tuple[str, str] | None = None) -> ElementSet:
         """Build from parsed values; ``lines`` are the original TLE lines when there were any.
 
-        Lines generated here (AMSAT, OMM) hold the epoch on the TLE's 1e-8-day grid; the set takes that
-        epoch, so memory, the stored catalog and SGP4 agree on one value (an OMM epoch may be finer)."""
+        Lines generated here (AMSAT, OMM) hold the values as a TLE rounds them (the epoch on its 1e-8-day
+        grid); the set reads its values from those lines, so memory, the stored catalog and SGP4 agree on
+        one value (an OMM epoch or eccentricity may be finer)."""
         if lines is None:
             line1, line2 = format_tle(fields)
             fields = replace(fields, epoch=epoch_from_tle(int(line1[18:20]), float(line1[20:32])))
         else:
             line1, line2 = lines
         satrec = Satrec.twoline2rv(line1, line2, WGS72)
-        return cls(
-            name=sanitize_element_name(name), catalog_number=fields.catalog_number,
-            international_designator=fields.international_designator, epoch=fields.epoch,
-            inclination_deg=fields.inclination_deg, raan_deg=fields.raan_deg, eccentricity=fields.eccentricity,
-            arg_perigee_deg=fields.arg_perigee_deg, mean_anomaly_deg=fields.mean_anomaly_deg,
-            mean_motion_rev_per_day=fields.mean_motion_rev_per_day, bstar=fields.bstar,
-            rev_number=fields.rev_number, line1=line1, line2=line2, source=source, line_number=line_number,
-            _satrec=satrec,
-        )
+        return cls(name=sanitize_element_name(name), catalog_number=fields.catalog_number, epoch=fields.epoch,
+                   line1=line1, line2=line2, source=source, line_number=line_number, _satrec=satrec)
 
     def tle_text(self) -> str:
         """The set as three lines (name, line 1, line 2), newline-terminated.

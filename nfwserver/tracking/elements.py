@@ -220,13 +220,11 @@ def _build_block(pending: list[Any], source: str, result: LoadResult, years: dic
         row = next(rows, None)
         if good_list[k] and row is not None:
             # Checked like parse_tle would, so twoline2rv accepts it when the model is first used.
-            year2, day, cat, inc, raan, ecc, argp, ma, mm, bstar, rev = row
+            year2, day, cat = row
             base = years.get(year2)
             if base is None:
                 base = years[year2] = epoch_from_tle(year2, 1.0)
-            element_set = ElementSetDraft(
-                name, cat, line1[9:17].strip(), base + timedelta(days=day - 1.0), inc, raan, ecc, argp, ma, mm,
-                bstar, rev, line1, line2, source, start)
+            element_set = ElementSetDraft(name, cat, base + timedelta(days=day - 1.0), line1, line2, source, start)
             element_set.__class__ = ElementSet
             result.sets.append(element_set)
             k += 1
@@ -239,9 +237,8 @@ def _build_block(pending: list[Any], source: str, result: LoadResult, years: dic
         _accept(result, source, start, f"{name}: " if name else "", build)
 
 
-#: Columns of tle_bulk.read_canonical used to build a set, in ElementSet's field order after the name.
-_BULK_COLUMNS = ("year2", "day", "catalog_number", "inclination", "raan", "eccentricity", "arg_perigee",
-                 "mean_anomaly", "mean_motion", "bstar", "rev_number")
+#: Columns of tle_bulk.read_canonical a set keeps as values (the others are read from its lines when asked).
+_BULK_COLUMNS = ("year2", "day", "catalog_number")
 
 
 def _take_amsat(lines: list[str], i: int, source: str, result: LoadResult) -> int:

@@ -12,6 +12,7 @@ for unknown) in the columns; angles degrees.
 
 from __future__ import annotations
 
+import mmap
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from datetime import datetime, timedelta
@@ -135,6 +136,66 @@ class PassList(Sequence[Pass]):
 
     def __repr__(self) -> str:
         return f"PassList({len(self)} passes from {self.start.isoformat()})"
+
+
+class PassColumns:
+    """Pass columns gathered part by part (unsorted), then sorted once into a :class:`PassList`.
+
+    The columns are allocated at ``capacity`` rows up front (grown by doubling if a search finds more):
+    pages never written cost no memory, and sorting needs one column's copy at a time, where joining
+    many parts at the end would hold every part beside a second copy of the whole.  The initial capacity
+    stays under 4 MiB a column, the size from which numpy asks for huge pages (committed 2 MiB at a time).
+    """
+
+    _MAX_INITIAL = (1 << 22) // 8 - 1
+
+    def __init__(self, capacity: int) -> None:
+        self._capacity = int(min(max(capacity, 1024), self._MAX_INITIAL))
+        self._rows = 0
+        self._columns: dict[str, np.ndarray] = {}
+
+    def __len__(self) -> int:
+        return self._rows
+
+    def add(self, part: dict[str, np.ndarray]) -> None:
+        """Append the rows of ``part`` (PassList columns, all of one length; an empty dict adds nothing)."""
+        k = len(part["tca_s"]) if part else 0
+        if not k:
+            return
+        n = self._rows
+        if not self._columns or n + k > self._capacity:
+            capacity = self._capacity if not self._columns else max(2 * self._capacity, n + k)
+            for name, dtype in COLUMNS:
+                grown = _mapped(capacity, dtype)
+                if name in self._columns:
+                    grown[:n] = self._columns[name][:n]
+                self._columns[name] = grown
+            self._capacity = capacity
+        for name, _ in COLUMNS:
+            self._columns[name][n : n + k] = part[name]
+        self._rows = n + k
+
+    def pass_list(self, start: datetime, window_s: float) -> PassList:
+        """The passes gathered, sorted as a :class:`PassList`; the gathered columns are released, one at a
+        time."""
+        n, columns = self._rows, self._columns
+        self._columns, self._rows = {}, 0
+        if not n:
+            return PassList(start, window_s)
+        first = np.where(np.isnan(columns["aos_s"][:n]), columns["tca_s"][:n], columns["aos_s"][:n])
+        order = np.lexsort((columns["catalog_number"][:n], first))
+        del first
+        merged = {}
+        for name, _ in COLUMNS:
+            merged[name] = columns.pop(name)[:n][order]
+        return PassList(start, window_s, merged, sort=False)
+
+
+def _mapped(rows: int, dtype: type) -> np.ndarray:
+    """An array of ``rows`` in its own anonymous memory map: its pages take memory only once written, and it
+    is unmapped (given back to the system) when the array is freed, whatever the C heap does meanwhile."""
+    buffer = mmap.mmap(-1, max(rows, 1) * np.dtype(dtype).itemsize)
+    return np.frombuffer(buffer, dtype=dtype)
 
 
 def distinct(values: np.ndarray) -> np.ndarray:

@@ -46,7 +46,7 @@ from nfwserver.tracking.observer import Observer
 from nfwserver.tracking.pass_assemble import assemble
 from nfwserver.tracking.pass_batch import Batch, Chunk
 from nfwserver.tracking.pass_kinematics import PairEvaluator
-from nfwserver.tracking.pass_records import Pass, PassList
+from nfwserver.tracking.pass_records import Pass, PassColumns, PassList
 from nfwserver.tracking.pass_screen import screen
 from nfwserver.tracking.timescale import julian_date
 
@@ -165,7 +165,10 @@ def find_passes(
     slow = ~short & (rev_per_day < _SLOW_REV_PER_DAY) & (ecc < 0.05)
     other = ~short & ~slow
     look_back = np.where((ecc < 0.05) & short, 0.5, 1.0) * periods  # s
-    parts: list[dict[str, np.ndarray]] = []
+    # Room for every pass there can be over a flat horizon (one per orbit in the searched span, plus the
+    # first); an obstructed horizon can split passes, and then the columns grow.
+    found = PassColumns(int(np.sum(np.ceil((window_s + 2.0 * np.minimum(look_back, SECONDS_PER_DAY)) / periods))
+                            + len(periods)))
     batch = Batch()
     # The rest is split by period so that each part looks back and ahead only as far as it needs.
     for group, step in ((short, _LOW_STEP_S), (slow, _SLOW_STEP_S), (other & (periods <= 8 * 3600.0), _OTHER_STEP_S),
@@ -181,11 +184,11 @@ def find_passes(
             batch.add(_screen_chunk(models, catalog_numbers[idx], observer, start, end, horizon, ut1_utc,
                                     fine_step_s, step, extension))
             if batch.size >= _BATCH_BRACKETS:
-                parts.append(_refine(batch, observer, horizon, ut1_utc))
+                found.add(_refine(batch, observer, horizon, ut1_utc))
                 batch = Batch()
     if batch.chunks:
-        parts.append(_refine(batch, observer, horizon, ut1_utc))
-    return PassList.concat(start, window_s, parts)
+        found.add(_refine(batch, observer, horizon, ut1_utc))
+    return found.pass_list(start, window_s)
 
 
 def _orbits(satellites: Sequence[Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -67,7 +67,7 @@ def encode_catalog_number(number: int) -> str:
     return _ALPHA5[number // 10000 - 10] + f"{number % 10000:04d}"
 
 
-def _exp_field(text: str, what: str) -> float:
+def exponent_field(text: str, what: str) -> float:
     """Value of an assumed-decimal exponent field like `` 12345-3`` (= 0.12345e-3)."""
     text = text.strip()
     if not text:
@@ -215,8 +215,8 @@ def parse_tle(line1: str, line2: str) -> TleFields:
         international_designator=l1[9:17].strip(),
         epoch=epoch_from_tle(int(year_text), day),
         mean_motion_dot=_float(l1[33:43], "first derivative of mean motion"),
-        mean_motion_ddot=_exp_field(l1[44:52], "second derivative of mean motion"),
-        bstar=_exp_field(l1[53:61], "BSTAR"),
+        mean_motion_ddot=exponent_field(l1[44:52], "second derivative of mean motion"),
+        bstar=exponent_field(l1[53:61], "BSTAR"),
         ephemeris_type=ephemeris_type,
         element_number=element_number,
         inclination_deg=_float(l2[8:16], "inclination"),

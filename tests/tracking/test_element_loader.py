@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 from datetime import datetime, timezone
 
 import pytest
@@ -254,3 +255,35 @@ def test_lines_split_in_pieces_match_a_whole_split(monkeypatch) -> None:
         data = data[:cut] + b"\xff" + data[cut:]
         whole = data.decode("utf-8", "replace").replace("\r\n", "\n").replace("\r", "\n").split("\n")
         assert elements._split_lines(data) == whole
+
+
+def test_every_value_a_set_reads_from_its_lines_is_the_one_sgp4_reads() -> None:
+    """A set keeps only its lines (and name, number, epoch); its other values are read from them when asked.
+    sgp4's own TLE parser is the oracle: every value of every set of a 15,000-object catalog agrees with it
+    (radians and rad/min converted back to the TLE's units, which sgp4 computes from the same digits)."""
+    result = load_element_file(DATA / "active.txt")
+    assert len(result.sets) > 15000 and not result.rejected
+    for es in result.sets:
+        sat = Satrec.twoline2rv(es.line1, es.line2)
+        assert es.catalog_number == sat.satnum
+        assert es.eccentricity == sat.ecco
+        assert es.bstar == sat.bstar
+        assert es.rev_number == sat.revnum
+        assert es.international_designator == sat.intldesg
+        assert math.radians(es.inclination_deg) == pytest.approx(sat.inclo, rel=1e-15, abs=1e-15)
+        assert math.radians(es.raan_deg) == pytest.approx(sat.nodeo, rel=1e-15, abs=1e-15)
+        assert math.radians(es.arg_perigee_deg) == pytest.approx(sat.argpo, rel=1e-15, abs=1e-15)
+        assert math.radians(es.mean_anomaly_deg) == pytest.approx(sat.mo, rel=1e-15, abs=1e-15)
+        assert es.mean_motion_rev_per_day * 2.0 * math.pi / 1440.0 == pytest.approx(sat.no_kozai, rel=1e-15)
+        jd = (es.epoch - datetime(2000, 1, 1, 12, tzinfo=timezone.utc)).total_seconds() / 86400.0 + 2451545.0
+        assert jd == pytest.approx(sat.jdsatepoch + sat.jdsatepochF, abs=2e-9)  # 0.2 ms: the datetime's resolution
+
+
+def test_values_of_a_generated_set_are_those_of_its_lines() -> None:
+    """An AMSAT set's values are the ones its generated TLE lines hold (what SGP4 and the stored catalog
+    use), not the finer ones of the text it came from."""
+    first = load_elements(AMSAT_W5BWF, "amsat").sets[0]
+    sat = Satrec.twoline2rv(first.line1, first.line2)
+    assert first.eccentricity == sat.ecco == 0.6027104
+    assert first.bstar == sat.bstar
+    assert math.radians(first.mean_anomaly_deg) == pytest.approx(sat.mo, rel=1e-15)

@@ -54,3 +54,31 @@ def test_concat_merges_parts_in_order_and_empty_lists_work() -> None:
     assert [p.catalog_number for p in merged] == [7530, 40000, 25544]
     empty = PassList(START, 10.0)
     assert len(empty) == 0 and list(empty) == [] and empty[:] == []
+
+
+def test_columns_gathered_in_parts_past_their_capacity_sort_like_one_list() -> None:
+    """PassColumns (the search's gatherer) grows past its first capacity and sorts what it gathered exactly as
+    PassList sorts the same rows given at once: by AOS (TCA when AOS is unknown), then catalog number."""
+    from nfwserver.tracking.pass_records import PassColumns
+
+    rng = np.random.default_rng(7)
+    parts = []
+    for size in (700, 0, 1500, 3000, 1):
+        tca = rng.uniform(-200.0, 86700.0, size).round(0)  # rounded: equal times, ordered by number
+        aos = np.where(rng.random(size) < 0.1, NAN, tca - 300.0)
+        parts.append({"catalog_number": rng.integers(1, 60000, size), "aos_s": aos, "tca_s": tca,
+                      "los_s": tca + 300.0, "max_elevation_deg": rng.uniform(0, 90, size),
+                      "aos_azimuth_deg": rng.uniform(0, 360, size), "los_azimuth_deg": rng.uniform(0, 360, size)})
+    gathered = PassColumns(capacity=1024)
+    for part in parts:
+        gathered.add(part)
+    gathered.add({})
+    assert len(gathered) == 5201
+    result = gathered.pass_list(START, 86400.0)
+    expected = PassList(START, 86400.0, {k: np.concatenate([p[k] for p in parts]) for k in parts[0]})
+    assert len(result) == 5201
+    for name, column in expected.columns.items():
+        np.testing.assert_array_equal(result.columns[name], column)
+    keys = [(p.aos or p.tca, p.catalog_number) for p in result]
+    assert keys == sorted(keys)
+    assert len(gathered) == 0 and len(gathered.pass_list(START, 86400.0)) == 0
