@@ -24,7 +24,7 @@ import numpy as np
 from nfwserver.cli.output_columns import SPACE, Cells, Column, codes_of
 
 #: Rows formatted at a time (bounds the temporary matrices: a few MiB).
-BLOCK_ROWS = 1024
+BLOCK_ROWS = 2048
 
 
 def _justify(cells: Cells, width: int) -> np.ndarray:
