@@ -38,6 +38,9 @@ _PAREN = re.compile(r"\(([^)]*)\)")
 _BLANKS = re.compile(r"\s+")
 _DASHES = re.compile(r"-{2,}")
 _WORD_END = re.compile(r"[\s&/]+")
+#: Text that the substitutions of :func:`sanitize` would only turn blanks into dashes in: words of allowed
+#: characters other than ``-``, each separated by one blank or one ``-``.
+_PLAIN = re.compile(r"[A-Za-z0-9_.+/]+(?:[ -][A-Za-z0-9_.+/]+)*")
 
 
 def sanitize(text: str) -> str:
@@ -46,9 +49,13 @@ def sanitize(text: str) -> str:
     A long name that ends in a number keeps the number whole and shortens what precedes it
     (``STARLINK-1008`` -> ``STARLIN-1008``); other long names are cut.
     """
-    text = _BLANKS.sub("-", text.strip())
-    text = _ALLOWED.sub("", text)
-    text = _DASHES.sub("-", text).strip("-")
+    text = text.strip()
+    if _PLAIN.fullmatch(text):  # most names: one match instead of three substitutions
+        text = text.replace(" ", "-")
+    else:
+        text = _BLANKS.sub("-", text)
+        text = _ALLOWED.sub("", text)
+        text = _DASHES.sub("-", text).strip("-")
     if len(text) > MAX_LENGTH:
         head, sep, tail = text.rpartition("-")
         if sep and head and any(c.isdigit() for c in tail) and len(tail) <= MAX_LENGTH - 4:
@@ -89,8 +96,11 @@ def _candidates(element_name: str, catalog_number: int) -> Iterator[str]:
     name = element_name.strip()
     if name.startswith("0 "):
         name = name[2:]
-    inner = [p.strip() for p in _PAREN.findall(name)]
-    main = _PAREN.sub(" ", name).strip()
+    if "(" in name:
+        inner = [p.strip() for p in _PAREN.findall(name)]
+        main = _PAREN.sub(" ", name).strip()
+    else:
+        inner, main = [], name.strip()
     given: set[str] = {""}
 
     def fresh(cand: str) -> bool:

@@ -43,3 +43,33 @@ def test_collisions_resolved_by_catalog_number() -> None:
 def test_any_name_gives_a_valid_dde_name(name: str, catnr: int) -> None:
     assert validate_dde_name(dde_name_for(name, catnr))
     assert len(sanitize(name)) <= 12
+
+
+def _sanitize_by_the_rule(text: str) -> str:
+    """The rule of :func:`sanitize`'s docstring spelt out with three substitutions, one step each: blanks
+    become ``-``, characters outside ``A-Z a-z 0-9 - _ . + /`` are dropped, runs of ``-`` become one and
+    none opens or ends the name; then the 12-character cut that keeps a trailing number whole."""
+    import re
+
+    text = re.sub(r"\s+", "-", text.strip())
+    text = re.sub(r"[^A-Za-z0-9_.+/-]", "", text)
+    text = re.sub(r"-{2,}", "-", text).strip("-")
+    if len(text) > 12:
+        head, sep, tail = text.rpartition("-")
+        if sep and head and any(c.isdigit() for c in tail) and len(tail) <= 8:
+            return head[: 12 - len(tail) - 1].rstrip("-") + "-" + tail
+    return text[:12].rstrip("-")
+
+
+@given(st.text(alphabet=st.sampled_from("AZaz09_.+/- \t()&'é"), max_size=30))
+def test_sanitize_follows_its_rule_for_any_text(text: str) -> None:
+    assert sanitize(text) == _sanitize_by_the_rule(text)
+
+
+def test_sanitize_follows_its_rule_for_every_name_of_a_catalog() -> None:
+    from tests.conftest import DATA
+
+    names = (DATA / "active.txt").read_text().splitlines()[0::3]
+    assert len(names) > 15000
+    for name in names:
+        assert sanitize(name) == _sanitize_by_the_rule(name)
