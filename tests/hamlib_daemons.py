@@ -50,21 +50,61 @@ class HamlibDaemon:
         self.proc: subprocess.Popen[bytes] | None = None
         self._reader: socket.socket | None = None
         self._pending = b""
+        self._started_once = False
 
     def start(self, timeout: float = 10.0) -> HamlibDaemon:
-        """Start the daemon and wait until it accepts connections."""
-        cmd = [self.program, "-m", str(self.model), "-T", self.host, "-t", str(self.port), *self.extra]
-        self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        """Start the daemon and wait until it accepts connections.
+
+        The port is free when chosen, but another test running in parallel may take it before the daemon
+        binds it; the daemon then exits and, on the first start, a new port is tried.  A listener that
+        answers is taken as the daemon only once it is seen to belong to this process (Linux: /proc), so a
+        test never talks, unknowingly, to another test's daemon."""
         deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            if self.proc.poll() is not None:
-                raise RuntimeError(f"{cmd[0]} exited with {self.proc.returncode}: {' '.join(cmd)}")
-            try:
-                with socket.create_connection((self.host, self.port), timeout=0.2):
-                    return self
-            except OSError:
+        for _attempt in range(5):
+            cmd = [self.program, "-m", str(self.model), "-T", self.host, "-t", str(self.port), *self.extra]
+            self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            while time.monotonic() < deadline and self.proc.poll() is None:
+                if self._listening_here():
+                    try:
+                        with socket.create_connection((self.host, self.port), timeout=0.2):
+                            self._started_once = True
+                            return self
+                    except OSError:
+                        pass
                 time.sleep(0.02)
+            if self.proc.poll() is None:
+                break
+            if self._started_once:  # a restart must keep its port: the test is about that port
+                raise RuntimeError(f"{cmd[0]} exited with {self.proc.returncode}: {' '.join(cmd)}")
+            self.port = free_port()
+        else:
+            raise RuntimeError(f"{self.program} could not listen on a free port in 5 attempts")
         raise RuntimeError(f"{' '.join(cmd)} did not listen within {timeout} s")
+
+    def _listening_here(self) -> bool:
+        """True once this daemon process holds the listening socket on ``port`` (where /proc can tell;
+        elsewhere, once anything listens there)."""
+        try:
+            with open("/proc/net/tcp") as table:
+                rows = [line.split() for line in table.readlines()[1:]]
+        except OSError:
+            return True
+        wanted = f"0100007F:{self.port:04X}"
+        inodes = {row[9] for row in rows if row[1] == wanted and row[3] == "0A"}  # 0A: LISTEN
+        if not inodes or self.proc is None:
+            return False
+        try:
+            fds = os.listdir(f"/proc/{self.proc.pid}/fd")
+        except OSError:
+            return False
+        for fd in fds:
+            try:
+                link = os.readlink(f"/proc/{self.proc.pid}/fd/{fd}")
+            except OSError:
+                continue
+            if link.startswith("socket:[") and link[8:-1] in inodes:
+                return True
+        return False
 
     def kill(self) -> None:
         """Kill the daemon (SIGKILL) and wait for it to be gone."""
