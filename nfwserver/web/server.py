@@ -27,6 +27,7 @@ import socket
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from datetime import datetime
 from http.server import ThreadingHTTPServer
 from typing import Any
 
@@ -187,22 +188,28 @@ class WebServer:
     # -- frames (thread nfw-web) -------------------------------------------------------------------
     def _frames(self) -> None:
         clock = self.core.clock
-        last = -1e18
+        framed: datetime | None = None  # the instant of the sample the last frame carried
         while not self._stop.is_set():
             clock.wait(self._ticked, 1.0)
             if self._stop.is_set():
                 break
-            early = 1.0 / MAX_FRAME_HZ - (clock.monotonic() - last)
-            if early > 0:  # a feed faster than MAX_FRAME_HZ: frames carry the newest sample at that rate
-                clock.wait(self._stop, early)
+            sample = self._sample
+            if sample is not None and framed is not None:
+                # A feed faster than MAX_FRAME_HZ: frames carry the newest sample at that rate.  Measured
+                # between the samples' own instants, not by the clock when the frame thread woke: a frame
+                # thread that woke late must not hold back the next sample's frame (on a clock that then
+                # stands still, for good).
+                early = 1.0 / MAX_FRAME_HZ - (sample.time - framed).total_seconds()
+                if early > 1e-6:
+                    clock.wait(self._stop, early)
             self._ticked.clear()
-            last = clock.monotonic()
             try:
-                self._build_frame()
+                framed = self._build_frame()
             except Exception:  # the page shows the last frame; the station carries on
                 log.exception("web: building a frame failed")
 
-    def _build_frame(self) -> None:
+    def _build_frame(self) -> datetime | None:
+        """Build and publish a frame of the newest sample; returns that sample's instant (None without one)."""
         now = self.core.clock.now()
         sample = self._sample or self.core.tracker.last_sample
         events, skipped = self._follower.new_events()
@@ -220,6 +227,7 @@ class WebServer:
         self._latest = frame
         self.stats.frames += 1
         self.hub.publish(json.dumps(frame, allow_nan=False, default=str).encode())
+        return sample.time if sample is not None else None
 
     def _counts(self) -> dict[str, object]:
         counts: dict[str, object] = {"web_streams": self.stats.streams}

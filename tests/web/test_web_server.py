@@ -185,3 +185,30 @@ def test_run_web_serves_the_dashboard_for_one_run_and_prints_its_url(tmp_path, c
     assert serve(config, plan) == 0
     driver.join()
     assert urls and f"nfwserver: web dashboard: {urls[0]}" in capsys.readouterr().err
+
+
+def test_a_newer_sample_is_framed_even_if_the_clock_then_stands_still() -> None:
+    """The frame thread once measured its rate limit from the clock's time when it woke: woken late (under
+    load), it took the next tick for one less than 0.1 s after its frame and waited 0.1 s of clock time for
+    it; on a clock that then stood still, that newest sample was never framed and the page stayed one tick
+    behind for good (the browser test flaked with it).  The limit is now measured between samples."""
+    from dataclasses import replace
+
+    clock = VirtualClock(ISS_PASS.aos + timedelta(seconds=200))
+    core = StationCore(CATALOG, OBSERVER, clock, satellite=25544, rate_hz=5.0)
+    core.set_tune(True)
+    web = WebServer(core, WebConfig(enabled=True, port=0))
+    web.start()
+    try:
+        first = core.tick(clock.now())  # the publisher's work, listeners included
+        wait_for(lambda: web.stats.frames >= 2, what="the first tick's frame")
+        seen = web.hub.seq
+        # The clock stands still from here; the ticks below are what a publisher catching up delivers.
+        web.on_tick(replace(first, time=first.time + timedelta(seconds=0.2), text="LATE AZ:1.0 EL:2.0 RR:0.0 AH:Y"))
+        wait_for(lambda: web.hub.seq > seen, timeout_s=10.0, what="the late sample's frame")
+        seen = web.hub.seq
+        web.on_tick(replace(first, time=first.time + timedelta(seconds=0.4), text="NEWEST AZ:1.0 EL:2.0 RR:0.0 AH:Y"))
+        wait_for(lambda: web.hub.seq > seen and b"NEWEST" in (web.hub.newest()[1] or b""), timeout_s=10.0,
+                 what="the newest sample's frame, the clock standing still")
+    finally:
+        web.stop()
