@@ -104,14 +104,19 @@ def _screen(sats: list[Any], catalog: Catalog, observer: Observer, ut1_utc: floa
 
     usable = usable_mask(sats, observer, at, ut1_utc).tolist()
     if not all(usable):
-        unusable = [s for s, ok in zip(sats, usable) if not ok]
-        names = _dde_names(unusable[:5], catalog) + (", ..." if len(unusable) > 5 else "")
-        warn(f"skipped {len(unusable)} object(s) whose position at {format_time(at)} cannot be computed "
-             f"or is implausibly far (decayed or elements far outside their validity): {names}")
+        _report_unusable([s for s, ok in zip(sats, usable) if not ok], catalog, at)
         sats = [s for s, ok in zip(sats, usable) if ok]
     if report_stale:
         _report_stale(stale_satellites(sats, at, stale_days), catalog, at, stale_days)
     return sats
+
+
+def _report_unusable(unusable: list[Any], catalog: Catalog, at: datetime) -> None:
+    """Warn of the satellites (or element sets) left out because their positions at ``at`` are unusable,
+    naming up to five by DDE name."""
+    names = _dde_names(unusable[:5], catalog) + (", ..." if len(unusable) > 5 else "")
+    warn(f"skipped {len(unusable)} object(s) whose position at {format_time(at)} cannot be computed "
+         f"or is implausibly far (decayed or elements far outside their validity): {names}")
 
 
 def _report_stale(stale: list[Any], catalog: Catalog, at: datetime, stale_days: float,
@@ -246,17 +251,21 @@ def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str], di
     sets = _chosen_sets(args, inputs, catalog)
     compact = args.format == "table" and not args.wide  # the only output that shows DDE names
     stale_days = _stale_days(inputs)
-    # The compact table names its satellites after the search: the stale sets are named then, in the same go.
-    sets = _screen(sets, catalog, observer, ut1_utc, start, stale_days, report_stale=not compact)
-    stale = stale_satellites(sets, start, stale_days) if compact else []
+    # The search leaves out the sets unusable at the start (it makes their models anyway); they and the
+    # stale sets are reported after it, before any row (the compact table names them with its satellites).
     passes = find_passes(sets, observer, start, start + timedelta(hours=args.hours), horizon=horizon,
                          ut1_utc=ut1_utc, workers=args.workers)
+    if passes.skipped:
+        left_out = set(passes.skipped)
+        _report_unusable([s for s in sets if s.catalog_number in left_out], catalog, start)
+        sets = [s for s in sets if s.catalog_number not in left_out]
+    stale = stale_satellites(sets, start, stale_days)
     numbers = passes.catalog_numbers()
     named: dict[int, str] = {}
     if compact:
         wanted = numbers + [s.catalog_number for s in stale[:5]]
         named = dict(zip(wanted, catalog.dde_names_of(wanted)))
-        _report_stale(stale, catalog, start, stale_days, named)
+    _report_stale(stale, catalog, start, stale_days, named)
     return (passes, dict(zip(numbers, _display_names(numbers, sets, catalog))),
             {n: named[n] for n in numbers} if compact else {})
 

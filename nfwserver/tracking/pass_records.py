@@ -56,14 +56,18 @@ class PassList(Sequence[Pass]):
 
     ``window_s`` is the length of the searched window: a pass whose AOS is unknown or before 0
     has ``aos_before_start``, one whose LOS is unknown or after ``window_s`` has ``los_after_end``.
+    ``skipped`` are the catalog numbers of the satellites the search left out because their positions at
+    the window start cannot be computed or are implausibly far (:mod:`~nfwserver.tracking.screening`),
+    ascending.
     """
 
-    __slots__ = ("start", "window_s", "columns")
+    __slots__ = ("start", "window_s", "columns", "skipped")
 
     def __init__(self, start: datetime, window_s: float, columns: dict[str, np.ndarray] | None = None,
-                 sort: bool = True) -> None:
+                 sort: bool = True, skipped: Sequence[int] = ()) -> None:
         self.start = start
         self.window_s = float(window_s)
+        self.skipped: tuple[int, ...] = tuple(sorted(skipped))
         cols = {name: np.asarray((columns or {}).get(name, np.empty(0)), dtype=dt) for name, dt in COLUMNS}
         if sort and len(cols["tca_s"]):
             first = np.where(np.isnan(cols["aos_s"]), cols["tca_s"], cols["aos_s"])
@@ -78,16 +82,17 @@ class PassList(Sequence[Pass]):
         Column by column, emptying ``parts`` as it goes, so that the peak memory stays near one
         copy of the result.
         """
+        skipped = [n for p in parts if isinstance(p, PassList) for n in p.skipped]
         cols = [p.columns if isinstance(p, PassList) else p for p in parts if len(p)]
         if not cols:
-            return cls(start, window_s)
+            return cls(start, window_s, skipped=skipped)
         first = np.concatenate([np.where(np.isnan(c["aos_s"]), c["tca_s"], c["aos_s"]) for c in cols])
         order = np.lexsort((np.concatenate([c["catalog_number"] for c in cols]), first))
         del first
         merged = {}
         for name, _ in COLUMNS:
             merged[name] = np.concatenate([c.pop(name) for c in cols])[order]
-        return cls(start, window_s, merged, sort=False)
+        return cls(start, window_s, merged, sort=False, skipped=skipped)
 
     def __len__(self) -> int:
         return len(self.columns["tca_s"])
@@ -175,20 +180,20 @@ class PassColumns:
             self._columns[name][n : n + k] = part[name]
         self._rows = n + k
 
-    def pass_list(self, start: datetime, window_s: float) -> PassList:
-        """The passes gathered, sorted as a :class:`PassList`; the gathered columns are released, one at a
-        time."""
+    def pass_list(self, start: datetime, window_s: float, skipped: Sequence[int] = ()) -> PassList:
+        """The passes gathered, sorted as a :class:`PassList` (with ``skipped``); the gathered columns are
+        released, one at a time."""
         n, columns = self._rows, self._columns
         self._columns, self._rows = {}, 0
         if not n:
-            return PassList(start, window_s)
+            return PassList(start, window_s, skipped=skipped)
         first = np.where(np.isnan(columns["aos_s"][:n]), columns["tca_s"][:n], columns["aos_s"][:n])
         order = np.lexsort((columns["catalog_number"][:n], first))
         del first
         merged = {}
         for name, _ in COLUMNS:
             merged[name] = columns.pop(name)[:n][order]
-        return PassList(start, window_s, merged, sort=False)
+        return PassList(start, window_s, merged, sort=False, skipped=skipped)
 
 
 def _mapped(rows: int, dtype: type) -> np.ndarray:

@@ -48,6 +48,7 @@ from nfwserver.tracking.pass_batch import Batch, Chunk
 from nfwserver.tracking.pass_kinematics import PairEvaluator
 from nfwserver.tracking.pass_records import Pass, PassColumns, PassList
 from nfwserver.tracking.pass_screen import screen
+from nfwserver.tracking.screening import usable_models
 from nfwserver.tracking.timescale import julian_date
 
 if TYPE_CHECKING:  # multiprocessing is imported only when workers are forked (1.3 MiB, 5 ms)
@@ -133,9 +134,12 @@ def find_passes(
 
     Returns the passes overlapping the window, sorted by AOS (TCA when AOS is unknown), as a
     :class:`~nfwserver.tracking.pass_records.PassList` (a read-only sequence of :class:`Pass`).  See the
-    module docstring for the method and for passes cut by the window.  ``fine_step_s`` is the
-    sampling step for low eccentric orbits and under non-flat horizons; slower satellites are
-    sampled proportionally more coarsely.
+    module docstring for the method and for passes cut by the window.  Satellites whose positions at
+    ``start`` cannot be computed or are implausibly far (:mod:`~nfwserver.tracking.screening`: decayed, or
+    elements far outside their validity) are left out and listed in the result's ``skipped``.
+
+    ``fine_step_s`` is the sampling step for low eccentric orbits and under non-flat horizons; slower
+    satellites are sampled proportionally more coarsely.
 
     ``workers`` > 1 splits large catalogs over that many forked processes (POSIX only; meant for
     command-line use).  Forking a process that runs other threads can deadlock the child, so the
@@ -170,6 +174,8 @@ def find_passes(
     found = PassColumns(int(np.sum(np.ceil((window_s + 2.0 * np.minimum(look_back, SECONDS_PER_DAY)) / periods))
                             + len(periods)))
     batch = Batch()
+    jd_start, fr_start = julian_date(start)
+    skipped: list[int] = []
     # The rest is split by period so that each part looks back and ahead only as far as it needs.
     for group, step in ((short, _LOW_STEP_S), (slow, _SLOW_STEP_S), (other & (periods <= 8 * 3600.0), _OTHER_STEP_S),
                         (other & (periods > 8 * 3600.0) & (periods <= 13 * 3600.0), _OTHER_STEP_S),
@@ -181,6 +187,13 @@ def find_passes(
             idx = members[c0 : c0 + _CHUNK]
             extension = float(min(np.max(look_back[idx]), SECONDS_PER_DAY))
             models = [_model(satellites[i]) for i in idx]
+            usable = usable_models(models, observer, jd_start, fr_start, ut1_utc)
+            if not usable.all():  # the check every caller would make, on the models made here anyway
+                skipped += catalog_numbers[idx[~usable]].tolist()
+                models = [m for m, ok in zip(models, usable.tolist()) if ok]
+                idx = idx[usable]
+                if not models:
+                    continue
             batch.add(_screen_chunk(models, catalog_numbers[idx], observer, start, end, horizon, ut1_utc,
                                     fine_step_s, step, extension))
             if batch.size >= _BATCH_BRACKETS:
@@ -188,7 +201,7 @@ def find_passes(
                 batch = Batch()
     if batch.chunks:
         found.add(_refine(batch, observer, horizon, ut1_utc))
-    return found.pass_list(start, window_s)
+    return found.pass_list(start, window_s, skipped)
 
 
 def _orbits(satellites: Sequence[Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

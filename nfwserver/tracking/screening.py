@@ -61,12 +61,19 @@ def usable_mask(satellites: Sequence[Any], observer: Observer, at: datetime, ut1
     jd, fr = julian_date(at)
     for b0 in range(0, len(satellites), _BLOCK):
         models = [_model(s) for s in satellites[b0 : b0 + _BLOCK]]
-        arr = look_angles_array(models, observer, np.array([jd]), np.array([fr]), ut1_utc)
-        rng = arr.range_km[:, 0]
-        with np.errstate(invalid="ignore"):
-            good[b0 : b0 + len(models)] = np.isfinite(rng) & (rng <= max_range_km) & np.isfinite(
-                arr.elevation_deg[:, 0])
+        good[b0 : b0 + len(models)] = usable_models(models, observer, jd, fr, ut1_utc, max_range_km)
     return good
+
+
+def usable_models(models: Sequence[Any], observer: Observer, jd: float, fr: float, ut1_utc: float = 0.0,
+                  max_range_km: float = MAX_PLAUSIBLE_RANGE_KM) -> npt.NDArray[np.bool_]:
+    """True for each SGP4 model (``sgp4`` Satrec) whose position at the UTC Julian date ``jd + fr`` is usable
+    (see the module docstring)."""
+    arr = look_angles_array(list(models), observer, np.array([jd]), np.array([fr]), ut1_utc)
+    rng = arr.range_km[:, 0]
+    with np.errstate(invalid="ignore"):
+        usable: npt.NDArray[np.bool_] = np.isfinite(rng) & (rng <= max_range_km) & np.isfinite(arr.elevation_deg[:, 0])
+    return usable
 
 
 def _model(satellite: Any) -> Any:

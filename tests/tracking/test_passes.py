@@ -207,9 +207,11 @@ def test_sgp4s_pure_python_model_finds_the_same_passes(monkeypatch) -> None:
     Satrec and SatrecArray; the search must run on them and agree with the compiled extension."""
     import sgp4.model
 
-    from nfwserver.tracking import pass_screen
+    from nfwserver.tracking import look_angles, pass_screen
 
+    # As the self-check does before these modules import it: every module's SatrecArray is the pure one.
     monkeypatch.setattr(pass_screen, "SatrecArray", sgp4.model.SatrecArray)
+    monkeypatch.setattr(look_angles, "SatrecArray", sgp4.model.SatrecArray)
     sets = VISUAL[:3]
     pure = find_passes([sgp4.model.Satrec.twoline2rv(s.line1, s.line2) for s in sets], OBSERVERS[0], START,
                        START + timedelta(hours=8))

@@ -6,13 +6,13 @@ import csv
 import io
 import json
 import re
-from datetime import datetime, timezone
+from datetime import datetime, timedelta, timezone
 
 import pytest
 
 from nfwserver.cli import main
 from nfwserver.tracking.elements import load_element_file
-from nfwserver.tracking.observer import Observer
+from nfwserver.tracking.observer import Observer, parse_observer
 from tests.conftest import DATA
 from tests.tracking.skyfield_oracle import skyfield_look_angles
 
@@ -196,3 +196,32 @@ def test_passes_table_csv_and_json_of_the_same_passes(capsys) -> None:
         if row["aos_utc"]:
             assert row["aos_utc"] in line
         assert f"{float(row['max_elevation_deg']):.1f}" in line.split()
+
+
+def test_passes_leaves_out_an_object_unusable_at_the_start_and_says_so(capsys, tmp_path) -> None:
+    """The search itself leaves out the sets whose positions at the start are unusable (the same check as
+    `visible`, judged by SGP4's own result: 63876 is 4.7e10 km away on 2026-07-01); `passes` names them
+    once, and every other satellite's passes are those of a search without them."""
+    from sgp4.api import jday
+
+    from nfwserver.tracking.passes import find_passes
+
+    active = load_element_file(DATA / "active.txt").sets
+    far = next(s for s in active if s.catalog_number == 63876)
+    iss = next(s for s in active if s.catalog_number == 25544)
+    error, position, _ = far.satrec.sgp4(*jday(2026, 7, 1, 0, 0, 0))
+    assert error == 0 and sum(p * p for p in position) ** 0.5 > 1e9  # the library's own verdict
+    start = datetime(2026, 7, 1, tzinfo=timezone.utc)
+    observer = parse_observer("52.2,0.12")
+    both = find_passes([far, iss], observer, start, start + timedelta(hours=12))
+    alone = find_passes([iss], observer, start, start + timedelta(hours=12))
+    assert both.skipped == (63876,) and alone.skipped == ()
+    assert len(both) == len(alone) >= 3 and list(both) == list(alone)
+    elements = tmp_path / "two.txt"
+    elements.write_text(far.tle_text() + iss.tle_text())
+    assert main(["passes", "--elements", str(elements), "--observer", "52.2,0.12", "--start", "2026-07-01T00:00Z",
+                 "--hours", "12", "--format", "csv"]) == 0
+    out, err = capsys.readouterr()
+    rows = list(csv.DictReader(io.StringIO(out)))
+    assert {r["catalog_number"] for r in rows} == {"25544"} and len(rows) == len(alone)
+    assert err.count("skipped 1 object(s) whose position at 2026-07-01T00:00:00.000Z cannot be computed") == 1
