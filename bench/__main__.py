@@ -8,6 +8,9 @@ Benchmarks in ``OPT_IN`` run only when named: ``wine-dde`` needs a Wine prefix (
 ``python -m bench reliability [OPTIONS]`` (``STANDALONE``) runs the hostile-input and fault campaign
 (bench/bench_reliability.py) with its output on the terminal and its options passed on; its figures go to
 docs/RELIABILITY.md by hand, not to docs/BENCHMARKS.md.
+
+A section may end in analysis written by hand: everything from a line :data:`KEPT` on is kept when the
+benchmark writes its section again (the figures above it are the benchmark's, the reading of them is not).
 """
 
 from __future__ import annotations
@@ -24,6 +27,8 @@ ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs" / "BENCHMARKS.md"
 OPT_IN = ("wine_dde",)  #: run only when named
 STANDALONE = ("reliability", "faults")  #: run alone, named first, with their own options; they write no section
+#: Opens the hand-written end of a section, which a new run of its benchmark keeps.
+KEPT = "<!-- written by hand: kept when the benchmark rewrites this section -->"
 HEADER = ("# Benchmarks\n\nRegenerate with `python -m bench` (a subset: `python -m bench NAME ...`; the Wine "
           "section: `NFW_WINE_HOME=... python -m bench wine-dde`).\n")
 
@@ -67,7 +72,11 @@ def main(argv: list[str]) -> int:
         sections = _sections(proc.stdout)
         if not sections:
             print(f"  bench_{name} printed no section: its section is kept as it was", file=sys.stderr)
-        old.update(sections)
+        for heading, section in sections.items():
+            before = old.get(heading, "")
+            if KEPT in before and KEPT not in section:
+                section = section.rstrip() + "\n\n" + before[before.index(KEPT):].rstrip() + "\n"
+            old[heading] = section
         print(f"  done in {time.monotonic() - started:.1f} s", file=sys.stderr)
     stamp = time.strftime("%Y-%m-%d", time.gmtime())
     text = HEADER + f"\nLast run {stamp}. {_machine()}\n\n" + "\n".join(old[h] for h in sorted(old))
