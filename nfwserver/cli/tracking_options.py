@@ -187,20 +187,33 @@ def _catalog_from_files(paths: list[str], inputs: TrackingInputs) -> Catalog:
 
     limits = source_limits(inputs.config().elements)
     sets = []
+    empty: list[str] = []  # why each file gave no set
     for path in paths:
         try:
-            result = load_elements(read_file(path, limits), source=path)
+            data = read_file(path, limits)
+            result = load_elements(data, source=path)
         except SourceError as exc:
             raise CliError(str(exc)) from None
         if len(result.sets) > limits.max_sets:
             raise CliError(str(limits.too_many(path)))
         for rejection in result.rejected:
             warn(f"skipped element set: {rejection}")
+        if not result.sets:
+            empty.append(_why_no_sets(path, data, len(result.rejected)))
         sets.extend(result.sets)
-        del result
+        del result, data
     if not sets:
-        raise CliError("no usable element sets in " + ", ".join(paths))
+        raise CliError("no usable element sets: " + "; ".join(empty))
     return Catalog(sets, dde_names=inputs.config().dde_names)
+
+
+def _why_no_sets(path: str, data: bytes | str, refused: int) -> str:
+    """One clause saying why ``path`` gave no element set: empty, every set refused, or no set found."""
+    if not data.strip():
+        return f"{path} is empty"
+    if refused:
+        return f"{path}: its {refused} set(s) were refused (reasons above)"
+    return f"{path} holds no TLE, AMSAT or OMM (JSON or CSV) element set"
 
 
 def _station_catalog(config: Config) -> Catalog:

@@ -225,3 +225,18 @@ def test_passes_leaves_out_an_object_unusable_at_the_start_and_says_so(capsys, t
     rows = list(csv.DictReader(io.StringIO(out)))
     assert {r["catalog_number"] for r in rows} == {"25544"} and len(rows) == len(alone)
     assert err.count("skipped 1 object(s) whose position at 2026-07-01T00:00:00.000Z cannot be computed") == 1
+
+
+@pytest.mark.parametrize(("content", "why"), [
+    ("", "{path} is empty"),
+    ("<html><body>404 Not Found</body></html>\n", "{path} holds no TLE, AMSAT or OMM (JSON or CSV) element set"),
+    ("1 25544U 98067A   26128.50000000  .00016717  00000-0  10270-3 0  9990\n"
+     "2 25544  51.6400 208.9163 0006317  69.9862  25.2906 15.54225995 12345\n",
+     "{path}: its 1 set(s) were refused (reasons above)"),
+])
+def test_an_element_file_without_a_usable_set_is_named_with_the_reason(capsys, tmp_path, content, why) -> None:
+    path = tmp_path / "elements.txt"
+    path.write_text(content)
+    assert main(["passes", "--elements", str(path), "--observer", "52.2,0.12"]) == 1
+    last = capsys.readouterr().err.strip().splitlines()[-1]
+    assert last == "nfwserver: no usable element sets: " + why.format(path=path)
