@@ -3,8 +3,8 @@
 part that changed to the station's core, in this order, and names the restart-only parts that changed.
 
 Parts not listed are read from the configuration when used (favourites), used only at start (the start-up
-satellite, ``tune``, ``track``, the state file, the radio's step and knob tolerance, the console's mode
-schedules) or describe the file itself.
+satellite, ``tune``, ``track``, the state file, the console's mode schedules: they say how a station starts,
+not how it runs) or describe the file itself.
 """
 
 from __future__ import annotations
@@ -50,6 +50,7 @@ CONFIG_PARTS: tuple[ConfigPart[StationCore], ...] = (
     ConfigPart("[elements]", ("elements",)),
     ConfigPart("[rotor]", ("rotor",)),
     ConfigPart("[radio] backend", ("radio.backend", "radio.host", "radio.port")),
+    ConfigPart("[radio] step_hz and knob_tolerance_hz", ("radio.step_hz", "radio.knob_tolerance_hz")),
     ConfigPart("[server] services/topic/items", ("server.services", "server.topic", "server.items")),
     ConfigPart("[dialects]", ("dialects",)),
     ConfigPart("[tcp]", ("tcp",)),

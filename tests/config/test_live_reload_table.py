@@ -18,19 +18,21 @@ RUNNING = parse_config('[observer]\nlocation = "JO02ae"\n[tcp]\nenabled = true\n
 
 def test_live_values_need_no_restart_and_are_taken() -> None:
     new = parse_config('[observer]\nlocation = "JO62qm"\n[tcp]\nenabled = true\nport = 8090\n'
-                       '[radio]\nbackend = "rigctld"\nhost = "127.0.0.1"\nstep_hz = 50\n')
+                       '[radio]\nbackend = "rigctld"\nhost = "127.0.0.1"\nstep_hz = 10\nenabled = true\n')
     assert restart_needed(CONFIG_PARTS, RUNNING, new) == []
     kept = keep_running(CONFIG_PARTS, RUNNING, new)
-    assert kept.observer == new.observer and kept.radio.step_hz == 50
+    assert kept.observer == new.observer and kept.radio.enabled
 
 
 def test_restart_only_values_are_named_and_kept_as_running() -> None:
     new = parse_config('[observer]\nlocation = "JO62qm"\n[tcp]\nenabled = true\nport = 8091\n'
                        '[radio]\nbackend = "rigctld"\nhost = "127.0.0.2"\nstep_hz = 50\n')
-    assert restart_needed(CONFIG_PARTS, RUNNING, new) == ["[radio] backend", "[tcp]"]
+    # The radio's step and knob tolerance are the running tuner's: a reload names them rather than pretend.
+    assert restart_needed(CONFIG_PARTS, RUNNING, new) == ["[radio] backend", "[radio] step_hz and knob_tolerance_hz",
+                                                          "[tcp]"]
     kept = keep_running(CONFIG_PARTS, RUNNING, new)
-    assert kept.tcp.port == 8090 and kept.radio.host == "127.0.0.1"  # still what runs
-    assert kept.radio.step_hz == 50 and kept.observer == new.observer  # the live parts are new
+    assert kept.tcp.port == 8090 and kept.radio.host == "127.0.0.1" and kept.radio.step_hz == 10  # what runs
+    assert kept.observer == new.observer  # the live parts are new
     assert restart_needed(CONFIG_PARTS, RUNNING, kept) == []  # so the next comparison is true
 
 
