@@ -14,9 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
+from bench.realtime_loop import run_publisher
 from nfwserver.clock import SystemClock, VirtualClock
 from nfwserver.config.schema import TcpConfig
-from nfwserver.core.publisher import Publisher
 from nfwserver.core.station_core import StationCore
 from nfwserver.tcp import NovaTcpServer
 from nfwserver.tracking.catalog import Catalog
@@ -125,15 +125,10 @@ def loop_lateness(clients: int, rate: float, seconds: float) -> tuple[float, flo
     watchers = Watchers(server.address, clients)
     _wait(lambda: server.watcher_count() == clients)
     core.set_tune(True)
-    publisher = Publisher(core, SystemClock())
-    publisher.start()
-    time.sleep(seconds)
-    publisher.stop()
-    got = min(len(a) for a in watchers.arrivals(publisher.stats.ticks))
+    p50, p99, worst, ticks = run_publisher(core, seconds)
+    got = min(len(a) for a in watchers.arrivals(ticks))
     server.stop()
-    late = np.array(publisher.stats.lateness_s) * 1e3
-    return (float(np.percentile(late, 50)), float(np.percentile(late, 99)), float(late.max()),
-            publisher.stats.ticks, got)
+    return p50, p99, worst, ticks, got
 
 
 def main() -> None:

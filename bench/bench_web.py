@@ -19,9 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
+from bench.realtime_loop import run_publisher
 from nfwserver.clock import SystemClock, VirtualClock
 from nfwserver.config.schema import WebConfig
-from nfwserver.core.publisher import Publisher
 from nfwserver.core.station_core import StationCore
 from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.elements import load_element_file
@@ -138,15 +138,10 @@ def loop_lateness(clients: int, rate: float, seconds: float) -> tuple[float, flo
     browsers = Browsers(web.address, clients)
     _wait(lambda: web.stats.streams == clients)
     core.set_tune(True)
-    publisher = Publisher(core, SystemClock())
-    publisher.start()
-    time.sleep(seconds)
-    publisher.stop()
+    p50, p99, worst, ticks = run_publisher(core, seconds)
     got = min(len(a) for a in browsers.arrivals())
     web.stop()
-    late = np.array(publisher.stats.lateness_s) * 1e3
-    return (float(np.percentile(late, 50)), float(np.percentile(late, 99)), float(late.max()),
-            publisher.stats.ticks, got)
+    return p50, p99, worst, ticks, got
 
 
 def main() -> None:
@@ -173,13 +168,8 @@ def main() -> None:
         if n == 0:
             core = StationCore(CATALOG, OBS, SystemClock(), satellite=25544, rate_hz=5.0)
             core.set_tune(True)
-            publisher = Publisher(core, SystemClock())
-            publisher.start()
-            time.sleep(30.0)
-            publisher.stop()
-            late = np.array(publisher.stats.lateness_s) * 1e3
-            print(f"| 0 | {publisher.stats.ticks} | - | {np.percentile(late, 50):.3f} ms | "
-                  f"{np.percentile(late, 99):.3f} ms | {late.max():.3f} ms |")
+            p50, p99, worst, ticks = run_publisher(core, 30.0)
+            print(f"| 0 | {ticks} | - | {p50:.3f} ms | {p99:.3f} ms | {worst:.3f} ms |")
             continue
         p50, p99, worst, ticks, got = loop_lateness(n, 5.0, 30.0)
         print(f"| {n} | {ticks} | {got} | {p50:.3f} ms | {p99:.3f} ms | {worst:.3f} ms |")
