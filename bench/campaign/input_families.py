@@ -187,9 +187,14 @@ _TERMINATOR = re.compile(rb"\r\n|[\r\n\x00]")
 
 def expected_replies(data: bytes, limit: int = 1024) -> int:
     """Replies Nova's TCP server owes for ``data`` (ending in a terminator): one per line that is not blank,
-    one per line over ``limit`` bytes; lines end at CR LF, CR, LF or NUL (docs of the TCP server)."""
+    one per line over ``limit`` bytes; lines end at CR LF, CR, LF or NUL, and a blank line holds only ASCII
+    white space (blanks, tabs, VT, FF, the 0x1C-0x1F separators) (docs of the TCP server)."""
     lines = _TERMINATOR.split(data)[:-1]
-    return sum(1 for line in lines if len(line) > limit or line.decode("ascii", "replace").strip(" \t"))
+    return sum(1 for line in lines if len(line) > limit or line.decode("ascii", "replace").strip(_ASCII_SPACE))
+
+
+#: The white space of a blank line: ASCII's (Python's ``str.strip`` on ASCII text strips exactly these).
+_ASCII_SPACE = " \t\x0b\x0c\x1c\x1d\x1e\x1f"
 
 
 def _is_mode_change(data: bytes) -> bool:

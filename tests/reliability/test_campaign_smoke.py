@@ -53,6 +53,7 @@ def test_the_independent_tcp_splitter_counts_owed_replies() -> None:
     # Lines end at CR LF, CR, LF or NUL; blank lines get no reply; an over-long line gets one refusal.
     assert expected_replies(b"SUMMARY\r\n") == 1
     assert expected_replies(b"  \t \r\n") == 0
+    assert expected_replies(b"\x0b\x0c\x1c\x1f \r\n") == 0  # VT, FF and the separators are white space too
     assert expected_replies(b"TUNE ON\rTRACK ON\nSAT=1\x00\r\n") == 3
     assert expected_replies(b" " * 2000 + b"\r\n") == 1
     assert expected_replies(b"A" * 1024 + b"\r\n") == 1
