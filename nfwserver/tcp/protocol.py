@@ -30,8 +30,9 @@ Nova's commands    ``TUNE ON|OFF``, ``TRACK ON|OFF``, ``SAT=n``, ``ANTAZ=deg``, 
 ``PARK``           ``TRACK OFF`` and the rotor to its park position; ``ERROR`` without a rotor.
 =================  ==========================================================================
 
-Keywords are accepted in any case with blanks around them.  An empty line outside ``WATCH`` gets
-no reply.  Every command is recorded in the event stream with the peer as ``client``.
+Keywords are accepted in any case with blanks around them.  A blank line outside ``WATCH`` (empty, or only
+blanks, tabs, VT, FF or the 0x1C-0x1F separators) gets no reply.  Every command is recorded in the event
+stream with the peer as ``client``.
 """
 
 from __future__ import annotations
