@@ -43,6 +43,9 @@ class PassSearch:
     passes: list[Pass] = field(default_factory=list)  #: favourites and selected, not yet over, by AOS
     next_pass: Pass | None = None  #: of the selected satellite (in progress or next)
     track: list[tuple[float, float]] = field(default_factory=list)  #: (az, el) deg along next_pass
+    #: catalog numbers the search left out: their positions at ``now`` cannot be computed (decayed, or
+    #: elements far outside their validity)
+    left_out: tuple[int, ...] = ()
 
 
 def _not_over(passes: Sequence[Pass], now: datetime) -> list[Pass]:
@@ -54,8 +57,9 @@ def search_passes(catalog: Catalog, observer: Observer, horizon: HorizonTable, u
     """Passes of ``wanted`` + ``selected`` over the next 12 h, and the selected one's next pass and track."""
     numbers = list(dict.fromkeys([*wanted, *([selected] if selected is not None else [])]))
     sats = [s for s in (catalog.get(n) for n in numbers) if s is not None]
-    passes = _not_over(find_passes(sats, observer, now, now + timedelta(hours=LIST_HOURS),
-                                   horizon=horizon, ut1_utc=ut1_utc), now) if sats else []
+    found = find_passes(sats, observer, now, now + timedelta(hours=LIST_HOURS), horizon=horizon,
+                        ut1_utc=ut1_utc) if sats else None
+    passes = _not_over(found, now) if found is not None else []
     sat = catalog.get(selected) if selected is not None else None
     next_pass = None
     track: list[tuple[float, float]] = []
@@ -75,14 +79,15 @@ def search_passes(catalog: Catalog, observer: Observer, horizon: HorizonTable, u
                     t += timedelta(seconds=TRACK_STEP_S)
             except PropagationError:
                 track = []
-    return PassSearch(now, selected, passes, next_pass, track)
+    return PassSearch(now, selected, passes, next_pass, track, found.skipped if found is not None else ())
 
 
 def pass_table(search: PassSearch | None, catalog: Catalog, times: TimeDisplay, now: datetime,
                stale_days: float = STALE_DAYS) -> Text:
     """The pass list under a header: satellite, date, AOS, max elevation, LOS (the pane's title names
     the zone).  A pass already in progress is marked ``*``; a satellite whose elements are more than
-    ``stale_days`` old is marked ``!``, and a line under the list says how old and what to run.
+    ``stale_days`` old is marked ``!``, and a line under the list says how old and what to run; another names
+    the satellites the search left out because their positions cannot be computed.
     """
     out = Text()
     out.append(f"{'Satellite':{NAME_WIDTH}} {'Date':5} {'AOS':5} {'Max':>3} {'LOS':5}\n", style="bold")
@@ -92,7 +97,7 @@ def pass_table(search: PassSearch | None, catalog: Catalog, times: TimeDisplay, 
     rows = [p for p in search.passes if p.los is None or p.los > now][:MAX_ROWS]
     if not rows:
         out.append(f"none in the next {LIST_HOURS:g} h")
-        return out
+        return _left_out(out, search, catalog)
     oldest = 0.0
     for i, p in enumerate(rows):
         sat = catalog.get(p.catalog_number)
@@ -111,6 +116,15 @@ def pass_table(search: PassSearch | None, catalog: Catalog, times: TimeDisplay, 
     if oldest > stale_days:
         out.append(f"\n! elements up to {oldest:.0f} days old (over {stale_days:g}): positions drift; "
                    "run `nfwserver elements update`", style="yellow")
+    return _left_out(out, search, catalog)
+
+
+def _left_out(out: Text, search: PassSearch, catalog: Catalog) -> Text:
+    """``out`` with a line naming the satellites the search left out (at most five), when there are some."""
+    if search.left_out:
+        names = [sat.dde_name if (sat := catalog.get(n)) is not None else str(n) for n in search.left_out[:5]]
+        more = ", ..." if len(search.left_out) > 5 else ""
+        out.append(f"\n! left out, position cannot be computed now: {', '.join(names)}{more}", style="yellow")
     return out
 
 

@@ -81,8 +81,8 @@ class PassBoard:
         self.favourites = favourites
         self.rotor = rotor
         self.version = 0
-        self._result: dict[str, object] = {"version": 0, "computed_at": None, "passes": [], "track": None,
-                                           "ground_track": [], "horizon": []}
+        self._result: dict[str, object] = {"version": 0, "computed_at": None, "passes": [], "left_out": [],
+                                           "track": None, "ground_track": [], "horizon": []}
         self._encoded = json.dumps(self._result).encode()
         self._wake = threading.Event()
         self._stop = threading.Event()
@@ -153,16 +153,20 @@ class PassBoard:
         generation = self.state.generation
         snap = self.state.snapshot()
         now = self.clock.now()
-        result: dict[str, object] = {"computed_at": iso(now), "passes": [], "track": None, "ground_track": [],
+        result: dict[str, object] = {"computed_at": iso(now), "passes": [], "left_out": [], "track": None,
+                                     "ground_track": [],
                                      "horizon": [[az, round(snap.horizon.min_elevation(float(az)), 2)]
                                                  for az in range(0, 361, 5)]}
         observer, selected = snap.observer, snap.satellite
         if observer is not None:
             numbers = list(dict.fromkeys([*self.favourites(), *([selected.catalog_number] if selected else [])]))
             sats = [s for s in (snap.catalog.get(n) for n in numbers) if s is not None]
-            found = [p for p in find_passes(sats, observer, now, now + timedelta(hours=LIST_HOURS),
-                                            horizon=snap.horizon, ut1_utc=snap.ut1_utc_s)
-                     if p.los is None or p.los > now] if sats else []
+            searched = find_passes(sats, observer, now, now + timedelta(hours=LIST_HOURS), horizon=snap.horizon,
+                                   ut1_utc=snap.ut1_utc_s) if sats else None
+            found = [p for p in searched if p.los is None or p.los > now] if searched is not None else []
+            # favourites whose positions cannot be computed now (decayed, elements far outside their validity)
+            result["left_out"] = [sat.dde_name if (sat := snap.catalog.get(n)) is not None else str(n)
+                                  for n in (searched.skipped if searched is not None else ())]
             calc = LookAngleCalculator(observer, snap.ut1_utc_s)
             rows = []
             for p in found[:MAX_PASSES]:

@@ -18,7 +18,7 @@ from skyfield.api import EarthSatellite, load, wgs84
 from nfwserver.channels.channel import Channel
 from nfwserver.console.app import NfwConsole
 from tests.app.console_helpers import log_text, screen_text, settle, static_text
-from tests.dde.conftest import CATALOG, ISS, ISS_PASS, OBSERVER, make_station
+from tests.dde.conftest import CATALOG, ISS, ISS_PASS, OBSERVER, dead_iss_text, make_station
 
 LONG_HINT = ("no observer configured: using 0.000000,0.000000 (Greenwich). Set [observer] location in "
              "/home/someone/.config/nfwserver/config.toml (`nfwserver config init` writes a starting file).")
@@ -164,3 +164,31 @@ def test_realtime_values_use_the_satellites_own_downlink_and_agree_with_skyfield
         assert "AH Y" in state
 
     asyncio.run(scenario())
+
+
+def test_the_pass_list_names_a_favourite_whose_position_cannot_be_computed() -> None:
+    """A favourite SGP4 refuses now (decayed) is left out of the search and named under the list, instead of
+    vanishing from it without a word."""
+    from nfwserver.tracking.catalog import Catalog
+    from nfwserver.tracking.elements import load_elements
+
+    dead = load_elements(dead_iss_text()).sets[0]
+    error = dead.satrec.sgp4(*_jd(ISS_PASS.tca))[0]
+    assert error != 0  # the library's own verdict
+    station = make_station(start=ISS_PASS.tca, catalog=Catalog([*(s.elements for s in CATALOG), dead]))
+
+    async def scenario() -> None:
+        app = NfwConsole(station.core, favourites=(ISS, 99901))
+        async with app.run_test(size=(120, 36)) as pilot:
+            await settle(app, pilot)
+            table = static_text(app, "passes").splitlines()
+            assert table[1].split()[0] == "ISS"
+            assert table[-1] == "! left out, position cannot be computed now: DEAD"
+
+    asyncio.run(scenario())
+
+
+def _jd(when) -> tuple[float, float]:
+    from sgp4.api import jday
+
+    return jday(when.year, when.month, when.day, when.hour, when.minute, when.second + when.microsecond / 1e6)

@@ -64,3 +64,14 @@ def state_for(catalog_number: int, observer: Observer = OBSERVER) -> StationStat
 @pytest.fixture
 def station() -> Station:
     return make_station()
+
+
+def dead_iss_text(number: int = 99901) -> str:
+    """ISS's element set under another number, dated ten years earlier: SGP4 reports it decayed now."""
+    from nfwserver.tracking.tle import tle_checksum
+
+    iss = CATALOG.get(ISS)
+    assert iss is not None
+    l1 = iss.elements.line1[:2] + f"{number:05d}" + iss.elements.line1[7:18] + "16" + iss.elements.line1[20:68]
+    l2 = iss.elements.line2[:2] + f"{number:05d}" + iss.elements.line2[7:68]
+    return f"DEAD\n{l1}{tle_checksum(l1)}\n{l2}{tle_checksum(l2)}\n"

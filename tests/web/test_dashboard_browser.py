@@ -181,3 +181,34 @@ def test_the_rotor_commanded_and_actual_positions_are_drawn_apart(browser) -> No
         wait_for(near_rotor, what="the actual mark at the rotor's position")
     finally:
         web.station.stop()
+
+
+def test_a_favourite_whose_position_cannot_be_computed_is_named_under_the_passes(browser, tmp_path) -> None:
+    """A favourite SGP4 refuses now (ISS's elements dated ten years back: decayed) is left out of the search
+    and named under the pass list, as text, instead of vanishing from it."""
+    from tests.conftest import DATA
+    from tests.dde.conftest import dead_iss_text
+    from tests.web.conftest import config_text, start_station
+
+    elements = tmp_path / "with_dead.txt"
+    elements.write_text((DATA / "visual.txt").read_text() + dead_iss_text())
+    web = start_station(config_text(elements, favourites="[25544, 99901]"))
+    try:
+        assert wait_for(lambda: web.get("/api/passes")["version"] >= 1, what="the first pass search")
+        assert web.get("/api/passes")["left_out"] == ["DEAD"]
+        open_page(browser, web)
+        note = wait_for(lambda: browser.find_element(By.CSS_SELECTOR, '[data-testid="left-out"]').text,
+                        what="the left-out note")
+        assert note == "Left out, position cannot be computed now: DEAD"
+        rows = browser.find_elements(By.CSS_SELECTOR, "#passes tr")
+        assert rows and all("DEAD" not in r.text for r in rows)
+        assert console_errors(browser) == []
+    finally:
+        web.station.stop()
+
+
+def test_no_left_out_note_when_every_favourite_is_computed(browser, web_station) -> None:
+    open_page(browser, web_station)
+    wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#passes tr"), what="the pass list")
+    note = browser.find_element(By.CSS_SELECTOR, '[data-testid="left-out"]')
+    assert not note.is_displayed() and note.text == ""

@@ -119,6 +119,10 @@ function renderPasses() {
   Polar.horizon(passes.horizon);
   Polar.pass(passes.track);
   WorldMap.groundTrack(passes.ground_track);
+  const leftOut = T("left-out"), names = passes.left_out || [];
+  leftOut.textContent = names.length ? "Left out, position cannot be computed now: " + names.slice(0, 5).join(", ")
+    + (names.length > 5 ? ", ..." : "") : "";
+  leftOut.classList.toggle("hidden", !names.length);
   const selected = frame && frame.now.satellite ? frame.now.satellite.catalog_number : null;
   if (!passes.passes.length) { row(["none in the next 12 h", "", "", "", "", "", ""], body); return; }
   for (const p of passes.passes) {
