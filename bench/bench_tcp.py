@@ -6,7 +6,6 @@ import json
 import selectors
 import socket
 import statistics
-import subprocess
 import sys
 import time
 from datetime import datetime, timedelta, timezone
@@ -14,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.realtime_loop import run_publisher
+from bench.realtime_loop import ClientProcess, run_publisher, wait_until
 from nfwserver.clock import SystemClock, VirtualClock
 from nfwserver.config.schema import TcpConfig
 from nfwserver.core.station_core import StationCore
@@ -64,28 +63,12 @@ def watcher_process(host: str, port: int, n: int) -> None:
             arrivals[key.data].extend([now] * (lines - taken))
 
 
-class Watchers:
-    """The WATCH clients, in a separate process (as real clients are: they do not share our GIL)."""
+class Watchers(ClientProcess):
+    """``n`` WATCH clients in another process (``--watchers``); ``arrivals(str(expected))`` waits until each
+    has ``expected`` lines (or 20 s) and returns every client's arrival times."""
 
     def __init__(self, address: tuple[str, int], n: int) -> None:
-        self.proc = subprocess.Popen([sys.executable, "-m", "bench.bench_tcp", "--watchers", address[0],
-                                      str(address[1]), str(n)], cwd=ROOT, stdin=subprocess.PIPE,
-                                     stdout=subprocess.PIPE, text=True)
-        assert self.proc.stdout.readline().strip() == "ready"
-
-    def arrivals(self, expected: int) -> list[list[float]]:
-        """Every client's arrival times, once each has ``expected`` lines (or after 20 s)."""
-        self.proc.stdin.write(f"{expected}\n")
-        self.proc.stdin.flush()
-        result = json.loads(self.proc.stdout.readline())
-        self.proc.wait(10)
-        return result
-
-
-def _wait(predicate, timeout: float = 10.0) -> None:
-    deadline = time.monotonic() + timeout
-    while not predicate() and time.monotonic() < deadline:
-        time.sleep(0.001)
+        super().__init__("bench.bench_tcp", "--watchers", address, n, ROOT)
 
 
 def tick_cost(clients: int, ticks: int = 2000, pace_s: float = 0.005) -> tuple[float, float, float, int]:
@@ -95,7 +78,7 @@ def tick_cost(clients: int, ticks: int = 2000, pace_s: float = 0.005) -> tuple[f
     server = NovaTcpServer(core, CONFIG, max_clients=clients + 10)
     server.start()
     watchers = Watchers(server.address, clients) if clients else None
-    _wait(lambda: server.watcher_count() == clients)
+    wait_until(lambda: server.watcher_count() == clients)
     core.set_tune(True)
     costs, sent = [], []
     when = START
@@ -109,7 +92,7 @@ def tick_cost(clients: int, ticks: int = 2000, pace_s: float = 0.005) -> tuple[f
         time.sleep(pace_s)
     delays = [0.0]
     if watchers is not None:
-        arrivals = watchers.arrivals(ticks)
+        arrivals = watchers.arrivals(str(ticks))
         assert all(len(a) == ticks for a in arrivals), f"a client missed strings: {sorted({len(a) for a in arrivals})}"
         delays = [max(a[k] for a in arrivals) - t for k, t in enumerate(sent)]
     lost = server.stats.lost
@@ -123,10 +106,10 @@ def loop_lateness(clients: int, rate: float, seconds: float) -> tuple[float, flo
     server = NovaTcpServer(core, CONFIG, max_clients=clients + 10)
     server.start()
     watchers = Watchers(server.address, clients)
-    _wait(lambda: server.watcher_count() == clients)
+    wait_until(lambda: server.watcher_count() == clients)
     core.set_tune(True)
     p50, p99, worst, ticks = run_publisher(core, seconds)
-    got = min(len(a) for a in watchers.arrivals(ticks))
+    got = min(len(a) for a in watchers.arrivals(str(ticks)))
     server.stop()
     return p50, p99, worst, ticks, got
 

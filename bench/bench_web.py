@@ -11,7 +11,6 @@ import re
 import selectors
 import socket
 import statistics
-import subprocess
 import sys
 import time
 from datetime import datetime, timedelta, timezone
@@ -19,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.realtime_loop import run_publisher
+from bench.realtime_loop import ClientProcess, run_publisher, wait_until
 from nfwserver.clock import SystemClock, VirtualClock
 from nfwserver.config.schema import WebConfig
 from nfwserver.core.station_core import StationCore
@@ -71,26 +70,11 @@ def browser_process(host: str, port: int, n: int) -> None:
     print(json.dumps(arrivals), flush=True)
 
 
-class Browsers:
+class Browsers(ClientProcess):
+    """``n`` event-stream connections read by another process (``--browsers``)."""
+
     def __init__(self, address: tuple[str, int], n: int) -> None:
-        self.proc = subprocess.Popen([sys.executable, "-m", "bench.bench_web", "--browsers", address[0],
-                                      str(address[1]), str(n)], cwd=ROOT, stdin=subprocess.PIPE,
-                                     stdout=subprocess.PIPE, text=True)
-        assert self.proc.stdout is not None and self.proc.stdout.readline().strip() == "ready"
-
-    def arrivals(self) -> list[dict[str, float]]:
-        assert self.proc.stdin is not None and self.proc.stdout is not None
-        self.proc.stdin.write("\n")
-        self.proc.stdin.flush()
-        result = json.loads(self.proc.stdout.readline())
-        self.proc.wait(10)
-        return result
-
-
-def _wait(predicate, timeout: float = 20.0) -> None:
-    deadline = time.monotonic() + timeout
-    while not predicate() and time.monotonic() < deadline:
-        time.sleep(0.001)
+        super().__init__("bench.bench_web", "--browsers", address, n, ROOT)
 
 
 def _iso(when: datetime) -> str:
@@ -106,7 +90,7 @@ def tick_cost(clients: int, ticks: int = 600, pace_s: float = 0.1) -> tuple[floa
     web.start()
     assert web.address is not None
     browsers = Browsers(web.address, clients) if clients else None
-    _wait(lambda: web.stats.streams == clients)
+    wait_until(lambda: web.stats.streams == clients)
     core.set_tune(True)
     costs, sent = [], {}
     when = START
@@ -136,7 +120,7 @@ def loop_lateness(clients: int, rate: float, seconds: float) -> tuple[float, flo
     web.start()
     assert web.address is not None
     browsers = Browsers(web.address, clients)
-    _wait(lambda: web.stats.streams == clients)
+    wait_until(lambda: web.stats.streams == clients)
     core.set_tune(True)
     p50, p99, worst, ticks = run_publisher(core, seconds)
     got = min(len(a) for a in browsers.arrivals())

@@ -1,9 +1,16 @@
-"""The real-time publish loop as the benchmarks run it: a station core ticking on the system clock for a
-while, and the lateness of each tick against its schedule (milliseconds)."""
+"""What the TCP and web benchmarks share: their clients in a process of their own, waiting for the station,
+and the real-time publish loop (a station core ticking on the system clock for a while, and the lateness of
+each tick against its schedule, in milliseconds)."""
 
 from __future__ import annotations
 
+import json
+import subprocess
+import sys
 import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -22,3 +29,30 @@ def run_publisher(core: StationCore, seconds: float) -> tuple[float, float, floa
     late = np.array(publisher.stats.lateness_s) * 1e3
     return (float(np.percentile(late, 50)), float(np.percentile(late, 99)), float(late.max()),
             publisher.stats.ticks)
+
+
+class ClientProcess:
+    """A benchmark's clients, run by ``python -m MODULE FLAG HOST PORT N`` in a process of their own (as real
+    clients are: they do not share our interpreter lock).  The process prints ``ready`` once connected; a
+    line sent to it asks for its arrival times, which it prints as one JSON line before it exits."""
+
+    def __init__(self, module: str, flag: str, address: tuple[str, int], n: int, root: Path) -> None:
+        self.proc = subprocess.Popen([sys.executable, "-m", module, flag, address[0], str(address[1]), str(n)],
+                                     cwd=root, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        assert self.proc.stdout is not None and self.proc.stdout.readline().strip() == "ready"
+
+    def arrivals(self, request: str = "") -> Any:
+        """Send ``request`` (one line) and return the JSON the clients answer with."""
+        assert self.proc.stdin is not None and self.proc.stdout is not None
+        self.proc.stdin.write(f"{request}\n")
+        self.proc.stdin.flush()
+        result = json.loads(self.proc.stdout.readline())
+        self.proc.wait(10)
+        return result
+
+
+def wait_until(predicate: Callable[[], bool], timeout: float = 20.0) -> None:
+    """Poll ``predicate`` every millisecond until it holds or ``timeout`` seconds have passed."""
+    deadline = time.monotonic() + timeout
+    while not predicate() and time.monotonic() < deadline:
+        time.sleep(0.001)
