@@ -12,6 +12,7 @@ from nfwserver.config import load_config, observer_hint
 from nfwserver.console.app import NfwConsole
 from nfwserver.dde.clipboard import CF_TEXT
 from nfwserver.fake_dde import FakeDdeSystem
+from tests.app.headless_run import serve_once
 from tests.conftest import advance_until
 from tests.dde.conftest import ISS_PASS
 
@@ -66,11 +67,7 @@ def test_headless_prints_the_log_file_logs_the_start_and_a_status_every_ten_minu
 
 def test_the_no_observer_hint_names_the_file_in_use(tmp_path, capsys) -> None:
     config = _config(tmp_path, '[server]\nstate_file = "none"\n')
-    stop = threading.Event()
-    stop.set()
-    plan = RunPlan(console=False, log_file=tmp_path / "nfw.log", clock=VirtualClock(ISS_PASS.aos),
-                   transport=FakeDdeSystem().server_transport(), stop=stop)
-    assert serve(config, plan) == 0
+    assert serve_once(config, tmp_path) == 0
     err = capsys.readouterr().err
     assert f"nfwserver: {observer_hint(config)}" in err and str(tmp_path / "station.toml") in err
 

@@ -5,14 +5,13 @@ in STATUS (``satellite_from``)."""
 from __future__ import annotations
 
 import json
-import threading
 
 from nfwserver.app.station import Station
-from nfwserver.cli.run_command import RunPlan, serve
 from nfwserver.clock import VirtualClock
 from nfwserver.config import load_config
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tcp.protocol import NovaTcpProtocol
+from tests.app.headless_run import serve_once
 from tests.dde.conftest import ISS_PASS
 
 
@@ -25,11 +24,7 @@ def _start(tmp_path, configured: int, saved: dict | None, capsys) -> tuple[str, 
     config = load_config(str(path))
     if saved is not None:
         state.write_text(json.dumps(saved))
-    stop = threading.Event()
-    stop.set()
-    plan = RunPlan(console=False, log_file=tmp_path / "nfw.log", clock=VirtualClock(ISS_PASS.aos),
-                   transport=FakeDdeSystem().server_transport(), stop=stop)
-    assert serve(config, plan) == 0
+    assert serve_once(config, tmp_path) == 0
     err = capsys.readouterr().err
     if saved is not None:
         state.write_text(json.dumps(saved))  # as before the run (the run saved its own choice)
