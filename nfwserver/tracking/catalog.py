@@ -117,9 +117,15 @@ class Catalog:
         with self._lock:
             old = self._elements, self._satellites
             self._elements, self._overrides, self._satellites = elements, overrides, satellites
-        for table in old:  # freed one entry at a time: a whole catalog freed at once holds the GIL for 20-40 ms
-            while table:
-                table.popitem()
+        # A published table is never changed: a reader may still be reading the old one, and the new one may be
+        # the old one (a new name keeps the element sets).  The old entries are released one at a time from a
+        # list of their own, since a whole catalog freed at once holds the interpreter lock for 20-40 ms; a
+        # reader still holding an old table keeps it whole.
+        leftovers = [list(table.values()) for table in old if table is not None and table is not elements]
+        del old
+        for entries in leftovers:
+            while entries:
+                entries.pop()
 
     @staticmethod
     def _make_satellites(elements: dict[int, ElementSet], overrides: dict[int, str]) -> dict[int, Satellite]:

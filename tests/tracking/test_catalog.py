@@ -107,3 +107,28 @@ def test_dde_names_are_assigned_when_first_needed(monkeypatch) -> None:
     assert len(calls) == 2  # once read, names are made by the writer, before the swap (never by a reader)
     assert cat.get(VISUAL[0].catalog_number).elements.epoch > VISUAL[0].epoch
     assert len(calls) == 2
+
+
+@pytest.mark.parametrize("named_first", [False, True])
+def test_a_new_dde_name_keeps_every_satellite(named_first) -> None:
+    """A name given on a running catalog (a live reload of [satellites] names) once emptied it: the swap
+    released the 'old' table entry by entry, and with the element sets unchanged the old table was the new."""
+    cat = Catalog(VISUAL)
+    if named_first:
+        assert cat.get(25544) is not None
+    cat.set_dde_name(25544, "ARISS")
+    assert len(cat) == len(VISUAL) and len(cat.element_sets()) == len(VISUAL)
+    iss = cat.get(25544)
+    assert iss is not None and iss.dde_name == "ARISS" and cat.find("ARISS") is iss
+    assert len(cat.satellites()) == len(VISUAL)
+
+
+def test_a_reader_holding_the_previous_tables_finds_them_whole_after_an_update() -> None:
+    """An update publishes new tables and releases the old ones gradually without changing them: a reader in
+    the middle of a lookup (find() walks the table it took) never sees it shrink."""
+    cat = Catalog(VISUAL)
+    satellites, elements = cat._named(), cat._elements  # what a reader took just before the update
+    before = dict(satellites), dict(elements)
+    cat.update([_shifted(es, 0.5) for es in VISUAL[:20]])
+    assert (satellites, elements) == before
+    assert cat.get(VISUAL[0].catalog_number).elements.epoch > VISUAL[0].epoch
