@@ -88,7 +88,7 @@ def _in_forked_workers(satellites: list[Any], args: tuple[Any, ...], workers: in
     ``workers``-th satellite), in the order of the shares (POSIX: the caller checked that fork exists)."""
     import multiprocessing
 
-    if sys.platform == "win32":
+    if sys.platform == "win32":  # never true here (the caller checked); it tells the type checker the rest is POSIX
         raise OSError("fork is POSIX only")
 
     context = multiprocessing.get_context("fork")
@@ -102,7 +102,14 @@ def _in_forked_workers(satellites: list[Any], args: tuple[Any, ...], workers: in
             sender.close()  # the child holds its own end: EOF here if it dies without an answer
             receivers.append(receiver)
             processes.append(process)
-        outcomes = [receiver.recv() for receiver in receivers]  # before joining: a large answer fills the pipe
+        outcomes = []
+        for receiver, process in zip(receivers, processes):  # before joining: a large answer fills the pipe
+            try:
+                outcomes.append(receiver.recv())
+            except EOFError:  # killed (out of memory, a signal) before it answered
+                process.join(5.0)
+                raise OSError(f"a pass-search worker process ended without its answer (exit status "
+                              f"{process.exitcode})") from None
         for process in processes:
             process.join()
     finally:

@@ -191,6 +191,32 @@ except AttributeError as exc:
     assert done.stdout.startswith("raised "), done.stdout
 
 
+@pytest.mark.skipif(sys.platform == "win32", reason="fork")
+def test_a_worker_killed_before_it_answers_is_one_clear_error() -> None:
+    """A forked worker that dies (out of memory, a signal) ends the search with an OSError naming its exit
+    status, which the command reports in one line, instead of a bare EOFError traceback."""
+    import subprocess
+
+    script = """
+import os, sys
+from datetime import datetime, timezone, timedelta
+from nfwserver.tracking import passes
+from nfwserver.tracking.elements import load_element_file
+from nfwserver.tracking.observer import Observer
+passes._fork_worker = lambda satellites, args, results: os._exit(3)  # dies at once, in the child
+sats = load_element_file(sys.argv[1]).sets[:500]
+start = datetime(2026, 5, 8, tzinfo=timezone.utc)
+try:
+    passes.find_passes(sats, Observer(52.2, 0.12, 20.0), start, start + timedelta(hours=6), workers=2)
+except OSError as exc:
+    print("raised", exc)
+"""
+    done = subprocess.run([sys.executable, "-c", script, str(DATA / "active.txt")], capture_output=True, text=True,
+                          timeout=100)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "raised a pass-search worker process ended without its answer (exit status 3)"
+
+
 def test_element_sets_and_their_models_give_the_same_passes_and_no_model_is_kept() -> None:
     """Element sets are grouped by their own fields and propagated by models made for the search only;
     the passes are exactly those of the same satellites given as sgp4 Satrecs."""
