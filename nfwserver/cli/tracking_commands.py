@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Mapping, Sequence
 from datetime import datetime, timedelta
 from typing import TYPE_CHECKING, Any
 
@@ -96,43 +97,37 @@ def _pick(catalog: Catalog, text: str) -> Satellite:
 
 
 def _screen(sats: list[Any], catalog: Catalog, observer: Observer, ut1_utc: float, at: datetime,
-            stale_days: float, report_stale: bool = True) -> list[Any]:
-    """The satellites (or element sets) whose positions at ``at`` are usable; the rest and (unless
-    ``report_stale`` is false) sets older than ``stale_days`` (``[elements] stale_days``) are reported (by DDE
-    name)."""
+            stale_days: float) -> list[Any]:
+    """The satellites (or element sets) whose positions at ``at`` are usable; the rest and the sets older than
+    ``stale_days`` (``[elements] stale_days``) are reported (by DDE name)."""
     from nfwserver.tracking.screening import stale_satellites, usable_mask
 
     usable = usable_mask(sats, observer, at, ut1_utc).tolist()
-    if not all(usable):
-        _report_unusable([s for s, ok in zip(sats, usable) if not ok], catalog, at)
+    unusable = [s for s, ok in zip(sats, usable) if not ok]
+    if unusable:
         sats = [s for s, ok in zip(sats, usable) if ok]
-    if report_stale:
-        _report_stale(stale_satellites(sats, at, stale_days), catalog, at, stale_days)
+    stale = stale_satellites(sats, at, stale_days)
+    names = _dde_name_map(unusable[:5] + stale[:5], catalog)
+    _report_unusable(unusable, names, at)
+    _report_stale(stale, names, at, stale_days)
     return sats
 
 
-def _report_unusable(unusable: list[Any], catalog: Catalog, at: datetime) -> None:
+def _report_unusable(unusable: list[Any], names: Mapping[int, str], at: datetime) -> None:
     """Warn of the satellites (or element sets) left out because their positions at ``at`` are unusable,
-    naming up to five by DDE name."""
-    names = _dde_names(unusable[:5], catalog) + (", ..." if len(unusable) > 5 else "")
-    warn(f"skipped {len(unusable)} object(s) whose position at {format_time(at)} cannot be computed "
-         f"or is implausibly far (decayed or elements far outside their validity): {names}")
+    naming up to five by DDE name (``names``, by catalog number)."""
+    if unusable:
+        shown = ", ".join(names[s.catalog_number] for s in unusable[:5]) + (", ..." if len(unusable) > 5 else "")
+        warn(f"skipped {len(unusable)} object(s) whose position at {format_time(at)} cannot be computed "
+             f"or is implausibly far (decayed or elements far outside their validity): {shown}")
 
 
-def _report_stale(stale: list[Any], catalog: Catalog, at: datetime, stale_days: float,
-                  named: dict[int, str] | None = None) -> None:
-    """Warn of the sets older than ``stale_days`` before ``at``, naming up to five by DDE name (from ``named``
-    when it has them)."""
-    if not stale:
-        return
-    shown = stale[:5]
-    if named is not None and all(s.catalog_number in named for s in shown):
-        names = ", ".join(named[s.catalog_number] for s in shown)
-    else:
-        names = _dde_names(shown, catalog)
-    names += ", ..." if len(stale) > 5 else ""
-    warn(f"{len(stale)} element set(s) are more than {stale_days:g} days older than {format_time(at)}, "
-         f"so their positions drift ({names}); `nfwserver elements update` fetches newer ones")
+def _report_stale(stale: list[Any], names: Mapping[int, str], at: datetime, stale_days: float) -> None:
+    """Warn of the sets older than ``stale_days`` before ``at``, naming up to five by DDE name (``names``)."""
+    if stale:
+        shown = ", ".join(names[s.catalog_number] for s in stale[:5]) + (", ..." if len(stale) > 5 else "")
+        warn(f"{len(stale)} element set(s) are more than {stale_days:g} days older than {format_time(at)}, "
+             f"so their positions drift ({shown}); `nfwserver elements update` fetches newer ones")
 
 
 def _stale_days(inputs: TrackingInputs) -> float:
@@ -140,21 +135,13 @@ def _stale_days(inputs: TrackingInputs) -> float:
     return float(inputs.config().elements.stale_days)
 
 
-def _dde_names(sats: list[Any], catalog: Catalog) -> str:
-    """The DDE names of satellites or element sets (those of the catalog's satellites), comma-separated."""
-    unnamed = [s.catalog_number for s in sats if not hasattr(s, "dde_name")]
-    made = iter(catalog.dde_names_of(unnamed) if unnamed else ())
-    return ", ".join(s.dde_name if hasattr(s, "dde_name") else next(made) for s in sats)
-
-
-def _display_names(numbers: list[int], sets: list[Any], catalog: Catalog) -> list[str]:
-    """The name shown for each catalog number: the element set's name, else the satellite's DDE name."""
-    by_number = {es.catalog_number: es.name for es in sets}
-    names = [by_number[n] for n in numbers]
-    unnamed = [n for n, name in zip(numbers, names) if not name]
-    if unnamed:
-        made = dict(zip(unnamed, catalog.dde_names_of(unnamed)))
-        names = [name or made[n] for n, name in zip(numbers, names)]
+def _dde_name_map(items: list[Any], catalog: Catalog, more: Sequence[int] = ()) -> dict[int, str]:
+    """The DDE names of satellites or element sets (a satellite's own; the sets' from the catalog) and of the
+    catalog numbers ``more``, by catalog number: one naming of the catalog for all of them (each call names
+    the whole catalog when nothing has named it yet)."""
+    names = {s.catalog_number: s.dde_name for s in items if hasattr(s, "dde_name")}
+    wanted = [s.catalog_number for s in items if not hasattr(s, "dde_name")] + [n for n in more if n not in names]
+    names.update(zip(wanted, catalog.dde_names_of(wanted)) if wanted else ())
     return names
 
 
@@ -206,9 +193,9 @@ def run_passes(args: argparse.Namespace) -> int:
     from nfwserver.cli.pass_table import compact_columns
 
     start = args.start
-    passes, names, short_names = _find_passes(args)  # the catalog is gone: its memory serves the output
+    passes, names, short_names, searched = _find_passes(args)  # the catalog is gone: its memory serves the output
     cols = passes.columns
-    if args.min_el > 0.0 or args.min_el < 0.0:
+    if args.min_el != 0.0:
         keep = cols["max_elevation_deg"] >= args.min_el
         cols = {key: value[keep] for key, value in cols.items()}
     numbers = np.array(sorted(names), dtype=np.int64)
@@ -216,7 +203,7 @@ def run_passes(args: argparse.Namespace) -> int:
     if args.format == "table" and not args.wide:
         if not len(cols["catalog_number"]):
             reach = f" reaching {args.min_el:g} deg" if args.min_el else ""
-            warn(f"no passes{reach} of the {len(names) or 'chosen'} satellite(s) in the {args.hours:g} h from "
+            warn(f"no passes{reach} of the {searched} satellite(s) in the {args.hours:g} h from "
                  f"{format_time(start)}")
         write_rows(compact_columns(start, cols, [short_names[n] for n in numbers.tolist()], which, args.local),
                    "table", sys.stdout)
@@ -238,9 +225,10 @@ def run_passes(args: argparse.Namespace) -> int:
     return 0
 
 
-def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str], dict[int, str]]:
-    """The passes the options ask for, and the name and the DDE name (at most 12 characters; only for the
-    compact table, which alone shows them) to show for each satellite that has one (by catalog number)."""
+def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str], dict[int, str], int]:
+    """The passes the options ask for, the name and the DDE name (at most 12 characters; only for the compact
+    table, which alone shows them) to show for each satellite that has one (by catalog number), and how many
+    satellites were searched."""
     from nfwserver.cli.tracking_options import TrackingInputs
     from nfwserver.tracking.passes import find_passes
     from nfwserver.tracking.screening import stale_satellites
@@ -255,19 +243,20 @@ def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str], di
     # stale sets are reported after it, before any row (the compact table names them with its satellites).
     passes = find_passes(sets, observer, start, start + timedelta(hours=args.hours), horizon=horizon,
                          ut1_utc=ut1_utc, workers=args.workers)
-    if passes.skipped:
-        left_out = set(passes.skipped)
-        _report_unusable([s for s in sets if s.catalog_number in left_out], catalog, start)
-        sets = [s for s in sets if s.catalog_number not in left_out]
+    left_out = set(passes.skipped)
+    unusable = [s for s in sets if s.catalog_number in left_out]
+    sets = [s for s in sets if s.catalog_number not in left_out] if left_out else sets
     stale = stale_satellites(sets, start, stale_days)
     numbers = passes.catalog_numbers()
-    named: dict[int, str] = {}
-    if compact:
-        wanted = numbers + [s.catalog_number for s in stale[:5]]
-        named = dict(zip(wanted, catalog.dde_names_of(wanted)))
-    _report_stale(stale, catalog, start, stale_days, named)
-    return (passes, dict(zip(numbers, _display_names(numbers, sets, catalog))),
-            {n: named[n] for n in numbers} if compact else {})
+    by_number = {es.catalog_number: es.name for es in sets}
+    element_names = {n: by_number[n] for n in numbers}
+    # Every DDE name shown (the warnings', the compact table's, those of unnamed sets) from one naming.
+    dde = _dde_name_map(unusable[:5] + stale[:5], catalog,
+                        numbers if compact else [n for n, name in element_names.items() if not name])
+    _report_unusable(unusable, dde, start)
+    _report_stale(stale, dde, start, stale_days)
+    return (passes, {n: name or dde[n] for n, name in element_names.items()},
+            {n: dde[n] for n in numbers} if compact else {}, len(sets))
 
 
 def _chosen_sets(args: argparse.Namespace, inputs: TrackingInputs, catalog: Catalog) -> list[Any]:
