@@ -158,6 +158,16 @@ class _Requests:
         self.stop = stop
         self.station: Station | None = None
         self.app: NfwConsole | None = None
+        self._reload_pending = False  #: a reload asked for before the station was up
+        self._lock = threading.Lock()
+
+    def station_started(self, station: Station) -> None:
+        """The station is up: reload requests reach it from now on, and one asked for while it started is
+        carried out now (the file may have changed after it was read)."""
+        with self._lock:
+            self.station, pending, self._reload_pending = station, self._reload_pending, False
+        if pending:
+            station.reload_config()
 
     def on_stop(self) -> None:
         self.stop.set()
@@ -165,8 +175,11 @@ class _Requests:
             _exit_app(self.app)
 
     def on_reload(self) -> None:
-        if self.station is not None:
-            self.station.reload_config()
+        with self._lock:
+            station = self.station
+            self._reload_pending = station is None
+        if station is not None:
+            station.reload_config()
 
 
 def _listen(plan: RunPlan, requests: _Requests, clock: Clock) -> tuple[StationSignals | None, ControlFile | None]:
@@ -208,7 +221,7 @@ def serve(config: Config, plan: RunPlan, watch: str | None = None) -> int:
         except OSError as exc:
             station.stop()
             raise CliError(f"cannot start the station: {exc.strerror or exc}") from None
-        requests.station = station
+        requests.station_started(station)
         try:
             file_handler = _serve_started(station, config, plan, watch, requests, file_handler)
         finally:

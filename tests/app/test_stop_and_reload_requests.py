@@ -115,3 +115,32 @@ def test_a_requested_read_applies_the_file_even_when_it_looks_unchanged(tmp_path
         assert _until(lambda: len(refused) == 1) and applied == [27607]
     finally:
         watcher.stop()
+
+
+def test_a_reload_asked_for_while_the_station_starts_is_carried_out_once_it_is_up(tmp_path, caplog) -> None:
+    """A SIGHUP between reading the configuration and the station being up was logged as a reload and then
+    dropped; it is now kept and carried out when the station is up (one reload, not one per request)."""
+    from nfwserver.app.station import Station
+    from nfwserver.cli.run_command import _Requests
+    from nfwserver.clock import VirtualClock
+    from nfwserver.config import load_config
+    from nfwserver.fake_dde import FakeDdeSystem
+    from tests.dde.conftest import ISS_PASS
+
+    path = tmp_path / "station.toml"
+    path.write_text('[observer]\nlocation = "JO02ae"\n[server]\nstate_file = "none"\n')
+    station = Station(load_config(str(path)), VirtualClock(ISS_PASS.aos), transport=FakeDdeSystem().server_transport())
+    requests = _Requests(threading.Event())
+    caplog.set_level(logging.INFO, logger="nfwserver.app.station")
+    requests.on_reload()
+    requests.on_reload()
+    assert not [r for r in caplog.records if "reloading the configuration" in r.getMessage()]
+    station.start()
+    try:
+        requests.station_started(station)
+        reloads = [r for r in caplog.records if "reloading the configuration" in r.getMessage()]
+        assert len(reloads) == 1 and str(path) in reloads[0].getMessage()
+        requests.on_reload()  # from now on each request reaches the station at once
+        assert len([r for r in caplog.records if "reloading the configuration" in r.getMessage()]) == 2
+    finally:
+        station.stop()
