@@ -12,13 +12,13 @@ almost always the wrong file or an error page.
 from __future__ import annotations
 
 import contextlib
-import os
 import socket
 from collections.abc import Callable, Mapping
 from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
 from importlib import resources
 
+from nfwserver.config.files import FileRefused, FileTooLarge, read_regular_bytes
 from nfwserver.tracking.elements import ElementSet, LoadResult, Rejection, load_elements
 
 BUNDLED = "amateur.txt"
@@ -124,18 +124,17 @@ def fetch_url(url: str, timeout_s: float = 20.0, progress: ProgressCallback | No
 
 
 def read_file(path: str, limits: SourceLimits = SourceLimits()) -> bytes:
-    """The bytes of the file ``path``, refused unread when its size is over ``limits.max_bytes`` and read
-    with a bounded read (a file that grows, or is no regular file, is cut at the limit and refused)."""
+    """The bytes of the regular file ``path``, refused unread when its size is over ``limits.max_bytes`` and
+    read with a bounded read (a file that grows past the limit is refused).  Anything but a regular file (a
+    FIFO, whose open would wait for a writer for ever; a device such as /dev/zero) is refused at once."""
     try:
-        with open(path, "rb") as f:
-            if os.fstat(f.fileno()).st_size > limits.max_bytes:
-                raise limits.too_large(path)
-            data = f.read(limits.max_bytes + 1)
+        return read_regular_bytes(path, limits.max_bytes)
+    except FileTooLarge:
+        raise limits.too_large(path) from None
+    except FileRefused:
+        raise SourceError(f"cannot read {path}: it is not a regular file") from None
     except OSError as exc:
         raise SourceError(f"cannot read {path}: {(exc.strerror or str(exc)).lower()}") from None
-    if len(data) > limits.max_bytes:
-        raise limits.too_large(path)
-    return data
 
 
 def _looks_binary(data: bytes) -> bool:

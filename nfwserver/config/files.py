@@ -21,12 +21,26 @@ class FileRefused(ValueError):
     """The path exists but is not a regular file of acceptable size; the message is one sentence."""
 
 
+class FileTooLarge(FileRefused):
+    """The regular file is larger than the limit (or grew past it while being read)."""
+
+
 def read_regular_file(path: str | Path, limit: int = MAX_FILE_BYTES, errors: str = "strict") -> str:
     """Return the UTF-8 text of the regular file ``path`` (at most ``limit`` bytes).
 
     Raises :class:`FileNotFoundError` / :class:`OSError` when it cannot be opened,
     :class:`FileRefused` when it is not a regular file or is larger than ``limit``, and
     :class:`UnicodeDecodeError` for undecodable text when ``errors`` is ``"strict"``.
+    """
+    return read_regular_bytes(path, limit).decode("utf-8", errors)
+
+
+def read_regular_bytes(path: str | Path, limit: int) -> bytes:
+    """The bytes of the regular file ``path``, at most ``limit`` of them, read without ever blocking.
+
+    Raises :class:`OSError` when it cannot be opened, :class:`FileRefused` when it is not a regular file and
+    :class:`FileTooLarge` when it holds more than ``limit`` bytes (checked before reading, and again while
+    reading, for a file that grows).
     """
     flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
     fd = os.open(path, flags)
@@ -35,7 +49,7 @@ def read_regular_file(path: str | Path, limit: int = MAX_FILE_BYTES, errors: str
         if not stat.S_ISREG(info.st_mode):
             raise FileRefused(f"{path} is not a regular file")
         if info.st_size > limit:
-            raise FileRefused(f"{path} is larger than {_size(limit)}")
+            raise FileTooLarge(f"{path} is larger than {_size(limit)}")
         chunks: list[bytes] = []
         total = 0
         while total <= limit:
@@ -45,10 +59,10 @@ def read_regular_file(path: str | Path, limit: int = MAX_FILE_BYTES, errors: str
             chunks.append(chunk)
             total += len(chunk)
         if total > limit:  # it grew while being read
-            raise FileRefused(f"{path} is larger than {_size(limit)}")
+            raise FileTooLarge(f"{path} is larger than {_size(limit)}")
     finally:
         os.close(fd)
-    return b"".join(chunks).decode("utf-8", errors)
+    return b"".join(chunks)
 
 
 def check_regular_file(path: str | Path) -> str | None:

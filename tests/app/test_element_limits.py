@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import logging
+import os
 import threading
 import time
 import tracemalloc
@@ -47,10 +48,26 @@ def test_a_sparse_gibibyte_file_is_refused_unread_naming_the_file_and_the_limit(
                        "([elements] max_source_mib)")
 
 
-def test_a_source_that_never_ends_is_cut_at_the_limit() -> None:
-    """/dev/zero reports size 0: the bounded read stops one byte past the limit."""
-    with pytest.raises(SourceError, match=r"^/dev/zero is larger than 1 MiB, the limit"):
-        read_source("/dev/zero", limits=SourceLimits(max_bytes=2**20))
+def test_a_source_that_is_not_a_regular_file_is_refused_at_once(tmp_path) -> None:
+    """/dev/zero would never end and a FIFO's open would wait for a writer for ever (the refresher thread with
+    it): both are refused unread, in one sentence."""
+    fifo = tmp_path / "elements.fifo"
+    os.mkfifo(fifo)
+    for path in ("/dev/zero", str(fifo)):
+        outcome: list[BaseException] = []
+
+        def read(path: str = path, outcome: list[BaseException] = outcome) -> None:
+            try:
+                read_source(path, limits=SourceLimits(max_bytes=2**20))
+            except BaseException as exc:
+                outcome.append(exc)
+
+        reader = threading.Thread(target=read, daemon=True)  # a blocked open must not hang the suite
+        reader.start()
+        reader.join(30.0)
+        assert not reader.is_alive(), f"reading {path} blocked"
+        assert isinstance(outcome[0], SourceError)
+        assert str(outcome[0]) == f"cannot read {path}: it is not a regular file"
 
 
 def test_too_many_sets_in_one_source_are_refused_in_every_format(tmp_path) -> None:
