@@ -26,16 +26,13 @@ def device_status(rotor: RotorCoupling | None, radio: RadioCoupling | None,
         if rotor is not None:
             _, _, target_el, target_az = rotor.driver.positions()
             position = rotor.driver.rotor_position()
-            if position is None or not rotor.driver.backend_reachable:
-                out["rotor"] = "unreachable"
-            else:
-                out["rotor"] = "stalled" if rotor.driver.stalled else ("ok" if rotor.driver.health.ok else "retrying")
+            out["rotor"] = rotor.driver.link_state()
             if position is not None:
                 out["rotor_az"], out["rotor_el"] = f"{position[0]:.1f}", f"{position[1]:.1f}"
             if target_az is not None and target_el is not None:
                 out["rotor_target"] = f"{target_az:.1f}/{target_el:.1f}"
         if radio is not None:
-            out["radio"] = "ok" if radio.tuner.available else "unreachable"
+            out["radio"] = radio.link_state()
             result = radio.last_result
             if result is not None:
                 out["radio_rx"] = result.rx_hz

@@ -222,3 +222,11 @@ class HamlibConnection:
                 self._sock.close()
             finally:
                 self._sock = None
+
+
+def daemon_link_ok(device: object) -> bool:
+    """False while the Hamlib daemon behind ``device`` (a backend holding a :class:`HamlibConnection` as
+    ``connection``) has a fault on the station's board: unreachable, answering slowly or with nonsense.  True
+    for a device without a daemon (the simulated rotor)."""
+    connection = getattr(device, "connection", None)
+    return not isinstance(connection, HamlibConnection) or connection.health.ok

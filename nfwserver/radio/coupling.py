@@ -17,6 +17,7 @@ from nfwserver.clock import Clock
 from nfwserver.core.sample import TickSample
 from nfwserver.core.state import StationState
 from nfwserver.core.tick_worker import TickWorker
+from nfwserver.hamlib.connection import daemon_link_ok
 from nfwserver.radio.tuning import DopplerTuner, TuneResult
 
 log = logging.getLogger(__name__)
@@ -48,6 +49,16 @@ class RadioCoupling(TickWorker):
             self.tuner.set_channel(channel)
         self.last_result = self.tuner.update(sample.look_angles.range_rate_km_s)
         return self.last_result
+
+    def link_state(self) -> str:
+        """The radio's state in one word, as STATUS, the console and the web page show it: ``unreachable``,
+        ``refusing`` (the radio refused the last command), ``failing`` (its daemon answers slowly or with
+        nonsense), else ``ok``."""
+        if not self.tuner.available:
+            return "unreachable"
+        if self.tuner.last_error is not None:
+            return "refusing"
+        return "ok" if daemon_link_ok(self.tuner.backend) else "failing"
 
     def stop(self) -> None:
         super().stop()

@@ -19,6 +19,7 @@ from __future__ import annotations
 import logging
 
 from nfwserver.clock import Clock
+from nfwserver.hamlib.connection import daemon_link_ok
 from nfwserver.health import Backoff, LinkHealth
 from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.rotor.backend import RotorBackend, RotorError, RotorUnavailable
@@ -129,6 +130,18 @@ class KctRotorLink:
     def stalled(self) -> bool:
         """Any axis is stalled and held now (status bits 10h/20h)."""
         return any(self.stall.stalled)
+
+    def link_state(self) -> str:
+        """The rotor's state in one word, as STATUS, the console and the web page show it: ``unreachable`` (no
+        position read back, or the backend cannot be reached), ``stalled``, ``retrying`` (moves refused),
+        ``failing`` (its daemon answers slowly or with nonsense), else ``ok``."""
+        if self.rotor_position() is None or not self.backend_reachable:
+            return "unreachable"
+        if self.stalled:
+            return "stalled"
+        if not self.health.ok:
+            return "retrying"
+        return "ok" if daemon_link_ok(self.backend) else "failing"
 
     def _stop_rotor(self) -> None:
         try:

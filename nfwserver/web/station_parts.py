@@ -42,10 +42,7 @@ def rotor_part(rotor: RotorCoupling | None) -> dict[str, object] | None:
     _, _, target_el, target_az = driver.positions()
     out: dict[str, object] = {"flip_mode": rotor.flip_mode, "flipped": bool(rotor.flip_state),
                               "suspended": rotor.suspended, "kct_status": f"0x{int(driver.status().bits):02X}"}
-    if position is None or not driver.backend_reachable:
-        out["state"] = "unreachable"
-    else:
-        out["state"] = "stalled" if driver.stalled else ("ok" if driver.health.ok else "retrying")
+    out["state"] = driver.link_state()
     out["actual"] = None
     if position is not None and all(map(math.isfinite, position)):
         az, el = sky_from_rotor(position[0], position[1])
@@ -63,8 +60,8 @@ def radio_part(radio: RadioCoupling | None, tuning_on: bool) -> dict[str, object
     if radio is None:
         return None
     result = radio.last_result
-    return {"state": "ok" if radio.tuner.available else "unreachable", "tuning": tuning_on,
-            "error": None if radio.tuner.available else str(radio.tuner.last_error or ""),
+    state = radio.link_state()
+    return {"state": state, "tuning": tuning_on, "error": None if state == "ok" else str(radio.tuner.last_error or ""),
             "rx_hz": result.rx_hz if result is not None else None,
             "tx_hz": result.tx_hz if result is not None and result.tx_hz else None}
 

@@ -97,3 +97,26 @@ def test_a_reply_that_arrives_slowly_keeps_the_link_failing_until_a_prompt_one(m
         assert conn.health.ok
     finally:
         slow.close()
+
+
+def test_a_rotor_behind_a_slow_daemon_is_failing_in_status_not_ok(monkeypatch) -> None:
+    """STATUS said ``rotor=ok`` beside ``faults=rotctld`` while the daemon answered slowly: the rotor's one
+    word (STATUS, console, web page) now comes from its daemon link too, and is ``ok`` again after a prompt
+    reply."""
+    import nfwserver.hamlib.connection as connection
+    from nfwserver.rotor.geometry import RotorGeometry
+    from nfwserver.rotor.kct_driver import KctDriver
+    from nfwserver.rotor.rotctld_backend import RotctldBackend
+
+    monkeypatch.setattr(connection, "SLOW_REPLY_S", 0.3)
+    slow = TricklingPeer(delay_s=0.02)  # 0.44 s a reply: within the deadline, over SLOW_REPLY_S
+    try:
+        clock = VirtualClock(datetime(2026, 5, 8, tzinfo=timezone.utc))
+        driver = KctDriver(clock, RotctldBackend(clock, RotorGeometry(), port=slow.port))
+        assert driver.read_position() == (180.0, 45.0)  # answered: the position is used
+        assert driver.link_state() == "failing"
+        slow.trickle.clear()
+        assert driver.read_position() == (180.0, 45.0)
+        assert driver.link_state() == "ok"
+    finally:
+        slow.close()
