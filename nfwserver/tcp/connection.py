@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import os
 import selectors
 import socket
@@ -91,9 +92,11 @@ class ListenerRest:
     def __init__(self, health: LinkHealth) -> None:
         self.health = health
         self.resting = False
+        self._descriptors = False  #: the rest is for want of descriptors (a spare one can be looked for)
 
     def rest(self, selector: selectors.BaseSelector, listener: socket.socket, exc: OSError) -> None:
         self.health.failed(f"cannot accept connections: {exc.strerror or exc}")
+        self._descriptors = exc.errno in (errno.EMFILE, errno.ENFILE)
         if not self.resting:
             selector.unregister(listener)
             self.resting = True
@@ -104,13 +107,17 @@ class ListenerRest:
         return fault.retry_at if self.resting and fault is not None else None
 
     def maybe_resume(self, selector: selectors.BaseSelector, listener: socket.socket) -> None:
+        """At the end of the back-off: listen again.  Out of descriptors, a spare one found clears the fault
+        at once; out of memory (which a spare descriptor does not prove over), the fault stays until a
+        connection is accepted, so a shortage that lasts keeps growing the back-off instead of restarting it."""
         if not self.resting or not self.health.may_try():
             return
-        try:
-            os.close(os.dup(listener.fileno()))
-        except OSError as exc:
-            self.health.failed(f"cannot accept connections: {exc.strerror or exc}")
-            return
-        self.health.succeeded()
+        if self._descriptors:
+            try:
+                os.close(os.dup(listener.fileno()))
+            except OSError as exc:
+                self.health.failed(f"cannot accept connections: {exc.strerror or exc}")
+                return
+            self.health.succeeded()
         selector.register(listener, selectors.EVENT_READ, "listen")
         self.resting = False
