@@ -22,6 +22,7 @@ from __future__ import annotations
 import logging
 import os
 import stat
+import threading
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
@@ -64,10 +65,12 @@ class ConfigWatcher(ServiceThread):
         super().__init__()
         self._seen: Signature = None
         self._requested = False
+        self._request_lock = threading.Lock()  #: a request is never lost between reading and clearing the flag
 
     def request(self) -> None:
         """Read the file on the watcher's thread now, changed or not (any thread; only sets flags)."""
-        self._requested = True
+        with self._request_lock:
+            self._requested = True
         self._wake.set()
 
     def start(self) -> None:
@@ -122,7 +125,8 @@ class ConfigWatcher(ServiceThread):
             if self._stop.is_set():
                 return
             self._wake.clear()
-            forced, self._requested = self._requested, False
+            with self._request_lock:
+                forced, self._requested = self._requested, False
             if not forced and self.interval_s is None:
                 continue
             try:

@@ -17,6 +17,7 @@ threads.  :meth:`start` and :meth:`stop` are idempotent.
 from __future__ import annotations
 
 import logging
+import threading
 from collections.abc import Callable
 
 from nfwserver.app.config_watcher import ConfigWatcher
@@ -102,6 +103,7 @@ class Station:
                                                           favourites=lambda: self.config.favourites))
             if config.web.enabled else None)
         self.watcher: ConfigWatcher | None = None
+        self._watcher_lock = threading.Lock()
         self.selection_note = ""  #: which satellite the station started with, and why (set by start())
         self._unsubscribe: list[Callable[[], None]] = []
         self._started = False
@@ -156,10 +158,11 @@ class Station:
         if not self.config.path:
             log.warning("reload requested, but the station runs on built-in defaults: there is no file to read")
             return False
-        if self.watcher is None:  # not watching: a watcher that reads only on request
-            self.watcher = ConfigWatcher(self.config.path, self.clock, self._config_changed, self._config_refused,
-                                         None)
-            self.watcher.start()
+        with self._watcher_lock:  # any thread: two requests at once make one watcher
+            if self.watcher is None:  # not watching: a watcher that reads only on request
+                self.watcher = ConfigWatcher(self.config.path, self.clock, self._config_changed,
+                                             self._config_refused, None)
+                self.watcher.start()
         log.info("reloading the configuration from %s", self.config.path)
         self.watcher.request()
         return True
