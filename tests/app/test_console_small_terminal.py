@@ -75,6 +75,8 @@ def test_page_keys_scroll_the_shown_log_while_typing_stays_possible() -> None:
 
 def test_the_footer_shows_every_key_at_80_columns() -> None:
     async def scenario(app, pilot, station) -> None:
+        # under load the first frame can come before the footer is drawn: wait for it (not for its contents)
+        await settle(app, pilot, until=lambda: screen_text(app).splitlines()[-1].strip() != "")
         footer = screen_text(app).splitlines()[-1]
         for label in ("Out", "Sats", "In", "Zone", "Tune", "Doppler", "Flip", "Quit"):
             assert label in footer, footer

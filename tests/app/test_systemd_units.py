@@ -75,7 +75,7 @@ def test_the_wine_unit_signals_only_the_launcher_with_signals_it_handles() -> No
     assert start[0].endswith("/tools/wine/nfwserver") and start[1:3] == ["run", "--headless"]
     assert "NFW_WINE_TIMEOUT=0" in service["Environment"][0].split()  # no time limit on a service
     traps = launcher_traps()
-    stop, reload = traps["on_stop"], traps["'ask reload'"]
+    stop, reload = traps["on_stop"], traps["on_reload"]
     assert signal.Signals[service["KillSignal"][0]] in stop
     assert {signal.SIGTERM, signal.SIGINT, signal.SIGHUP} <= stop
     assert kill_signal(service["ExecReload"][0]) in reload
