@@ -11,7 +11,7 @@ from nfwserver.cli.arguments import number_in
 
 
 def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    p = subparsers.add_parser("config", help="configuration file: path, init, show",
+    p = subparsers.add_parser("config", help="configuration file: path, init, show, set, edit",
                               description="Manage the configuration file.")
     sub = p.add_subparsers(dest="config_action", metavar="ACTION", required=True)
     sub.add_parser("path", help="print where the configuration file is looked for").set_defaults(func=run_path)
@@ -25,6 +25,10 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
                       help="your station's longitude, degrees east (with --lat)")
     init.add_argument("--alt", type=number_in(-500, 9000, unit="m"), metavar="M", default=0.0,
                       help="height above the WGS84 ellipsoid, metres (with --lat/--lon; default 0)")
+    init.add_argument("--web", action="store_true", help="serve the web dashboard ([web] enabled = true, on "
+                      "127.0.0.1)")
+    init.add_argument("--keep", action="store_true", help="leave an existing file as it is and succeed (for "
+                      "installers); without it an existing file is an error")
     init.set_defaults(func=run_init)
     show = sub.add_parser("show", help="validate the file and print what the server will use")
     show.add_argument("--config", metavar="FILE")
@@ -39,6 +43,12 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     edit.add_argument("value", metavar="VALUE", help='e.g. JO01ab, true, "[25544, 7530]"')
     edit.add_argument("--config", metavar="FILE", help="the file to change (default: the usual location)")
     edit.set_defaults(func=run_set)
+    opened = sub.add_parser("edit", help="open the configuration file in your editor (created when missing)",
+                            description="Open the configuration file in your editor: $VISUAL or $EDITOR, else "
+                            "the system's editor for the file (Notepad on Windows).  A missing file is "
+                            "first written from the template, as `config init` does.")
+    opened.add_argument("--config", metavar="FILE", help="the file to open (default: the usual location)")
+    opened.set_defaults(func=run_edit)
 
 
 def run_path(args: argparse.Namespace) -> int:
@@ -56,6 +66,9 @@ def run_init(args: argparse.Namespace) -> int:
 
     path = Path(args.config) if args.config else default_config_path()
     if path.exists() and not args.force:
+        if args.keep:
+            print(f"{path} (kept as it was)")
+            return 0
         raise CliError(f"{path} already exists (use --force to overwrite)")
     if (args.lat is None) != (args.lon is None):
         raise CliError("give both --lat and --lon (or --locator)")
@@ -65,6 +78,8 @@ def run_init(args: argparse.Namespace) -> int:
     if args.locator or args.lat is not None:
         location = args.locator or f"{args.lat:g},{args.lon:g},{args.alt:g}"
         text = _edited(text, "observer", "location", location, path)
+    if args.web:
+        text = _edited(text, "web", "enabled", True, path)
     try:
         atomic_write_text(path, text)
     except OSError as exc:
@@ -72,6 +87,12 @@ def run_init(args: argparse.Namespace) -> int:
                        "(choose another place with --config FILE)") from None
     print(path)
     return 0
+
+
+def run_edit(args: argparse.Namespace) -> int:
+    from nfwserver.cli.config_editor import open_in_editor
+
+    return open_in_editor(Path(args.config) if args.config else None)
 
 
 def run_show(args: argparse.Namespace) -> int:
