@@ -231,3 +231,17 @@ def test_the_quiet_uninstall_removes_the_program_and_keeps_the_users_files(insta
     assert 'location = "JO01ab"' in (installed.user_files / "config.toml").read_text()
     assert (installed.user_files / "state.json").is_file()
     assert (installed.user_files / "Logs" / "nfwserver.log").is_file()
+
+
+def test_another_folder_chosen_with_d_is_installed_to_and_removed_from(installed: Installed) -> None:
+    folder = PureWindowsPath(r"C:\Radio\nfw server")
+    assert installed.setup(f"/D={folder}") == 0  # NSIS: /D= comes last and is never quoted
+    values = installed.prefix.reg_values(UNINSTALL_KEY)
+    assert values is not None and values["InstallLocation"] == str(folder)
+    version = installed.prefix.run([str(folder / "nfwserver.exe"), "--version"])
+    assert version.returncode == 0 and version.stdout.strip() == f"nfwserver {__version__}"
+    assert not installed.prefix.unix(installed.folder).exists()
+    program, switch = values["QuietUninstallString"].rsplit(" ", 1)
+    assert installed.prefix.run_detached([program.strip('"'), switch]) == 0
+    wait_until(lambda: not installed.prefix.unix(folder).exists(), 120, f"{folder} removed")
+    assert installed.prefix.unix(folder.parent).is_dir()  # only the program's own folder goes
