@@ -19,10 +19,12 @@ import pytest
 from nfwserver.cli import main
 from nfwserver.cli.station_channel import StationChannel
 from nfwserver.cli.windowless import TailText
-from tests.app.test_run_signals import Station
+from tests.app import test_run_signals
 from tests.conftest import ROOT
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX processes (Windows: tests/windows)")
+#: The fixture making real ``nfwserver run --headless`` stations in ``tmp_path``.
+station = test_run_signals.station
 
 
 def _cli(home: Path, *args: str, env: dict[str, str] | None = None,
@@ -40,19 +42,6 @@ def wait_until(predicate: Callable[[], bool], timeout_s: float) -> None:
     while not predicate():
         assert time.monotonic() < deadline, f"not within {timeout_s:g} s: {predicate}"
         time.sleep(0.05)
-
-
-@pytest.fixture
-def station(tmp_path):
-    made: list[Station] = []
-
-    def make(**kw) -> Station:
-        made.append(Station(tmp_path, **kw))
-        return made[-1]
-
-    yield make
-    for st in made:
-        st.stop()
 
 
 def test_stop_asks_the_station_through_its_channel_and_returns_once_it_has_stopped(station, tmp_path) -> None:
