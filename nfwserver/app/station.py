@@ -86,7 +86,8 @@ class Station:
         self.core.rotor_configured = self.rotor is not None
         self.radio: RadioCoupling | None = make_radio(config.radio, self.core, clock)
         self.saver = (SessionSaver(self.state_file, config.server.satellite,
-                                   self.core.health.link("state-file", Backoff(0.2, 0.4)))
+                                   self.core.health.link("state-file", Backoff(0.2, 0.4)),
+                                   current=lambda: self.core.state.catalog_number)
                       if self.state_file else None)
         self.easycomm: EasyCommOutput | None = (
             EasyCommOutput(config.easycomm, self.core.state, clock,
@@ -281,7 +282,7 @@ class Station:
                 listener.stop()
         for dialect_server in self.dialect_servers:
             dialect_server.detach()
-        for worker in (self.radio, self.rotor, self.saver, self.easycomm):
+        for worker in (self.radio, self.rotor, self.easycomm):
             if worker is not None:
                 worker.stop()
         self.nova.detach()
@@ -290,6 +291,8 @@ class Station:
                 self.transport.close()
             except Exception:
                 log.exception("closing the transport failed")
+        if self.saver is not None:  # last: no face can change the selection any more
+            self.saver.stop()
 
 
 def _selection_note(choice: int | None, source: str, configured: int | None, saved: SessionState,

@@ -8,6 +8,7 @@ again), the TCP server on a free port and EasyComm on a real pseudo-terminal.
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import socket
@@ -30,8 +31,9 @@ STOP_WITHIN_S = 5.0
 class Station:
     """``nfwserver run --headless`` in a process of its own, configured through ``$XDG_CONFIG_HOME``."""
 
-    def __init__(self, home: Path, elements: Path = DATA / "visual.txt", extra: str = "") -> None:
+    def __init__(self, home: Path, elements: Path = DATA / "visual.txt", extra: str = "", server: str = "") -> None:
         self.home = home
+        self.server = server
         self.elements = elements
         self.port = free_port()
         self.pty = Pty(home / "ttyUSB0")
@@ -52,7 +54,7 @@ class Station:
         self.config.write_text(
             '[observer]\nlocation = "52.2053,0.1218,20"\n'
             f'[elements]\nfiles = ["{self.elements}"]\nuse_bundled = false\nstore = "none"\n'
-            '[server]\nsatellite = 25544\ntune = true\ntrack = true\n'
+            f'[server]\nsatellite = 25544\ntune = true\ntrack = true\n{self.server}'
             f'[tcp]\nenabled = true\nport = {self.port}\n'
             f'[easycomm]\nenabled = true\ndevice = "{self.pty.path}"\nrate_hz = 2\n{extra}')
 
@@ -136,6 +138,20 @@ def test_sigterm_and_sigint_stop_the_station_cleanly_within_5_s(station, sig) ->
     assert st.pty.lines() == ["SA SE"]  # written at shutdown: the rotor controller was told to stop
     log = st.log.read_text()
     assert f"{sig.name}: stopping" in log and log.rstrip().endswith("stopped")
+
+
+def test_a_choice_answered_ok_just_before_sigterm_is_restored(station) -> None:
+    """#34 item 4: the saver wrote the last tick's sample at stop, so a ``SAT=`` answered ``OK`` and followed by
+    SIGTERM before the next tick (1 Hz here) was lost; the next start came back with the old satellite."""
+    st = station(server="rate_hz = 1\n")
+    st.wait_serving()
+    assert _until(lambda: '"satellite": 25544' in (st.state.read_text() if st.state.exists() else ""), 5.0)
+    assert st.ask("SAT=694") == "OK"
+    st.proc.send_signal(signal.SIGTERM)
+    err = st.finish()
+    assert st.proc.returncode == 0 and "Traceback" not in err, err
+    # What the next start restores (tests/app/test_satellite_origin.py): the choice, made under this configuration.
+    assert json.loads(st.state.read_text()) == {"satellite": 694, "configured": 25544}
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
