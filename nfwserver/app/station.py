@@ -156,16 +156,17 @@ class Station:
         as a change the watcher sees.  False when the station runs on built-in defaults or is not running."""
         if not self._started:
             return False
-        if not self.config.path:
-            log.warning("reload requested, but the station runs on built-in defaults: there is no file to read")
-            return False
         with self._watcher_lock:  # any thread: two requests at once make one watcher
+            path = self.watcher.path if self.watcher is not None else self.config.path
+            if not path:
+                log.warning("reload requested, but the station runs on built-in defaults: there is no file to read")
+                return False
             if self.watcher is None:  # not watching: a watcher that reads only on request
-                self.watcher = ConfigWatcher(self.config.path, self.clock, self._config_changed,
-                                             self._config_refused, None)
+                self.watcher = ConfigWatcher(path, self.clock, self._config_changed, self._config_refused, None)
                 self.watcher.start()
-        log.info("reloading the configuration from %s", self.config.path)
-        self.watcher.request()
+            watcher = self.watcher
+        log.info("reloading the configuration from %s", path)
+        watcher.request()
         return True
 
     # -- elements ----------------------------------------------------------------------------------

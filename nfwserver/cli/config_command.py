@@ -33,8 +33,9 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
                           description="Set SECTION.KEY to VALUE in the configuration file (created from the "
                           "template when missing).  The whole file is validated before it is written; a "
                           "refused value changes nothing.  VALUE is read as TOML when it is a TOML value "
-                          "(true, 12.5, [25544, 7530]), else as text (JO01ab).  A running station applies "
-                          "the change by itself.")
+                          "(true, 12.5, [25544, 7530]), else as text (JO01ab).  A running station follows the "
+                          "file it loaded and applies the change by itself; the command says when a change "
+                          "needs a restart.")
     edit.add_argument("key", metavar="SECTION.KEY", help="e.g. observer.location, tcp.enabled, rotor.backend")
     edit.add_argument("value", metavar="VALUE", help='e.g. JO01ab, true, "[25544, 7530]"')
     edit.add_argument("--config", metavar="FILE", help="the file to change (default: the usual location)")
@@ -145,5 +146,20 @@ def run_set(args: argparse.Namespace) -> int:
         atomic_write_text(path, new)
     except OSError as exc:
         raise CliError(f"cannot write {path}: {exc.strerror or exc}") from None
-    print(f"{path}: [{section}] {key} set")
+    note = _change_note(text, new, path)
+    print(f"{path}: [{section}] {key} set" + (f"; {note}" if note else ""))
     return 0
+
+
+def _change_note(old_text: str, new_text: str, path: Path) -> str:
+    """How a running station takes the change (:func:`nfwserver.app.change_note.change_note`)."""
+    from nfwserver.app.change_note import change_note
+    from nfwserver.config import ConfigError
+    from nfwserver.config.loader import parse_config
+
+    new = parse_config(new_text, str(path), path.parent)
+    try:
+        old = parse_config(old_text, str(path), path.parent)
+    except ConfigError:
+        return "a running station applies it within seconds, or names what needs a restart in its log"
+    return change_note(old, new)

@@ -2,8 +2,8 @@
 EasyComm ``SA SE`` sent, exit 0), also during start-up and when repeated; SIGHUP reloads the configuration.
 
 The station runs with its configuration and state in the XDG directories of a temporary home (no
-``--config``: the configuration file is not watched, so only SIGHUP can make the station read it
-again), the TCP server on a free port and EasyComm on a real pseudo-terminal.
+``--config``, as the README starts it: the station still follows the file it loaded, and SIGHUP reads it at
+once), the TCP server on a free port and EasyComm on a real pseudo-terminal.
 """
 
 from __future__ import annotations
@@ -138,6 +138,22 @@ def test_sigterm_and_sigint_stop_the_station_cleanly_within_5_s(station, sig) ->
     assert st.pty.lines() == ["SA SE"]  # written at shutdown: the rotor controller was told to stop
     log = st.log.read_text()
     assert f"{sig.name}: stopping" in log and log.rstrip().endswith("stopped")
+
+
+def test_config_set_reaches_a_station_started_without_config(station) -> None:
+    """#34 item 2: the file was watched only with ``run --config``; ``config set`` on a station started as the
+    README starts it did nothing, although ``config set --help`` says a running station applies it."""
+    st = station()
+    st.wait_serving()
+    assert st.status()["name"] == "ISS"
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "XDG_CONFIG_HOME": str(st.home / "config")}
+    done = subprocess.run([sys.executable, "-m", "nfwserver", "config", "set", "satellites.names",
+                           '{ 25544 = "ZARYA" }'], cwd=ROOT, env=env, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0 and done.stdout.startswith(str(st.config)), done
+    assert "applies it within seconds" in done.stdout
+    assert _until(lambda: st.status()["name"] == "ZARYA", 15.0), st.status()
+    st.proc.send_signal(signal.SIGTERM)
+    assert "Traceback" not in st.finish()
 
 
 def test_a_choice_answered_ok_just_before_sigterm_is_restored(station) -> None:

@@ -75,3 +75,20 @@ def test_show_prints_values_as_written(station_file, capsys) -> None:
     assert 'location = "JO01ab"' in out
     assert "0.041666666666666664" not in out  # the locator's longitude is shown rounded, as derived
     assert "longitude_deg = 0.04166666667  # from location" in out
+
+
+@pytest.mark.parametrize(("key", "value", "says"), [
+    ("tcp.port", "9001", "a running station needs a restart to apply [tcp]"),
+    ("rotor.backend", "sim", "a running station needs a restart to apply [rotor]"),
+    ("observer.location", "IO91wm", "a running station applies it within seconds"),
+    ("satellites.names", '{ 25544 = "ZARYA" }', "a running station applies it within seconds"),
+    ("server.satellite", "7530", "used when the station starts; a running station keeps its current setting"),
+])
+def test_set_says_how_a_running_station_takes_the_change(station_file, capsys, key: str, value: str,
+                                                         says: str) -> None:
+    """#34 item 2: what needs a restart was said only in the station's log; ``config set`` says it itself."""
+    capsys.readouterr()
+    assert main(["config", "set", "--config", str(station_file), key, value]) == 0
+    out = capsys.readouterr().out.strip()
+    section, name = key.split(".")
+    assert out == f"{station_file}: [{section}] {name} set; {says}"
