@@ -30,6 +30,7 @@ from nfwserver.app.platform_transport import default_transport
 from nfwserver.app.session_state import SessionSaver, SessionState, StateFile
 from nfwserver.app.station_catalog import configured_store, configured_urls, fetch_configured, load_station_catalog
 from nfwserver.app.status_fields import combined, device_status, elements_status
+from nfwserver.app.store_watcher import StoreWatcher
 from nfwserver.clock import Clock
 from nfwserver.config.live_reload import keep_running, restart_needed
 from nfwserver.config.schema import Config
@@ -104,6 +105,8 @@ class Station:
                                                           favourites=lambda: self.config.favourites))
             if config.web.enabled else None)
         self.watcher: ConfigWatcher | None = None
+        #: follows the stored catalog, which ``nfwserver elements update`` writes while the station runs
+        self.store_watcher = StoreWatcher(self.store.path, clock, self.reload_store) if self.store else None
         self._watcher_lock = threading.Lock()
         self.selection_note = ""  #: which satellite the station started with, and why (set by start())
         self._unsubscribe: list[Callable[[], None]] = []
@@ -156,6 +159,8 @@ class Station:
         as a change the watcher sees.  False when the station runs on built-in defaults or is not running."""
         if not self._started:
             return False
+        if self.store_watcher is not None:
+            self.store_watcher.request()  # the stored catalog too (written by `elements update`)
         with self._watcher_lock:  # any thread: two requests at once make one watcher
             path = self.watcher.path if self.watcher is not None else self.config.path
             if not path:
@@ -208,6 +213,21 @@ class Station:
                     log.error("cannot save the element catalog to %s: %s", self.store.path, exc)
             release(fetched.sets)  # the sets that were not newer
         log.info("elements refreshed: %d added, %d updated", len(summary.added), len(summary.updated))
+        return summary
+
+    def reload_store(self) -> UpdateSummary | None:
+        """Merge the stored catalog into the live one (the store watcher's thread): sets added by ``nfwserver
+        elements update`` become selectable, newer epochs replace older ones.  None without a store."""
+        if self.store is None:
+            return None
+        with building_long_lived():
+            stored = self.store.load()
+            summary = self.core.state.catalog.update(stored)
+            if summary.added or summary.updated:
+                self.core.state.catalog_changed()
+            release(stored)
+        if summary.added or summary.updated:
+            log.info("stored elements read again: %d added, %d updated", len(summary.added), len(summary.updated))
         return summary
 
     # -- session -------------------------------------------------------------------------------------
@@ -265,6 +285,8 @@ class Station:
         cfg = self.config.elements
         if configured_urls(cfg) or (cfg.refresh_hours > 0 and cfg.files) or self.predict is not None:
             self.refresher.start()
+        if self.store_watcher is not None:
+            self.store_watcher.start()
 
     def stop(self) -> None:
         if not self._started:
@@ -272,6 +294,8 @@ class Station:
         self._started = False
         if self.watcher is not None:
             self.watcher.stop()
+        if self.store_watcher is not None:
+            self.store_watcher.stop()
         self.refresher.stop()
         self.publisher.stop()
         for unsubscribe in self._unsubscribe:
