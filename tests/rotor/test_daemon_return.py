@@ -95,3 +95,31 @@ def test_a_rotor_neither_on_target_nor_moving_there_is_off_target_not_ok() -> No
         clock.advance(TICK_S)
         driver.service()
         assert status()["rotor"] == "ok"
+
+
+def test_four_outages_within_a_minute_each_get_their_lost_and_recovered_lines(caplog) -> None:
+    """#34 item 9, with a real rotctld killed four times within one (virtual) minute: the log lines were
+    limited per link, so only the first outage was written."""
+    import logging
+
+    from nfwserver.hamlib.commands import GET_POSITION
+    from nfwserver.hamlib.connection import HamlibConnection, HamlibUnavailable
+
+    with HamlibDaemon("rotctld") as daemon:
+        clock = VirtualClock(START)
+        link = HamlibConnection("127.0.0.1", daemon.port, clock, name="rotctld")
+        with caplog.at_level(logging.INFO, logger="nfwserver.hamlib.connection"):
+            for _ in range(4):
+                assert len(link.call(GET_POSITION)) == 2
+                daemon.kill()
+                for _ in range(40):  # 8 s out, polled at 5 Hz
+                    with pytest.raises(HamlibUnavailable):
+                        link.call(GET_POSITION)
+                    clock.advance(TICK_S)
+                daemon.start()
+                clock.advance(2.0)  # past the back-off
+                assert len(link.call(GET_POSITION)) == 2 and link.health.ok
+                clock.advance(4.0)
+        lines = [r.getMessage() for r in caplog.records]
+        assert sum("rotctld at 127.0.0.1" in line and " lost (" in line for line in lines) == 4, lines
+        assert sum("rotctld: recovered after" in line for line in lines) == 4, lines
