@@ -53,6 +53,7 @@ def run_init(args: argparse.Namespace) -> int:
     from nfwserver.cli import CliError
     from nfwserver.config import default_config_path
     from nfwserver.config.render import template
+    from nfwserver.file_lock import locked
     from nfwserver.storage import atomic_write_text
 
     path = Path(args.config) if args.config else default_config_path()
@@ -67,7 +68,8 @@ def run_init(args: argparse.Namespace) -> int:
         location = args.locator or f"{args.lat:g},{args.lon:g},{args.alt:g}"
         text = _edited(text, "observer", "location", location, path)
     try:
-        atomic_write_text(path, text)
+        with locked(path):
+            atomic_write_text(path, text)
     except OSError as exc:
         raise CliError(f"cannot write {path}: {exc.strerror or exc} "
                        "(choose another place with --config FILE)") from None
@@ -130,6 +132,7 @@ def run_set(args: argparse.Namespace) -> int:
     from nfwserver.config.edit import parse_value, split_key
     from nfwserver.config.loader import read_config_text
     from nfwserver.config.render import template
+    from nfwserver.file_lock import locked
     from nfwserver.storage import atomic_write_text
 
     try:
@@ -138,12 +141,13 @@ def run_set(args: argparse.Namespace) -> int:
         raise CliError(str(exc)) from None
     path = Path(args.config) if args.config else default_config_path()
     try:
-        text = read_config_text(path) if path.exists() else template()
-    except ConfigError as exc:
-        raise CliError(str(exc)) from None
-    new = _edited(text, section, key, parse_value(args.value), path)
-    try:
-        atomic_write_text(path, new)
+        with locked(path):  # read, edit and write under the lock: a parallel `config set` loses nothing
+            try:
+                text = read_config_text(path) if path.exists() else template()
+            except ConfigError as exc:
+                raise CliError(str(exc)) from None
+            new = _edited(text, section, key, parse_value(args.value), path)
+            atomic_write_text(path, new)
     except OSError as exc:
         raise CliError(f"cannot write {path}: {exc.strerror or exc}") from None
     note = _change_note(text, new, path)
