@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -56,9 +57,11 @@ def run_init(args: argparse.Namespace) -> int:
     from nfwserver.file_lock import locked
     from nfwserver.storage import atomic_write_text
 
-    path = Path(args.config) if args.config else default_config_path()
+    path = _written_through(Path(args.config) if args.config else default_config_path())
     if path.exists() and not args.force:
         raise CliError(f"{path} already exists (use --force to overwrite)")
+    if path.exists() and not path.is_file():
+        raise CliError(f"{path} is not a regular file; not replacing it")
     if (args.lat is None) != (args.lon is None):
         raise CliError("give both --lat and --lon (or --locator)")
     if args.locator and args.lat is not None:
@@ -114,6 +117,12 @@ def _written(path: str | None) -> dict[str, Any]:
     return toml_document(read_config_text(Path(path)))
 
 
+def _written_through(path: Path) -> Path:
+    """The file a write of ``path`` must replace: a symbolic link's target (written through the link, which
+    stays), else ``path`` itself."""
+    return Path(os.path.realpath(path)) if path.is_symlink() else path
+
+
 def _edited(text: str, section: str, key: str, value: Any, path: Path) -> str:
     from nfwserver.cli import CliError
     from nfwserver.config import ConfigError
@@ -132,6 +141,7 @@ def run_set(args: argparse.Namespace) -> int:
     from nfwserver.config.edit import parse_value, split_key
     from nfwserver.config.loader import read_config_text
     from nfwserver.config.render import template
+    from nfwserver.config.table import setting
     from nfwserver.file_lock import locked
     from nfwserver.storage import atomic_write_text
 
@@ -139,14 +149,14 @@ def run_set(args: argparse.Namespace) -> int:
         section, key = split_key(args.key)
     except ValueError as exc:
         raise CliError(str(exc)) from None
-    path = Path(args.config) if args.config else default_config_path()
+    path = _written_through(Path(args.config) if args.config else default_config_path())
     try:
         with locked(path):  # read, edit and write under the lock: a parallel `config set` loses nothing
             try:
                 text = read_config_text(path) if path.exists() else template()
             except ConfigError as exc:
                 raise CliError(str(exc)) from None
-            new = _edited(text, section, key, parse_value(args.value), path)
+            new = _edited(text, section, key, parse_value(args.value, setting(section, key).kind), path)
             atomic_write_text(path, new)
     except OSError as exc:
         raise CliError(f"cannot write {path}: {exc.strerror or exc}") from None

@@ -92,3 +92,57 @@ def test_set_says_how_a_running_station_takes_the_change(station_file, capsys, k
     out = capsys.readouterr().out.strip()
     section, name = key.split(".")
     assert out == f"{station_file}: [{section}] {name} set; {says}"
+
+
+@pytest.mark.parametrize(("content", "says"), [
+    ("[tcp\n", "the file is not valid TOML, so it was not changed (Expected ']' at the end of a table declaration"),
+    ("web = 1\n", "[web] is a plain value (web = ...) in the file, not a table; fix or remove it first"),
+    ('[[web]]\ntoken = "x"\n', "[web] is an array of tables ([[web]]) in the file, not a table"),
+    ("[web]\nenabled = false\n[web]\nport = 1\n", "the file is not valid TOML, so it was not changed (Cannot declare"),
+])
+def test_a_malformed_file_is_one_sentence_not_a_traceback(tmp_path, capsys, content: str, says: str) -> None:
+    """#34 item 13: these four shapes made ``config set`` print a tomlkit traceback (TypeError, ParseError)."""
+    path = tmp_path / "c.toml"
+    path.write_text(content)
+    assert main(["config", "set", "--config", str(path), "web.enabled", "true"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("nfwserver: web.enabled = True refused: ") and says in err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert path.read_text() == content
+
+
+def test_a_text_setting_takes_digits_as_text(station_file, capsys) -> None:
+    """#34 item 13: ``web.token 12345678`` was read as the integer 12345678 and refused as no text."""
+    assert main(["config", "set", "--config", str(station_file), "web.token", "12345678"]) == 0
+    assert load_config(station_file).web.token == "12345678"
+    assert main(["config", "set", "--config", str(station_file), "tcp.port", "9001"]) == 0  # numbers stay numbers
+    assert load_config(station_file).tcp.port == 9001
+
+
+@pytest.mark.skipif(os.name == "nt", reason="symbolic links and FIFOs")
+def test_set_and_init_write_through_a_symlink(tmp_path, capsys) -> None:
+    """#34 item 13: a symlinked configuration (kept in a dotfiles repository) was replaced by a regular file."""
+    real = tmp_path / "dotfiles" / "nfw.toml"
+    real.parent.mkdir()
+    assert main(["config", "init", "--config", str(real), "--locator", "JO01ab"]) == 0
+    link = tmp_path / "config.toml"
+    link.symlink_to(real)
+    assert main(["config", "set", "--config", str(link), "tcp.enabled", "true"]) == 0
+    assert link.is_symlink() and load_config(real).tcp.enabled
+    assert main(["config", "init", "--config", str(link), "--force", "--locator", "IO91wm"]) == 0
+    assert link.is_symlink() and load_config(real).observer == parse_observer("IO91wm")
+
+
+@pytest.mark.skipif(os.name == "nt", reason="FIFOs and /dev/null")
+def test_init_force_refuses_anything_but_a_regular_file(tmp_path, capsys) -> None:
+    """#34 item 13: ``init --force`` replaced a FIFO and a character device."""
+    fifo = tmp_path / "fifo.toml"
+    os.mkfifo(fifo)
+    device = tmp_path / "device.toml"
+    device.symlink_to("/dev/null")  # a character device, reached through a link (never written on failure)
+    for path in (fifo, device):
+        capsys.readouterr()
+        assert main(["config", "init", "--config", str(path), "--force"]) == 1
+        assert "is not a regular file; not replacing it" in capsys.readouterr().err
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode) and device.is_symlink()
+    assert stat.S_ISCHR(os.stat("/dev/null").st_mode)
