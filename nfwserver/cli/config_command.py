@@ -72,7 +72,7 @@ def run_init(args: argparse.Namespace) -> int:
         text = _edited(text, "observer", "location", location, path)
     try:
         with locked(path):
-            atomic_write_text(path, text)
+            atomic_write_text(path, text, _private_mode(text, path))
     except OSError as exc:
         raise CliError(f"cannot write {path}: {exc.strerror or exc} "
                        "(choose another place with --config FILE)") from None
@@ -82,6 +82,8 @@ def run_init(args: argparse.Namespace) -> int:
 
 def run_show(args: argparse.Namespace) -> int:
     """Every key with its effective value; "default" stores resolved to the paths actually used."""
+    from dataclasses import replace
+
     from nfwserver.app.element_store import default_store_path
     from nfwserver.app.session_state import default_state_path
     from nfwserver.cli import CliError
@@ -102,6 +104,9 @@ def run_show(args: argparse.Namespace) -> int:
     elif config.state_file is None:
         notes["server.state_file"] = "not kept"
     written = _written(config.path)
+    if config.web.token:  # a secret: `config show` output ends up in bug reports and screen shares
+        config = replace(config, web=replace(config.web, token="********"))
+        notes["web.token"] = "hidden (the file holds it)"
     if "location" in written.get("observer", {}):
         notes.update({f"observer.{key}": "from location" for key in ("latitude_deg", "longitude_deg", "altitude_m")})
     sys.stdout.write(show(config, notes, written))
@@ -115,6 +120,18 @@ def _written(path: str | None) -> dict[str, Any]:
     from nfwserver.config.loader import read_config_text, toml_document
 
     return toml_document(read_config_text(Path(path)))
+
+
+def _private_mode(text: str, path: Path) -> int | None:
+    """0600 for a configuration that holds the web token (a secret: only its owner may read it), else None
+    (the file keeps its mode)."""
+    from nfwserver.config import ConfigError
+    from nfwserver.config.loader import parse_config
+
+    try:
+        return 0o600 if parse_config(text, str(path), path.parent).web.token else None
+    except ConfigError:
+        return None
 
 
 def _written_through(path: Path) -> Path:
@@ -157,7 +174,7 @@ def run_set(args: argparse.Namespace) -> int:
             except ConfigError as exc:
                 raise CliError(str(exc)) from None
             new = _edited(text, section, key, parse_value(args.value, setting(section, key).kind), path)
-            atomic_write_text(path, new)
+            atomic_write_text(path, new, _private_mode(new, path))
     except OSError as exc:
         raise CliError(f"cannot write {path}: {exc.strerror or exc}") from None
     note = _change_note(text, new, path)

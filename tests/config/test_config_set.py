@@ -112,9 +112,9 @@ def test_a_malformed_file_is_one_sentence_not_a_traceback(tmp_path, capsys, cont
 
 
 def test_a_text_setting_takes_digits_as_text(station_file, capsys) -> None:
-    """#34 item 13: ``web.token 12345678`` was read as the integer 12345678 and refused as no text."""
-    assert main(["config", "set", "--config", str(station_file), "web.token", "12345678"]) == 0
-    assert load_config(station_file).web.token == "12345678"
+    """#34 item 13: ``web.token 73190286`` was read as the integer 73190286 and refused as no text."""
+    assert main(["config", "set", "--config", str(station_file), "web.token", "73190286"]) == 0
+    assert load_config(station_file).web.token == "73190286"
     assert main(["config", "set", "--config", str(station_file), "tcp.port", "9001"]) == 0  # numbers stay numbers
     assert load_config(station_file).tcp.port == 9001
 
@@ -146,3 +146,20 @@ def test_init_force_refuses_anything_but_a_regular_file(tmp_path, capsys) -> Non
         assert "is not a regular file; not replacing it" in capsys.readouterr().err
     assert stat.S_ISFIFO(os.stat(fifo).st_mode) and device.is_symlink()
     assert stat.S_ISCHR(os.stat("/dev/null").st_mode)
+
+
+@pytest.mark.skipif(os.name == "nt", reason="POSIX permission bits")
+def test_a_file_holding_the_web_token_is_private_and_show_masks_it(station_file, capsys) -> None:
+    """#34 item 13: the file holding the token stayed 0644 (readable by every local user) and ``config show``
+    printed the token."""
+    station_file.chmod(0o644)
+    token = "q7Rk2mZp9vXw"
+    assert main(["config", "set", "--config", str(station_file), "web.token", token]) == 0
+    assert stat.S_IMODE(station_file.stat().st_mode) == 0o600
+    assert main(["config", "set", "--config", str(station_file), "tcp.enabled", "true"]) == 0
+    assert stat.S_IMODE(station_file.stat().st_mode) == 0o600  # and stays so
+    capsys.readouterr()
+    assert main(["config", "show", "--config", str(station_file)]) == 0
+    out = capsys.readouterr().out
+    assert token not in out
+    assert 'token = "********"  # hidden (the file holds it)' in out
