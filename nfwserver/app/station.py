@@ -111,6 +111,7 @@ class Station:
         self.selection_note = ""  #: which satellite the station started with, and why (set by start())
         self._unsubscribe: list[Callable[[], None]] = []
         self._started = False
+        self._stopping = threading.Event()  #: set by stop(): a download in progress is aborted at once
 
     # -- convenience views -------------------------------------------------------------------------
     @property
@@ -176,8 +177,8 @@ class Station:
 
     # -- elements ----------------------------------------------------------------------------------
     @staticmethod
-    def _report(fetched: FetchResult) -> None:
-        for problem in fetched.failed:
+    def _report(fetched: FetchResult, failures: bool = True) -> None:
+        for problem in fetched.failed if failures else ():
             log.warning("element source unavailable: %s", problem)
         for rejection in fetched.rejected:
             log.info("element set skipped: %s", rejection)
@@ -200,8 +201,14 @@ class Station:
         catalog (:meth:`Catalog.update`), and saving the store.  The publish thread only ever sees the
         swap of the catalog's contents, a reference change, and no garbage collection over the new
         sets (:func:`~nfwserver.app.long_lived.building_long_lived`), so a refresh never delays a tick."""
-        fetched = fetch_configured(self.config.elements, fetch_urls=True, parsing=building_long_lived)
-        self._report(fetched)
+        fetched = fetch_configured(self.config.elements, fetch_urls=True, parsing=building_long_lived,
+                                   cancel=self._stopping)
+        self._report(fetched, failures=False)  # the failures are the `elements` link's (one line an episode)
+        sources = self.core.health.link("elements", paced=False)  # STATUS faults=elements while sources fail
+        if fetched.failed:
+            sources.failed("; ".join(fetched.failed))
+        else:
+            sources.succeeded()
         with building_long_lived():
             summary = self.core.state.catalog.update(fetched.sets)
             if summary.added or summary.updated:
@@ -256,6 +263,7 @@ class Station:
         """Load, bind and start everything; raises OSError when a listener cannot bind (nothing keeps running)."""
         if self._started:
             return
+        self._stopping.clear()
         for warning in self.config.warnings:
             log.warning("%s", warning)
         self._load_catalog()
@@ -292,6 +300,7 @@ class Station:
         if not self._started:
             return
         self._started = False
+        self._stopping.set()
         if self.watcher is not None:
             self.watcher.stop()
         if self.store_watcher is not None:
