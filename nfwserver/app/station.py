@@ -242,7 +242,8 @@ class Station:
         srv = self.config.server
         saved = self.state_file.load() if self.state_file is not None else SessionState()
         choice, source = srv.satellite, "config"
-        if saved.satellite is not None and saved.satellite in self.catalog and saved.configured == srv.satellite:
+        if (saved.satellite is not None and saved.satellite != srv.satellite and saved.satellite in self.catalog
+                and saved.configured == srv.satellite):
             choice, source = saved.satellite, "saved-state"  # chosen at run time; the configuration unchanged
         self.selection_note = _selection_note(choice, source, srv.satellite, saved, self.state_file)
         if choice is not None and not self.core.select_satellite(choice, source=source):

@@ -67,9 +67,11 @@ def run_init(args: argparse.Namespace) -> int:
     if args.locator and args.lat is not None:
         raise CliError("give --locator or --lat/--lon, not both")
     text = template()
+    derived = ""
     if args.locator or args.lat is not None:
         location = args.locator or f"{args.lat:g},{args.lon:g},{args.alt:g}"
         text = _edited(text, "observer", "location", location, path)
+        derived = _position(text, path, location)
     try:
         with locked(path):
             atomic_write_text(path, text, _private_mode(text, path))
@@ -77,7 +79,20 @@ def run_init(args: argparse.Namespace) -> int:
         raise CliError(f"cannot write {path}: {exc.strerror or exc} "
                        "(choose another place with --config FILE)") from None
     print(path)
+    if derived:
+        print(derived)
     return 0
+
+
+def _position(text: str, path: Path, location: str) -> str:
+    """The station position ``location`` stands for, as the configuration reads it (a locator is the centre
+    of its square), for the operator to check."""
+    from nfwserver.config.loader import parse_config
+
+    o = parse_config(text, str(path), path.parent).observer
+    ns, ew = ("N" if o.latitude_deg >= 0 else "S"), ("E" if o.longitude_deg >= 0 else "W")
+    return (f"observer: {abs(o.latitude_deg):.4f} {ns}, {abs(o.longitude_deg):.4f} {ew}, {o.altitude_m:g} m "
+            f"(from {location})")
 
 
 def run_show(args: argparse.Namespace) -> int:

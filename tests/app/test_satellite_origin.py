@@ -89,3 +89,12 @@ def test_a_choice_made_after_the_last_tick_is_saved_at_stop_and_restored(tmp_pat
         assert again.core.selected_by == "saved-state"
     finally:
         again.stop()
+
+
+def test_a_saved_state_that_only_repeats_the_configuration_is_not_called_a_choice(tmp_path, capsys) -> None:
+    """#34 item 10: the saver records the configured satellite too, so the next start said "restored ...
+    (chosen while running)" of a satellite nobody chose."""
+    err, status = _start(tmp_path, 25544, {"satellite": 25544, "configured": 25544}, capsys)
+    assert status["satellite"] == "25544" and status["satellite_from"] == "config"
+    assert status["hint"] == "satellite 25544: from [server] satellite"
+    assert "chosen while running" not in err

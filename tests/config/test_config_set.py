@@ -163,3 +163,15 @@ def test_a_file_holding_the_web_token_is_private_and_show_masks_it(station_file,
     out = capsys.readouterr().out
     assert token not in out
     assert 'token = "********"  # hidden (the file holds it)' in out
+
+
+def test_init_echoes_the_position_it_derived(tmp_path, capsys) -> None:
+    """#34 item 10: ``config init --locator`` did not say where it put the station.  The oracle is the Maidenhead
+    rule worked by hand: IN80do is field I,N (20 deg x 10 deg from 180 W, 90 S), square 8,0 (2 x 1 deg),
+    subsquare d,o (5' x 2.5'), and the position is the subsquare's centre."""
+    lon = -180 + 8 * 20 + 8 * 2 + 3 * 5 / 60 + 2.5 / 60
+    lat = -90 + 13 * 10 + 0 * 1 + 14 * 2.5 / 60 + 1.25 / 60
+    path = tmp_path / "c.toml"
+    assert main(["config", "init", "--config", str(path), "--locator", "IN80do"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out == [str(path), f"observer: {lat:.4f} N, {-lon:.4f} W, 0 m (from IN80do)"]
