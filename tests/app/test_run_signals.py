@@ -212,3 +212,30 @@ def test_sighup_reloads_the_configuration_and_the_station_keeps_serving(station)
     assert st.proc.returncode == 0 and "Traceback" not in err, err
     log = st.log.read_text()
     assert log.count("SIGHUP: reloading the configuration") == 3 and "configuration reloaded" in log
+
+
+def test_a_station_on_built_in_defaults_takes_the_file_config_set_creates(tmp_path) -> None:
+    """#34 item 2: with no configuration file at all, the station follows the path where ``config set`` creates
+    one (the default location), and applies it when it appears."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "XDG_CONFIG_HOME": str(tmp_path / "config"),
+           "XDG_STATE_HOME": str(tmp_path / "state"), "XDG_DATA_HOME": str(tmp_path / "data")}
+    env.pop("NFW_CONTROL_FILE", None)
+    log = tmp_path / "nfw.log"
+    proc = subprocess.Popen([sys.executable, "-m", "nfwserver", "run", "--headless", "--log-file", str(log)], cwd=ROOT,
+                            env=env, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    try:
+        assert _until(lambda: "outputs:" in (log.read_text() if log.exists() else ""), 60.0)
+        assert "configuration: <built-in defaults>" in log.read_text()
+        done = subprocess.run([sys.executable, "-m", "nfwserver", "config", "set", "observer.location", "JO02ae"],
+                              cwd=ROOT, env=env, capture_output=True, text=True, timeout=60)
+        assert done.returncode == 0, done.stderr
+        assert _until(lambda: "configuration reloaded" in log.read_text(), 15.0), log.read_text()[-2000:]
+        proc.send_signal(signal.SIGTERM)
+        proc.wait(STOP_WITHIN_S)
+        assert proc.returncode == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(10)
+        assert proc.stderr is not None
+        proc.stderr.close()
