@@ -17,6 +17,7 @@ from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.radio.defaults import DEFAULT_CHANNELS
 from nfwserver.radio.rigctld_backend import RigctldBackend
 from nfwserver.radio.tuning import DopplerTuner
+from nfwserver.web.station_parts import radio_part
 from tests.dde.conftest import CATALOG, ISS, ISS_PASS, OBSERVER
 
 pytestmark = pytest.mark.hamlib
@@ -38,6 +39,8 @@ def test_a_satellite_without_a_channel_is_no_channel_with_no_stale_frequency(rig
     assert core.command(f"SAT={other}").ok
     # At once, before any tick: the state says why nothing is tuned, and no frequency of the ISS is shown.
     assert status() == {"radio": "no-channel"}
+    part = radio_part(radio, True)  # what the web page gets, at once too
+    assert part is not None and part["state"] == "no-channel" and part["rx_hz"] is None and part["tx_hz"] is None
     run_virtual(core, clock, 1.0)
     assert status() == {"radio": "no-channel"} and radio.last_result is None
     core.set_radio_tuning(False)  # tuning off: nothing is expected of the radio
