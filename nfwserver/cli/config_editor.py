@@ -47,12 +47,15 @@ def open_in_editor(path: Path | None) -> int:
     from nfwserver.cli import CliError
     from nfwserver.config import default_config_path
     from nfwserver.config.render import template
+    from nfwserver.file_lock import locked
     from nfwserver.storage import atomic_write_text
 
     target = path if path is not None else default_config_path()
     if not target.exists():
         try:
-            atomic_write_text(target, template())
+            with locked(target):
+                if not target.exists():  # written meanwhile by another command: keep that one
+                    atomic_write_text(target, template())
         except OSError as exc:
             raise CliError(f"cannot write {target}: {exc.strerror or exc}") from None
         print(f"{target} (written from the template)")

@@ -40,7 +40,8 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     p = subparsers.add_parser(
         "run", help="run the server (console on a terminal, or --headless)",
         description="Run the Nova-compatible DDE server with the configuration file (see `nfwserver config path`), "
-        "or with built-in defaults when there is none.",
+        "or with built-in defaults when there is none.  The station follows that file while it runs "
+        "(`nfwserver config set` changes it; settings that need a restart are named).",
     )
     p.add_argument("--config", metavar="FILE", help="configuration file (default: the platform's config directory)")
     p.add_argument("--headless", action="store_true", help="no console: run as a service, log to a rotating file")
@@ -89,7 +90,7 @@ class RunPlan:
 
 def run(args: argparse.Namespace) -> int:
     from nfwserver.cli import CliError
-    from nfwserver.config import ConfigError, load_config
+    from nfwserver.config import ConfigError, default_config_path, load_config
 
     try:
         config = load_config(args.config)
@@ -101,7 +102,9 @@ def run(args: argparse.Namespace) -> int:
         config = with_web(config)
     plan = RunPlan(console=sys.stdout.isatty() and not args.headless,
                    log_file=Path(args.log_file) if args.log_file else default_log_file(), duration_s=args.duration)
-    return serve(config, plan, watch=args.config)
+    # The station follows the file it loaded, with or without --config; with none yet, the file `config init`
+    # or `config set` would create, so a station started on built-in defaults takes it when it appears.
+    return serve(config, plan, watch=config.path or str(default_config_path()))
 
 
 def with_web(config: Config) -> Config:

@@ -12,8 +12,8 @@ releases the lock when the process ends, however it ends, so a station killed ou
 ``nfwserver dashboard`` opens the address.  A second ``nfwserver run`` of the same user while one runs is
 refused, naming the running one: two stations would offer the same DDE service names and ports.
 
-The lock is ``fcntl.flock`` on Linux and ``msvcrt.locking`` (one byte) on Windows; both are released by
-the system at process exit.
+The lock is :mod:`nfwserver.file_lock`'s (``fcntl.flock`` on Linux, ``msvcrt.locking`` of one byte on
+Windows), held here for the whole run; the system releases it at process exit.
 """
 
 from __future__ import annotations
@@ -21,7 +21,6 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -51,36 +50,27 @@ class _Lock:
 
     def try_acquire(self) -> bool:
         """Take the lock if it is free; True when this object now holds it."""
+        from nfwserver.file_lock import try_lock
+
         if self._fd is not None:
             return True
         self.path.parent.mkdir(parents=True, exist_ok=True)
         fd = os.open(self.path, os.O_RDWR | os.O_CREAT | getattr(os, "O_BINARY", 0), 0o600)
-        try:
-            if sys.platform == "win32":
-                import msvcrt
-
-                msvcrt.locking(fd, msvcrt.LK_NBLCK, 1)
-            else:
-                import fcntl
-
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
+        if not try_lock(fd):
             os.close(fd)
             return False
         self._fd = fd
         return True
 
     def release(self) -> None:
+        from nfwserver.file_lock import unlock
+
         fd, self._fd = self._fd, None
         if fd is None:
             return
-        if sys.platform == "win32":
-            import msvcrt
-
-            with contextlib.suppress(OSError):
-                os.lseek(fd, 0, os.SEEK_SET)
-                msvcrt.locking(fd, msvcrt.LK_UNLCK, 1)
-        os.close(fd)  # on Linux closing the descriptor releases the flock
+        with contextlib.suppress(OSError):
+            unlock(fd)
+        os.close(fd)
 
 
 @dataclass(frozen=True)
