@@ -129,6 +129,8 @@ class Station:
                 part.apply(self.core, new)
         restart = restart_needed(CONFIG_PARTS, self.config, new)
         self.config = keep_running(CONFIG_PARTS, self.config, new)  # what needs a restart keeps running as it was
+        if self.web is not None:  # control and token at once: an old token stops working with the change
+            self.web.configure(self.config.web)
         return restart
 
     def _config_changed(self, new: Config) -> None:

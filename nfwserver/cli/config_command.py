@@ -25,6 +25,8 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
                       help="your station's longitude, degrees east (with --lat)")
     init.add_argument("--alt", type=number_in(-500, 9000, unit="m"), metavar="M", default=0.0,
                       help="height above the WGS84 ellipsoid, metres (with --lat/--lon; default 0)")
+    init.add_argument("--web-control", action="store_true",
+                      help="let the web page send commands, with a freshly generated token (printed)")
     init.set_defaults(func=run_init)
     show = sub.add_parser("show", help="validate the file and print what the server will use")
     show.add_argument("--config", metavar="FILE")
@@ -52,6 +54,7 @@ def run_init(args: argparse.Namespace) -> int:
     from nfwserver.cli import CliError
     from nfwserver.config import default_config_path
     from nfwserver.config.render import template
+    from nfwserver.config.tokens import TEMPLATE_TOKEN, new_token
     from nfwserver.storage import atomic_write_text
 
     path = Path(args.config) if args.config else default_config_path()
@@ -61,7 +64,10 @@ def run_init(args: argparse.Namespace) -> int:
         raise CliError("give both --lat and --lon (or --locator)")
     if args.locator and args.lat is not None:
         raise CliError("give --locator or --lat/--lon, not both")
-    text = template()
+    token = new_token()  # the template's example token is refused: offer a fresh one instead
+    text = template().replace(f'# token = "{TEMPLATE_TOKEN}"', f'# token = "{token}"')
+    if args.web_control:
+        text = _edited(_edited(text, "web", "token", token, path), "web", "control", True, path)
     if args.locator or args.lat is not None:
         location = args.locator or f"{args.lat:g},{args.lon:g},{args.alt:g}"
         text = _edited(text, "observer", "location", location, path)
@@ -71,6 +77,8 @@ def run_init(args: argparse.Namespace) -> int:
         raise CliError(f"cannot write {path}: {exc.strerror or exc} "
                        "(choose another place with --config FILE)") from None
     print(path)
+    if args.web_control:
+        print(f"web control is on; the page's token is {token}")
     return 0
 
 

@@ -149,10 +149,10 @@ def test_hub_gives_the_newest_frame_and_wakes_waiters_on_close() -> None:
 
 def test_web_configuration() -> None:
     assert WebConfig() == WebConfig(enabled=False, host="127.0.0.1", port=8091, allow=("127.0.0.1/32", "::1/128"),
-                                    control=False, token=None)
+                                    hostnames=(), control=False, token=None)
     with pytest.raises(ConfigError, match=r"\[web\] token: required when control is on"):
         parse_config("[web]\ncontrol = true\n")
-    with pytest.raises(ConfigError, match=r"\[web\] token: at least 8 characters"):
+    with pytest.raises(ConfigError, match=r"\[web\] token: must be at least 8 characters"):
         parse_config('[web]\ncontrol = true\ntoken = "short"\n')
     exposed = parse_config('[web]\nenabled = true\nhost = "0.0.0.0"\nallow = ["192.168.1.0/24"]\n')
     assert any(w.startswith('[web] host = "0.0.0.0"') for w in exposed.warnings)
