@@ -13,8 +13,14 @@ What it computes, for the instant of the computation (``docs/WEB.md`` gives the 
 
 It recomputes when the live state changes (its generation), when the first listed pass is over, and
 at least every :data:`REFRESH_S` seconds of the station's clock.  Readers get the newest result whole
-(:meth:`PassBoard.result`); the frame carries its ``version`` so a page fetches ``/api/passes`` again
-only when it changed.
+(:meth:`PassBoard.result`): its version, the result and its encoding are published as one reference, so
+a frame never carries a version whose result is not yet served.  The frame carries ``version`` so a page
+fetches ``/api/passes`` again only when it changed.
+
+A computation that fails is retried after :data:`RETRY_FIRST_S`, doubling up to :data:`REFRESH_S`
+(station clock), whatever else would make it due; the failure is logged once per episode (the
+traceback at DEBUG), shown on the page (``error`` in the result) until a computation succeeds, and the
+first success after it is logged.
 """
 
 from __future__ import annotations
@@ -49,6 +55,7 @@ GROUND_BEFORE_S = 45 * 60.0
 GROUND_AFTER_S = 95 * 60.0
 GROUND_STEP_S = 60.0
 REFRESH_S = 120.0
+RETRY_FIRST_S = 5.0  #: first retry after a failed computation (station clock seconds), then doubling
 MAX_PASSES = 12
 
 
@@ -80,10 +87,13 @@ class PassBoard:
         self.clock = clock
         self.favourites = favourites
         self.rotor = rotor
-        self.version = 0
-        self._result: dict[str, object] = {"version": 0, "computed_at": None, "passes": [], "left_out": [],
-                                           "track": None, "ground_track": [], "horizon": []}
-        self._encoded = json.dumps(self._result).encode()
+        empty: dict[str, object] = {"version": 0, "computed_at": None, "passes": [], "left_out": [],
+                                    "track": None, "ground_track": [], "horizon": [], "error": None}
+        #: (version, result, its JSON): replaced whole, so readers on other threads see one of them
+        self._published: tuple[int, dict[str, object], bytes] = (0, empty, json.dumps(empty).encode())
+        self._error: str | None = None  #: the failing computation's error while an episode lasts
+        self._retry_s = 0.0  #: the current back-off after a failure (0: none)
+        self._retry_at = -1e18  #: monotonic clock seconds before which a failed computation is not retried
         self._wake = threading.Event()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -91,15 +101,19 @@ class PassBoard:
         self._done_at = -1e18
         self._first_los: datetime | None = None
 
+    @property
+    def version(self) -> int:
+        return self._published[0]
+
     def result(self) -> dict[str, object]:
-        return self._result
+        return self._published[1]
 
     def encoded(self) -> bytes:
-        return self._encoded
+        return self._published[2]
 
     def next_event(self, now: datetime) -> dict[str, object] | None:
         """AOS or LOS of the selected satellite's pass, with the seconds until it (negative: past)."""
-        track = self._result.get("track")
+        track = self.result().get("track")
         if not isinstance(track, dict):
             return None
         for kind in ("aos", "los"):
@@ -131,21 +145,41 @@ class PassBoard:
 
     def _due(self) -> bool:
         now = self.clock.now()
+        if self._error is not None and self.clock.monotonic() < self._retry_at:
+            return False  # backing off after a failure, whatever else changed
         return (self.state.generation != self._done_generation
                 or self.clock.monotonic() - self._done_at >= REFRESH_S
-                or (self._first_los is not None and now >= self._first_los))
+                or (self._first_los is not None and now >= self._first_los)
+                or self._error is not None)
 
     def _run(self) -> None:
         while not self._stop.is_set():
-            if self._due():
-                try:
-                    self.compute()
-                except Exception:  # keep the board alive; the page shows the last result
-                    log.exception("web: pass computation failed")
-                    self._done_at = self.clock.monotonic()
-                    self._done_generation = self.state.generation
+            self.step()
             self.clock.wait(self._wake, 1.0)
             self._wake.clear()
+
+    def step(self) -> bool:
+        """Compute if it is due (the board thread's one round); True when a computation was tried."""
+        if not self._due():
+            return False
+        try:
+            self.compute()
+        except Exception as exc:  # keep the board alive; the page shows the failure and the last result
+            self._failed(exc)
+        return True
+
+    def _failed(self, exc: Exception) -> None:
+        """One failed computation: back off, show it, and log it once for the episode."""
+        error = f"the pass search failed: {type(exc).__name__}: {exc}"[:300]
+        if self._error is None:
+            log.warning("web: %s (retrying with back-off; the page shows it)", error)
+            log.debug("web: pass search failure", exc_info=exc)
+        self._error = error
+        self._retry_s = min(REFRESH_S, self._retry_s * 2 if self._retry_s else RETRY_FIRST_S)
+        self._retry_at = self.clock.monotonic() + self._retry_s
+        version, result, _ = self._published
+        shown = {**result, "version": version + 1, "error": error}
+        self._published = (version + 1, shown, json.dumps(shown).encode())
 
     # -- the work ------------------------------------------------------------------------------------
     def compute(self) -> dict[str, object]:
@@ -177,11 +211,13 @@ class PassBoard:
             if selected is not None:
                 result["track"] = self._selected_track(selected, found, observer, snap, calc, now)
                 result["ground_track"] = self._ground_track(selected.satrec, now, snap.ut1_utc_s)
-        self.version += 1
-        result["version"] = self.version
-        self._result = result
-        self._encoded = json.dumps(result).encode()
+        version = self.version + 1
+        result["version"], result["error"] = version, None
+        self._published = (version, result, json.dumps(result).encode())  # one step: version and result
         self._done_generation, self._done_at = generation, self.clock.monotonic()
+        if self._error is not None:
+            log.info("web: the pass search works again")
+            self._error, self._retry_s = None, 0.0
         return result
 
     def _flipped(self, track: list[tuple[float, float]]) -> bool | None:

@@ -4,9 +4,13 @@ Threads and what they do:
 
 - the publisher thread only runs :meth:`WebServer.on_tick`: it keeps a reference to the newest sample
   and sets an event, at a cost that does not depend on the number of browsers;
-- ``nfw-web`` (the frame thread) wakes on that event, builds one frame (JSON) from the live state
+- ``nfw-web`` (the frame thread) wakes on that event and, while at least one page is connected (an
+  event stream is open), builds one frame (JSON) from the live state
   (:mod:`~nfwserver.web.state_view`, :mod:`~nfwserver.web.station_parts`) at most
-  :data:`MAX_FRAME_HZ` times a second, and puts it in the :class:`~nfwserver.web.hub.FrameHub`;
+  :data:`MAX_FRAME_HZ` times a second, and puts it in the :class:`~nfwserver.web.hub.FrameHub`; with no
+  page connected it builds none (``/api/state`` then builds its own).  A frame that fails to build is
+  logged once a minute and replaced in the hub by ``{"frame_error": ...}``, so no page shows itself live
+  on a frame that no longer changes;
 - ``nfw-web-http`` accepts connections (Python's :class:`http.server.ThreadingHTTPServer`); each
   connection has a thread of its own, at most ``max_clients`` at once (others are closed at once);
   an event-stream connection sends the hub's newest frame whenever there is one (Server-Sent Events);
@@ -150,6 +154,8 @@ class WebServer:
         self._threads: list[threading.Thread] = []
         self._unsubscribe: Callable[[], None] | None = None
         self._refusals = RateLimitedLog(log, core.clock, 60.0)
+        self._frame_log = RateLimitedLog(log, core.clock, 60.0)
+        self._build_lock = threading.Lock()
 
     @property
     def url(self) -> str:
@@ -173,7 +179,6 @@ class WebServer:
         self.hub.reopen()
         self._unsubscribe = self.core.subscribe(self.on_tick)
         self.board.start()
-        self._build_frame()
         self._threads = [threading.Thread(target=self._frames, name="nfw-web", daemon=True),
                          threading.Thread(target=self._httpd.serve_forever, kwargs={"poll_interval": 0.25},
                                           name="nfw-web-http", daemon=True)]
@@ -221,13 +226,28 @@ class WebServer:
                 if early > 1e-6:
                     clock.wait(self._stop, early)
             self._ticked.clear()
-            try:
-                framed = self._build_frame()
-            except Exception:  # the page shows the last frame; the station carries on
-                log.exception("web: building a frame failed")
+            if self.stats.streams == 0:
+                continue  # nobody to send it to: build nothing (a page that connects gets one at once)
+            framed = self._safe_frame() or framed
+
+    def _safe_frame(self) -> datetime | None:
+        """:meth:`_build_frame`; a failure is logged (rate-limited) and put in the hub as a frame error."""
+        try:
+            framed = self._build_frame()
+        except Exception as exc:  # the station carries on; the pages say they are not updated
+            error = f"{type(exc).__name__}: {exc}"[:300]
+            self._frame_log.log(logging.ERROR, "frame", "web: building a frame failed: %s", error, exc_info=True)
+            self.hub.publish(json.dumps({"frame_error": f"the station's page is not updating: {error}"}).encode())
+            return None
+        self._frame_log.clear("frame")
+        return framed
 
     def _build_frame(self) -> datetime | None:
         """Build and publish a frame of the newest sample; returns that sample's instant (None without one)."""
+        with self._build_lock:
+            return self._build_frame_locked()
+
+    def _build_frame_locked(self) -> datetime | None:
         now = self.core.clock.now()
         sample = self._sample or self.core.tracker.last_sample
         events, skipped = self._follower.new_events()
@@ -260,6 +280,8 @@ class WebServer:
     # -- what the handler reads ------------------------------------------------------------------
     def state_json(self) -> bytes:
         """``/api/state``: the newest frame, with the last :data:`HISTORY_EVENTS` log lines."""
+        if self.stats.streams == 0:  # no frame thread at work: this request's own, from the live state
+            self._safe_frame()
         frame = dict(self._latest)
         frame["log"] = self.history()
         return json.dumps(frame, allow_nan=False, default=str).encode()
@@ -330,13 +352,16 @@ class WebServer:
 
     def stream_opened(self, peer: str) -> str | None:
         """Count an event stream in; or why not (over :attr:`max_streams`)."""
+        first = False
         with self._lock:
             if self.stats.streams >= self.max_streams:
                 self.stats.refused += 1
                 reason = f"already {self.max_streams} event streams (the web server's cap)"
             else:
                 self.stats.streams += 1
-                reason = None
+                first, reason = self.stats.streams == 1, None
+        if reason is None and first:
+            self._safe_frame()  # frames were not built while no page was connected: a fresh one now
         if reason is not None:
             host = peer.removeprefix("web ")
             self._note_refusal(host, "stream", f"web event stream for {host} refused: {reason}",

@@ -199,7 +199,11 @@ def test_a_newer_sample_is_framed_even_if_the_clock_then_stands_still() -> None:
     core.set_tune(True)
     web = WebServer(core, WebConfig(enabled=True, port=0))
     web.start()
+    assert web.address is not None
+    page = socket.create_connection(web.address, timeout=10)  # frames are built while a page is connected
     try:
+        page.sendall(b"GET /api/stream HTTP/1.0\r\n\r\n")
+        wait_for(lambda: web.stats.streams == 1, what="the page's stream")
         first = core.tick(clock.now())  # the publisher's work, listeners included
         wait_for(lambda: web.stats.frames >= 2, what="the first tick's frame")
         seen = web.hub.seq
@@ -211,4 +215,5 @@ def test_a_newer_sample_is_framed_even_if_the_clock_then_stands_still() -> None:
         wait_for(lambda: web.hub.seq > seen and b"NEWEST" in (web.hub.newest()[1] or b""), timeout_s=10.0,
                  what="the newest sample's frame, the clock standing still")
     finally:
+        page.close()
         web.stop()

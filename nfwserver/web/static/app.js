@@ -98,16 +98,22 @@ function logLine(e) {
     (e.detail ? "  -- " + e.detail : "") + (e.accepted === false ? "  REFUSED" : "");
   li.className = e.dir + (e.accepted === false ? " refused" : "");
   li.dataset.dir = e.dir;
+  li.dataset.seq = e.seq;
   return li;
 }
 function applyFilter(li) {
   const q = $("logfilter").value.toLowerCase(), dir = $("logdir").value;
   li.hidden = (dir && li.dataset.dir !== dir) || (q && !li.textContent.toLowerCase().includes(q));
 }
+let lastSeq = 0;  // the newest event shown: a frame's log repeats what the history already gave
 function addLog(events) {
   const list = $("logrows");
   const atBottom = list.scrollTop + list.clientHeight >= list.scrollHeight - 4;
-  for (const e of events) { const li = logLine(e); applyFilter(li); list.appendChild(li); }
+  for (const e of events) {
+    if (e.seq <= lastSeq) continue;
+    lastSeq = e.seq;
+    const li = logLine(e); applyFilter(li); list.appendChild(li);
+  }
   while (list.childElementCount > MAX_LOG_ROWS) list.firstElementChild.remove();
   if (atBottom) list.scrollTop = list.scrollHeight;
 }
@@ -123,6 +129,9 @@ function renderPasses() {
   leftOut.textContent = names.length ? "Left out, position cannot be computed now: " + names.slice(0, 5).join(", ")
     + (names.length > 5 ? ", ..." : "") : "";
   leftOut.classList.toggle("hidden", !names.length);
+  const failed = T("passes-error");
+  failed.textContent = passes.error || "";
+  failed.classList.toggle("hidden", !passes.error);
   const selected = frame && frame.now.satellite ? frame.now.satellite.catalog_number : null;
   if (!passes.passes.length) { row(["none in the next 12 h", "", "", "", "", "", ""], body); return; }
   for (const p of passes.passes) {
@@ -182,8 +191,16 @@ function onFrame(f) {
 function connect() {
   const link = T("connection");
   const source = new EventSource("/api/stream");
-  source.addEventListener("history", e => { $("logrows").textContent = ""; addLog(JSON.parse(e.data)); });
-  source.addEventListener("state", e => { link.textContent = "live"; link.className = "badge ok"; onFrame(JSON.parse(e.data)); });
+  source.addEventListener("history", e => { $("logrows").textContent = ""; lastSeq = 0; addLog(JSON.parse(e.data)); });
+  source.addEventListener("state", e => {
+    const f = JSON.parse(e.data);
+    if (f.frame_error) {  // the station could not build a frame: say so, never "live" on an old one
+      link.textContent = "not updating"; link.className = "badge bad"; link.title = f.frame_error;
+      return;
+    }
+    link.textContent = "live"; link.className = "badge ok"; link.title = "";
+    onFrame(f);
+  });
   source.onerror = () => { link.textContent = "reconnecting"; link.className = "badge bad"; };
 }
 
