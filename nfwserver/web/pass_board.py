@@ -6,7 +6,9 @@ What it computes, for the instant of the computation (``docs/WEB.md`` gives the 
   are not over: AOS/TCA/LOS (UTC), maximum elevation (degrees), duration (s) and, when the rotor can
   flip, whether the rotor's planner would fly the pass flipped;
 - the selected satellite's current or next pass as a sky track (azimuth/elevation in degrees, every
-  :data:`TRACK_STEP_S` s) with its AOS/TCA/LOS points, for the polar plot;
+  :data:`TRACK_STEP_S` s, or coarser so that a pass of any length, AO-10's 11 hours say, is drawn whole in
+  at most :data:`MAX_TRACK_POINTS` points ending at LOS) with its AOS/TCA/LOS points, for the polar plot;
+  a satellite that is up now and never sets (geostationary) gets ``always_up`` and its one point;
 - the selected satellite's ground track (geodetic latitude, east longitude in degrees) from
   :data:`GROUND_BEFORE_S` before to :data:`GROUND_AFTER_S` after the instant, for the map;
 - the horizon table as azimuth/elevation points every 5 degrees (the polar plot's mask).
@@ -27,6 +29,7 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 import threading
 from collections.abc import Callable, Sequence
 from datetime import datetime, timedelta
@@ -51,6 +54,7 @@ log = logging.getLogger(__name__)
 LIST_HOURS = 12.0
 NEXT_PASS_HOURS = 24.0
 TRACK_STEP_S = 10.0
+MAX_TRACK_POINTS = 721  #: a longer pass is sampled more coarsely, never cut
 GROUND_BEFORE_S = 45 * 60.0
 GROUND_AFTER_S = 95 * 60.0
 GROUND_STEP_S = 60.0
@@ -60,14 +64,15 @@ MAX_PASSES = 12
 
 
 def _track(calc: LookAngleCalculator, satrec: Satrec, p: Pass, now: datetime) -> list[tuple[float, float]]:
-    start = p.aos or now
-    end = p.los or (start + timedelta(minutes=20))
+    """The pass from AOS to LOS (both included) in at most :data:`MAX_TRACK_POINTS` points."""
+    start = p.aos or min(now, p.tca)
+    end = p.los or (max(now, p.tca) + timedelta(hours=NEXT_PASS_HOURS))  # a set beyond the search: a day on
+    span = max(0.0, (end - start).total_seconds())
+    steps = max(1, min(MAX_TRACK_POINTS - 1, math.ceil(span / TRACK_STEP_S)))
     out: list[tuple[float, float]] = []
-    t = start
-    while t <= end and len(out) < 2000:
-        la = calc.compute(satrec, t)
+    for i in range(steps + 1):
+        la = calc.compute(satrec, start + timedelta(seconds=span * i / steps))
         out.append((round(la.azimuth_deg, 2), round(la.elevation_deg, 2)))
-        t += timedelta(seconds=TRACK_STEP_S)
     return out
 
 
@@ -249,7 +254,7 @@ class PassBoard:
                                           horizon=snap.horizon, ut1_utc=snap.ut1_utc_s)
                    if p.los is None or p.los > now]
         if not own:
-            return None
+            return self._always_up(sat, snap, calc, now)
         p = own[0]
         try:
             points = _track(calc, sat.satrec, p, now)
@@ -259,6 +264,21 @@ class PassBoard:
                     "flipped": self._flipped(points)}
         except PropagationError:
             return None
+
+    @staticmethod
+    def _always_up(sat: Satellite, snap: StateSnapshot, calc: LookAngleCalculator,
+                   now: datetime) -> dict[str, object] | None:
+        """No pass in the next day: a satellite above the horizon now is up all that time (a point); else None."""
+        try:
+            la = calc.compute(sat.satrec, now)
+        except PropagationError:
+            return None
+        if la.elevation_deg < snap.horizon.min_elevation(la.azimuth_deg):
+            return None
+        point = (round(la.azimuth_deg, 2), round(la.elevation_deg, 2))
+        return {"catalog_number": sat.catalog_number, "points": [point], "always_up": True,
+                "aos": None, "tca": {"time": iso(now), "az": point[0], "el": point[1]}, "los": None,
+                "max_el": point[1], "flipped": None}
 
     @staticmethod
     def _ground_track(satrec: Satrec, now: datetime, ut1_utc: float) -> list[list[float]]:
