@@ -125,7 +125,7 @@ def error_response(status: int, message: str, head_only: bool = False,
     return ("\r\n".join(lines) + "\r\n\r\n").encode() + (b"" if head_only else body)
 
 
-def linger_close(sock: socket.socket, budget_s: float = 1.0, max_bytes: int = 256 * 1024) -> None:
+def linger_close(sock: socket.socket, budget_s: float = 0.5, max_bytes: int = 64 * 1024) -> None:
     """Say we are done sending, then read and drop what the peer still sends (at most ``max_bytes``,
     for at most ``budget_s`` real seconds), so closing does not reset the connection before the peer has
     read our answer."""

@@ -69,9 +69,9 @@ from nfwserver.web.station_parts import (
 log = logging.getLogger(__name__)
 
 MAX_FRAME_HZ = 10.0  #: frames built per second at most, whatever the feed's rate
-MAX_CLIENTS = 64  #: connections served at once (each event stream holds one)
+MAX_CLIENTS = 128  #: connections served at once (each event stream holds one)
 MAX_PER_ADDRESS = 16  #: connections served at once from one address
-MAX_STREAMS = 32  #: event streams at once (the other connections stay free for requests)
+MAX_STREAMS = 64  #: event streams at once (the other connections stay free for requests)
 IO_TIMEOUT_S = 10.0  #: a read or write that waits longer drops the connection
 HISTORY_EVENTS = 200  #: log lines a new page receives first
 
