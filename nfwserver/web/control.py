@@ -52,6 +52,11 @@ def _page_commands() -> list[Command]:
     return list(commands_for(Face.WEB))
 
 
+def _open(config: WebConfig) -> bool:
+    """Whether ``config`` lets the page send commands: control on, with a token that is not weak."""
+    return bool(config.control and config.token and weak_token_reason(config.token) is None)
+
+
 class Control:
     """Checks and runs control requests; called on the HTTP connection threads."""
 
@@ -63,8 +68,7 @@ class Control:
 
     @property
     def enabled(self) -> bool:
-        config = self.config
-        return bool(config.control and config.token and weak_token_reason(config.token) is None)
+        return _open(self.config)
 
     def refuse(self, peer: str, status: int, reason: str, text: str = "") -> ControlReply:
         """Refuse a request from ``peer``: one log line and one event per burst of the same reason."""
@@ -80,7 +84,7 @@ class Control:
     def run(self, request: object, peer: str) -> ControlReply:
         """Check and run one decoded JSON request from ``peer`` (``"web 192.0.2.1"``)."""
         config = self.config  # one reading for the whole request
-        if not (config.control and config.token and weak_token_reason(config.token) is None):
+        if not _open(config) or config.token is None:
             return self.refuse(peer, 403, "control is off ([web] control)")
         if not isinstance(request, dict):
             return self.refuse(peer, 400, "the request must be a JSON object with command and token")
