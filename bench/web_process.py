@@ -173,8 +173,13 @@ def measure(station: Station, n: int, seconds: float) -> dict[str, float]:
 
 def main(seconds: float = 15.0) -> None:
     """Print the section's table: 1/10/50 browsers, without and with the floods."""
-    print("Against the real process (`nfwserver run --headless --web`, 10 Hz; " + __doc__.split("\n\n", 1)[1]
-          .replace("\n", " ").strip() + f" Each window {seconds:g} s; load average at start "
+    print("Against the real process: the station is `nfwserver run --headless --web` at 10 Hz in a process of its "
+          "own; the browsers, N event streams each from an address of its own (127.0.1.x, as from other machines), "
+          "are read by another; the floods, from a third, are issue 35's: 64 connections from 127.0.0.2 each "
+          "trickling a header byte a second, and 16 threads each sending 99 headers of 65 KB from 127.0.0.3, "
+          "reconnecting whenever the station closes them. Frame latency = the wall time a frame arrived minus its "
+          "sample's instant (the same machine's clock). Station CPU = its user+system time over the window / the "
+          f"window (100% = one core); RSS from /proc. Each window {seconds:g} s; load average at start "
           f"{os.getloadavg()[0]:.1f} (the machine is shared).\n")
     print("| browsers | floods | frame latency p50 | p99 | frames/s the slowest browser got | station CPU | RSS "
           "(peak) |")
