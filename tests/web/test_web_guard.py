@@ -11,7 +11,7 @@ import pytest
 from nfwserver.config.loader import ConfigError, parse_config
 from nfwserver.config.tokens import TEMPLATE_TOKEN, new_token, token_matches, weak_token_reason
 from nfwserver.core.events import Direction
-from tests.web.conftest import TOKEN, config_text, start_station
+from tests.web.conftest import TOKEN, config_text, start_station, wait_for
 from tests.web.web_helpers import body, command_request, exchange, running_web, status
 
 
@@ -128,3 +128,43 @@ def test_a_change_of_control_or_token_takes_effect_at_once() -> None:
         assert refusals
     finally:
         web.station.stop()
+
+
+def test_a_new_token_in_the_watched_file_stops_the_old_one(tmp_path) -> None:
+    """The whole path of `config set web.token ...` on a running station: the file changes, the station's
+    watcher applies it, and the old token is refused from the next request on."""
+    from nfwserver.config.loader import load_config
+
+    path = tmp_path / "station.toml"
+    path.write_text(config_text())
+    web = start_station(config_text())
+    try:
+        web.station.config = load_config(path)  # the station runs on that file, as `run --config` does
+        web.station.watch_config(str(path), interval_s=0.5)
+        assert web.post({"command": "TUNE ON", "token": TOKEN})[0] == 200
+        fresh = new_token()
+        path.write_text(config_text().replace(TOKEN, fresh))
+
+        def old_refused() -> bool:
+            web.advance(0.4)
+            return web.post({"command": "TUNE ON", "token": TOKEN})[0] == 403
+
+        wait_for(old_refused, what="the old token refused")
+        assert web.post({"command": "TUNE ON", "token": fresh})[0] == 200
+    finally:
+        web.station.stop()
+
+
+def test_host_names_by_the_address_connected_to() -> None:
+    from nfwserver.config.schema import WebConfig
+    from nfwserver.web.guard import host_refusal
+
+    lan = WebConfig(host="0.0.0.0", hostnames=("shack-pc.lan",))
+    assert host_refusal("192.168.1.5:8091", lan, "192.168.1.5") is None  # typed the station's own address
+    assert host_refusal("[::ffff:192.168.1.5]:8091", lan, "::ffff:192.168.1.5") is None
+    assert host_refusal("192.168.1.7", lan, "192.168.1.5") is not None  # another machine's address
+    assert host_refusal("0.0.0.0", lan, "192.168.1.5") is not None  # the wildcard is no name
+    assert host_refusal("Shack-PC.lan.:8091", lan, "192.168.1.5") is None
+    assert host_refusal("shack-pc.lan.evil.example", lan, "192.168.1.5") is not None
+    assert host_refusal("", lan, "192.168.1.5") is not None and host_refusal(None, lan, "127.0.0.1") is None
+    assert host_refusal("station.example", WebConfig(host="station.example"), "10.0.0.2") is None
