@@ -8,8 +8,9 @@
 - **Commands** (cross-site requests): ``POST /api/command`` is taken only as ``application/json``, a type
   no other site's page can send without a CORS preflight, which the station never grants; and when
   the browser says where the request comes from (``Sec-Fetch-Site``, ``Origin``, else ``Referer``), it
-  must be the station's own page.  A request that says nothing of the kind (``curl``, a script) is no
-  browser's and may carry the token like any other.
+  must be the station's own page (``http://`` or, behind a TLS proxy, ``https://`` with the request's
+  Host).  A request that says nothing of the kind (``curl``, a script) is no browser's and may carry the
+  token like any other.
 """
 
 from __future__ import annotations
@@ -78,11 +79,11 @@ def cross_site_reason(headers: Headers, host: str) -> str | None:
     site = headers.get("Sec-Fetch-Site")
     if site is not None and site.strip().lower() not in ("same-origin", "none"):
         return f"a request from another site (Sec-Fetch-Site: {site.strip()[:40]})"
-    own = f"http://{host.strip().lower()}"
+    own = tuple(f"{scheme}://{host.strip().lower()}" for scheme in ("http", "https"))  # https: behind a TLS proxy
     origin = headers.get("Origin")
     if origin is not None:
-        return None if origin.strip().lower() == own else f"a request from another origin ({origin.strip()[:80]})"
+        return None if origin.strip().lower() in own else f"a request from another origin ({origin.strip()[:80]})"
     referer = headers.get("Referer")
-    if referer is not None and not (referer.strip().lower() + "/").startswith(own + "/"):
+    if referer is not None and not (referer.strip().lower() + "/").startswith(tuple(o + "/" for o in own)):
         return "a request from another page (Referer)"
     return None

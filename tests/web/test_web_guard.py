@@ -65,6 +65,18 @@ def test_commands_are_taken_only_as_json_from_the_station_own_page() -> None:
         reply = exchange(web, command_request(web, "TRACK ON", headers={"Origin": own, "Sec-Fetch-Site": "same-origin",
                                                                         "Referer": own + "/"}))
         assert status(reply) == 200 and json.loads(body(reply))["ok"] and core.state.snapshot().tracking
+        reply = exchange(web, command_request(web, "TRACK OFF", headers={"Origin": "https://station.example"},
+                                              host="station.example"))  # behind a TLS proxy: refused by Host
+        assert status(reply) == 421 and core.state.snapshot().tracking
+        web.configure(type(web.config)(**{**web.config.__dict__, "hostnames": ("station.example",)}))
+        reply = exchange(web, command_request(web, "TRACK OFF", headers={"Origin": "https://station.example"},
+                                              host="station.example"))  # ... and taken once it is named
+        assert status(reply) == 200 and not core.state.snapshot().tracking
+        reply = exchange(web, command_request(web, "TRACK ON", headers={"Origin": "https://evil.example"},
+                                              host="station.example"))
+        assert status(reply) == 403 and not core.state.snapshot().tracking
+        reply = exchange(web, command_request(web, "TRACK ON"))
+        assert status(reply) == 200 and core.state.snapshot().tracking
         reply = exchange(web, command_request(web, "TRACK OFF"))  # a tool (curl) says nothing of where it is
         assert status(reply) == 200 and not core.state.snapshot().tracking
         assert status(exchange(web, b"OPTIONS /api/command HTTP/1.1\r\nHost: x\r\n"
