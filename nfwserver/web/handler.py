@@ -21,6 +21,7 @@ makes a traceback: a failed connection is one log line (rate-limited) by :meth:`
 
 from __future__ import annotations
 
+import io
 import json
 import logging
 import re
@@ -93,7 +94,7 @@ class WebHandler(BaseHTTPRequestHandler):
             self.connection.sendall(error_response(head.status, head.message, headers=SECURITY_HEADERS))
             linger_close(self.connection)
             return
-        self.rfile = HeadReader(head.data, self.connection, deadline, web.io_timeout_s)  # type: ignore[assignment]
+        self.rfile = io.BufferedReader(HeadReader(head.data, self.connection, deadline, web.io_timeout_s))
         self.connection.settimeout(web.io_timeout_s)
         super().handle_one_request()
 
