@@ -129,11 +129,16 @@ class Station:
         One table drives it (:data:`~nfwserver.app.live_config.CONFIG_PARTS`): every live part that changed
         (observer, horizon, UT1-UTC, rate, channels, DDE names, radio tuning) changes the live state at once;
         the restart-only parts are compared with what is *running* and listed when they differ."""
+        favourites = self.config.favourites
         for part in CONFIG_PARTS:
             if part.apply is not None and part.differs(self.config, new):
                 part.apply(self.core, new)
         restart = restart_needed(CONFIG_PARTS, self.config, new)
         self.config = keep_running(CONFIG_PARTS, self.config, new)  # what needs a restart keeps running as it was
+        if self.web is not None:  # control and token at once: an old token stops working with the change
+            self.web.configure(self.config.web)
+            if self.config.favourites != favourites:
+                self.web.board.request()  # the page's pass list follows now, not at the next refresh
         return restart
 
     def _config_changed(self, new: Config) -> None:

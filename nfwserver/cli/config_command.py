@@ -30,6 +30,8 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
                       "127.0.0.1)")
     init.add_argument("--keep", action="store_true", help="leave an existing file as it is and succeed (for "
                       "installers); without it an existing file is an error")
+    init.add_argument("--web-control", action="store_true",
+                      help="let the web page send commands, with a freshly generated token (printed)")
     init.set_defaults(func=run_init)
     show = sub.add_parser("show", help="validate the file and print what the server will use")
     show.add_argument("--config", metavar="FILE")
@@ -64,6 +66,7 @@ def run_init(args: argparse.Namespace) -> int:
     from nfwserver.cli import CliError
     from nfwserver.config import default_config_path
     from nfwserver.config.render import template
+    from nfwserver.config.tokens import TEMPLATE_TOKEN, new_token
     from nfwserver.file_lock import locked
     from nfwserver.storage import atomic_write_text
 
@@ -79,7 +82,10 @@ def run_init(args: argparse.Namespace) -> int:
         raise CliError("give both --lat and --lon (or --locator)")
     if args.locator and args.lat is not None:
         raise CliError("give --locator or --lat/--lon, not both")
-    text = template()
+    token = new_token()  # the template's example token is refused: offer a fresh one instead
+    text = template().replace(f'# token = "{TEMPLATE_TOKEN}"', f'# token = "{token}"')
+    if args.web_control:
+        text = _edited(_edited(text, "web", "token", token, path), "web", "control", True, path)
     derived = ""
     if args.locator or args.lat is not None:
         location = args.locator or f"{args.lat:g},{args.lon:g},{args.alt:g}"
@@ -96,6 +102,8 @@ def run_init(args: argparse.Namespace) -> int:
     print(path)
     if derived:
         print(derived)
+    if args.web_control:
+        print(f"web control is on; the page's token is {token}")
     return 0
 
 
