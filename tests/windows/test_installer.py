@@ -248,3 +248,15 @@ def test_another_folder_chosen_with_d_is_installed_to_and_removed_from(installed
     assert installed.prefix.run_detached([program.strip('"'), switch]) == 0
     wait_until(lambda: not installed.prefix.unix(folder).exists(), 120, f"{folder} removed")
     assert installed.prefix.unix(folder.parent).is_dir()  # only the program's own folder goes
+
+
+def test_a_folder_holding_other_files_is_refused(installed: Installed) -> None:
+    other = installed.prefix.unix(PureWindowsPath(r"C:\Radio\Logbook"))
+    (other / "Lib").mkdir(parents=True)
+    (other / "Lib" / "mine.txt").write_text("not nfwserver's\n")
+    assert SETUP is not None
+    status = installed.prefix.run_detached(["cmd", "/c", rf"{winpath(Path(SETUP))} /S /D=C:\Radio\Logbook"])
+    assert status == 2  # refused: an upgrade or the uninstaller would remove that Lib folder
+    assert (other / "Lib" / "mine.txt").read_text() == "not nfwserver's\n"
+    assert sorted(p.name for p in other.iterdir()) == ["Lib"]
+    assert installed.prefix.reg_values(UNINSTALL_KEY) is None

@@ -84,9 +84,33 @@ Var WasRunning  ; "1" when an earlier install's station was running and has been
   ${EndIf}
 !macroend
 
+; NotOurFolder: "1" in $R1 when $INSTDIR holds files but no nfwserver.exe (a folder of someone else's, whose Lib
+; folder an upgrade or the uninstaller would otherwise remove); "0" for a new, empty or earlier nfwserver folder.
+!macro NotOurFolder
+  StrCpy $R1 "0"
+  ${DirState} "$INSTDIR" $R0
+  ${If} $R0 == 1
+  ${AndIfNot} ${FileExists} "$INSTDIR\nfwserver.exe"
+    StrCpy $R1 "1"
+  ${EndIf}
+!macroend
+
+Function .onVerifyInstDir
+  !insertmacro NotOurFolder
+  ${If} $R1 == "1"
+    Abort  ; the Next button stays off: choose an empty folder or a new one
+  ${EndIf}
+FunctionEnd
+
 Section "nfwserver (required)" SecProgram
   SectionIn RO
   SetShellVarContext current
+  !insertmacro NotOurFolder
+  ${If} $R1 == "1"
+    MessageBox MB_OK|MB_ICONSTOP "$INSTDIR holds other files: nfwserver installs only into an empty folder, a new one or its own." /SD IDOK
+    SetErrorLevel 2
+    Quit
+  ${EndIf}
   !insertmacro StopStation
   ; An upgrade replaces the whole program: what an older version had and this one does not must not stay
   ; importable.  Only the program's own folders and files are removed (uninstall.nsh lists them).
