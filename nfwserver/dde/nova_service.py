@@ -24,6 +24,8 @@ import logging
 import threading
 from collections.abc import Callable, Iterable
 
+from nfwserver.commands.parsing import parse_request
+from nfwserver.commands.table import Face
 from nfwserver.core.events import Direction
 from nfwserver.core.sample import TickSample
 from nfwserver.core.station_core import StationCore
@@ -139,7 +141,7 @@ class NovaDdeService:
         return data
 
     def _command(self, conv: ConversationId, text: str) -> PokeResult:
-        result = self.core.command(text, source=self._label(conv), conversation=conv)
+        result = self.core.execute(parse_request(text, Face.DDE), source=self._label(conv), conversation=conv)
         return PokeResult.FACK if result.accepted else PokeResult.FNOTPROCESSED
 
     def on_poke(self, conv: ConversationId, topic: str, item: str, fmt: int, data: bytes) -> PokeResult:

@@ -42,9 +42,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 from nfwserver.commands.help_text import help_lines
-from nfwserver.commands.parsing import clean_command_text, parse_line
-from nfwserver.commands.rotor_commands import RotorControl, run_rotor_command
-from nfwserver.commands.table import CommandError, Face, Target
+from nfwserver.commands.parsing import clean_command_text, parse_request
+from nfwserver.commands.table import Face, Target
 from nfwserver.core.events import Direction
 from nfwserver.core.nova_protocol import format_azimuth, format_elevation, format_range_rate
 from nfwserver.core.station_core import StationCore
@@ -80,67 +79,70 @@ def _one_line(text: str) -> str:
     return " ".join("".join(ch if ch.isprintable() else " " for ch in text).split())
 
 
+class _Session:
+    """The session commands' target for one line from ``peer``: each action leaves its reply here."""
+
+    def __init__(self, protocol: NovaTcpProtocol, peer: str) -> None:
+        self.protocol = protocol
+        self.peer = peer
+        self.reply: Reply | None = None
+
+    def summary(self) -> None:
+        text = self.protocol.core.current_text()
+        self.protocol.record(self.peer, "SUMMARY", text)
+        self.reply = Reply((text,))
+
+    def status(self) -> None:
+        self.protocol.record(self.peer, "STATUS")
+        self.reply = Reply((self.protocol.status_line(),))
+
+    def watch(self) -> None:
+        self.protocol.record(self.peer, "WATCH")
+        self.reply = Reply(("OK",), Action.WATCH)
+
+    def help(self) -> None:
+        self.protocol.record(self.peer, "HELP")
+        self.reply = Reply(help_lines(Face.TCP) + ("OK",))
+
+    def quit(self) -> None:
+        self.protocol.record(self.peer, "QUIT")
+        self.reply = Reply(("OK",), Action.QUIT)
+
+
 class NovaTcpProtocol:
     """Answers one line at a time for the station ``core``; ``extra`` adds STATUS fields."""
 
-    def __init__(self, core: StationCore, extra: StatusFields | None = None,
-                 rotor: RotorControl | None = None) -> None:
+    def __init__(self, core: StationCore, extra: StatusFields | None = None) -> None:
         self.core = core
         self.extra = extra
-        self.rotor = rotor  #: the rotor's command port (None without a rotor)
 
-    def _record(self, peer: str, text: str, detail: str = "") -> None:
+    def record(self, peer: str, text: str, detail: str = "") -> None:
+        """An event for a line that is not a station command (the core records those)."""
         self.core.events.add(self.core.clock.now(), Direction.IN, "request", text, client=peer, accepted=True,
                              detail=detail)
 
     def handle(self, line: str, peer: str, rate_key: str | None = None) -> Reply | None:
         """The reply to ``line`` (without its terminator) from ``peer``; None for a blank line.
 
-        ``rate_key`` groups the refusal log lines of one client across its connections (its address)."""
+        The line is parsed once and run by the core through the command table; ``rate_key`` groups the
+        refusal log lines of one client across its connections (its address)."""
         if not line.strip():  # blank, including lines of only VT, FF or the 0x1C-0x1F separators
             return None
-        try:
-            parsed = parse_line(line, Face.TCP)
-        except CommandError as exc:
-            if exc.command is not None and exc.command.target is Target.ROTOR and self.rotor is None:
-                self._record(peer, clean_command_text(line))
-                return Reply(("ERROR no rotor is configured",))
-            if exc.command is not None and exc.command.target is not Target.STATION:
-                self._record(peer, clean_command_text(line), str(exc))
-                return Reply((f"ERROR {_one_line(str(exc))}",))
-            return self._station(line, peer, rate_key)  # the core records and rate-limits the refusal
-        entry = parsed.command
-        if entry.target is Target.STATION:
-            return self._station(line, peer, rate_key)
-        if entry.target is Target.ROTOR:
-            self._record(peer, clean_command_text(line))
-            why = run_rotor_command(parsed, self.rotor, self.core, peer)
-            return Reply(("OK",) if why is None else (f"ERROR {why}",))
-        return self._session(entry.word, peer)
-
-    def _station(self, line: str, peer: str, rate_key: str | None) -> Reply:
-        result = self.core.command(line, source=peer, face=Face.TCP, rate_key=rate_key)
+        request = parse_request(line, Face.TCP)
+        target = request.target
+        if target is Target.ROTOR or (target is Target.SESSION and request.error is not None):
+            no_rotor = target is Target.ROTOR and self.core.rotor is None
+            detail = str(request.error) if request.error is not None and not no_rotor else ""
+            self.record(peer, clean_command_text(line), detail)  # the session's actions record their own
+        session = _Session(self, peer)
+        result = self.core.execute(request, source=peer, rate_key=rate_key, session=session)
+        if session.reply is not None:
+            return session.reply
         if result.ok:
             return Reply(("OK",))
         if result.accepted and result.warning:
             return Reply((f"OK warning: {_one_line(result.note or '')}",))
         return Reply((f"ERROR {_one_line(result.note or 'refused')}",))
-
-    def _session(self, word: str, peer: str) -> Reply:
-        if word == "SUMMARY":
-            text = self.core.current_text()
-            self._record(peer, "SUMMARY", text)
-            return Reply((text,))
-        self._record(peer, word)
-        if word == "STATUS":
-            return Reply((self.status_line(),))
-        if word == "WATCH":
-            return Reply(("OK",), Action.WATCH)
-        if word == "QUIT":
-            return Reply(("OK",), Action.QUIT)
-        if word == "HELP":
-            return Reply(help_lines(Face.TCP) + ("OK",))
-        raise AssertionError(f"the TCP face has no handler for {word}")  # a table entry without one
 
     @staticmethod
     def too_long(limit: int) -> Reply:

@@ -38,7 +38,6 @@ import threading
 from collections import Counter, deque
 from collections.abc import Callable
 
-from nfwserver.commands.rotor_commands import RotorControl
 from nfwserver.config.schema import TcpConfig
 from nfwserver.core.events import Direction
 from nfwserver.core.sample import TickSample
@@ -76,10 +75,10 @@ class NovaTcpServer:
 
     def __init__(self, core: StationCore, config: TcpConfig, extra: StatusFields | None = None, *,
                  output_limit: int = DEFAULT_OUTPUT_LIMIT, send_buffer_bytes: int | None = None,
-                 max_clients: int | None = None, rotor: RotorControl | None = None) -> None:
+                 max_clients: int | None = None) -> None:
         self.core = core
         self.config = config
-        self.protocol = NovaTcpProtocol(core, extra, rotor)
+        self.protocol = NovaTcpProtocol(core, extra)
         self.output_limit = output_limit
         self.send_buffer_bytes = send_buffer_bytes
         self.max_clients = max_clients if max_clients is not None else config.max_clients

@@ -128,6 +128,7 @@ def test_a_rotctld_reporting_nan_does_not_stop_the_console(nan_rotctld) -> None:
 def test_rotor_flip_state_events_and_the_flip_commands() -> None:
     station = make_station()
     rotor = make_rotor(RotorConfig(backend="sim"), station.core, station.clock)
+    station.core.rotor = rotor  # as the station sets it
 
     async def scenario() -> None:
         app = NfwConsole(station.core, rotor=rotor)

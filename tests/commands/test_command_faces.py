@@ -67,7 +67,7 @@ def test_flip_with_a_rotor_checks_the_argument(tcp_station, client) -> None:
         def request_park(self) -> None:
             modes.append("park")
 
-    server.protocol.rotor = Rotor()
+    server.core.rotor = Rotor()
     assert client.ask("FLIP sideways") == "ERROR FLIP needs AUTO, ON or OFF"
     assert client.ask("flip On") == "OK"
     assert modes == ["on"]

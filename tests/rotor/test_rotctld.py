@@ -130,7 +130,8 @@ def test_park_stops_tracking_and_sends_the_rotor_to_its_park_position_until_trac
         run_virtual(core, clock, 1.0)
         target_el, target_az = driver.positions()[2:]
         assert target_el is not None and target_el > 10  # following the satellite near its TCA
-        server = NovaTcpServer(core, LOOPBACK_ONLY, rotor=coupling)
+        core.rotor = coupling  # as the station sets it
+        server = NovaTcpServer(core, LOOPBACK_ONLY)
         server.start()
         client = LineClient(server.address)
         try:

@@ -207,7 +207,8 @@ def test_flip_sets_the_rotors_inverted_tracking_mode(tcp_station, client) -> Non
 
     assert client.ask("FLIP ON") == "ERROR no rotor is configured"  # this station has no rotor
     clock, core, _, _, coupling, _ = rotor_station(ISS_PASS.aos, RotorGeometry.preset("north-stop+flip"))
-    server = NovaTcpServer(core, LOOPBACK_ONLY, rotor=coupling)
+    core.rotor = coupling  # as the station sets it
+    server = NovaTcpServer(core, LOOPBACK_ONLY)
     server.start()
     try:
         with_rotor = LineClient(server.address)
