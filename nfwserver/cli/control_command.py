@@ -88,9 +88,11 @@ def status(args: argparse.Namespace) -> int:
     """The STATUS line on stdout; a stale element set (``elements_stale=yes``) is also said on stderr."""
     import sys
 
+    from nfwserver.tcp.status_line import parse_status
+
     line = _ask(args, "STATUS")
     print(line)
-    fields = dict(word.partition("=")[::2] for word in line.split() if "=" in word)
+    fields = parse_status(line)
     if fields.get("elements_stale") == "yes":
         name = fields.get("name", "the selected satellite")
         print(f"nfwserver: the elements of {name} are {fields.get('elements_age_d', '?')} days old, older than "

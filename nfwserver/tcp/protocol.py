@@ -17,7 +17,8 @@ Nova's commands    ``TUNE ON|OFF``, ``TRACK ON|OFF``, ``SAT=n``, ``ANTAZ=deg``, 
                    tracking needs to know it is not happening.  DDE clients still get an
                    acknowledgement for it; only this protocol reports it.
 ``STATUS``         one line of ``key=value`` pairs separated by single blanks (values never
-                   contain blanks): satellite, name, satellite_from (who chose it: config,
+                   contain blanks; :mod:`nfwserver.tcp.status_line` writes and reads it):
+                   satellite, name, satellite_from (who chose it: config,
                    saved-state, or the client that sent SAT=), tune, track, radio_tuning, status (the
                    status word, hex), interface (version), az/el/rr/ah of the last tick when
                    there is a position, then the fields of the ``extra`` callable (rotor and
@@ -48,6 +49,7 @@ from nfwserver.core.events import Direction
 from nfwserver.core.nova_protocol import format_azimuth, format_elevation, format_range_rate
 from nfwserver.core.station_core import StationCore
 from nfwserver.tcp.greeting import GREETING as GREETING  # the server sends it
+from nfwserver.tcp.status_line import format_status
 
 StatusFields = Callable[[], Mapping[str, object]]
 
@@ -62,16 +64,6 @@ class Action(enum.Enum):
 class Reply:
     lines: tuple[str, ...]
     action: Action = Action.REPLY
-
-
-def _value(value: object) -> str:
-    """A STATUS value without blanks or control characters."""
-    if isinstance(value, bool):
-        return "on" if value else "off"
-    if value is None:
-        return "-"
-    text = "".join(ch if ch.isprintable() and not ch.isspace() else "_" for ch in str(value))
-    return text or "-"
 
 
 def _one_line(text: str) -> str:
@@ -170,4 +162,4 @@ class NovaTcpProtocol:
                 fields.update(self.extra())
             except Exception as exc:  # a broken extra field must not cost the client its answer
                 fields["extra_error"] = type(exc).__name__
-        return " ".join(f"{_value(key)}={_value(value)}" for key, value in fields.items())
+        return format_status(fields)

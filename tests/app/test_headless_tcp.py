@@ -19,6 +19,7 @@ from nfwserver.clock import VirtualClock
 from nfwserver.config import load_config
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.rotor.coupling import angular_distance
+from nfwserver.tcp.status_line import parse_status
 from tests.conftest import DATA, ROOT
 from tests.dde.conftest import ISS_PASS
 from tests.hamlib_daemons import HamlibDaemon, free_port
@@ -37,7 +38,7 @@ def _config(tmp_path: Path, tcp_port: int, rotor_port: int | None = None) -> Pat
 
 
 def _fields(line: str) -> dict[str, str]:
-    return dict(pair.split("=", 1) for pair in line.split(" "))
+    return parse_status(line)
 
 
 @pytest.mark.hamlib

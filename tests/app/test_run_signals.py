@@ -18,6 +18,7 @@ from pathlib import Path
 
 import pytest
 
+from nfwserver.tcp.status_line import parse_status
 from tests.conftest import DATA, ROOT
 from tests.easycomm.test_easycomm_pty import Pty
 from tests.hamlib_daemons import free_port
@@ -65,7 +66,7 @@ class Station:
             return reader.readline().decode("ascii").strip()
 
     def status(self) -> dict[str, str]:
-        return dict(pair.split("=", 1) for pair in self.ask("STATUS").split(" "))
+        return parse_status(self.ask("STATUS"))
 
     def wait_serving(self, timeout_s: float = 30.0) -> None:
         deadline = time.monotonic() + timeout_s

@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from nfwserver.cli.signals import RELOAD, STOP, signal_actions
+from nfwserver.tcp.status_line import parse_status
 from tests.conftest import DATA, ROOT
 from tests.hamlib_daemons import free_port
 
@@ -86,7 +87,7 @@ def _status(port: int) -> dict[str, str]:
         reader = sock.makefile("rb")
         reader.readline()
         sock.sendall(b"STATUS\r\n")
-        return dict(pair.split("=", 1) for pair in reader.readline().decode().split())
+        return parse_status(reader.readline().decode())
 
 
 def _until(predicate, timeout_s: float) -> bool:

@@ -7,6 +7,7 @@ import pytest
 from nfwserver.config.schema import TcpConfig
 from nfwserver.core.events import Direction
 from nfwserver.tcp import NovaTcpServer
+from nfwserver.tcp.status_line import parse_status
 from tests.dde.conftest import CATALOG, make_station
 from tests.tcp.conftest import LOOPBACK_ONLY, LineClient, wait_for
 
@@ -103,7 +104,7 @@ def test_status_is_one_line_of_key_values(tcp_station, client) -> None:
     server.protocol.extra = lambda: {"rotor": "ok", "rotor_az": "12.5", "note": "two words"}
     station.core.set_tune(True)
     station.run(0.4)
-    fields = dict(pair.split("=", 1) for pair in client.ask("STATUS").split(" "))
+    fields = parse_status(client.ask("STATUS"))
     sample = station.core.tracker.last_sample
     assert fields["satellite"] == "25544" and fields["name"] == "ISS"
     assert (fields["tune"], fields["track"], fields["radio_tuning"]) == ("on", "off", "off")
@@ -224,13 +225,13 @@ def test_flip_sets_the_rotors_inverted_tracking_mode(tcp_station, client) -> Non
 
 def test_status_names_every_failing_link_while_its_fault_lasts(tcp_station, client) -> None:
     station, _ = tcp_station
-    fields = dict(pair.split("=", 1) for pair in client.ask("STATUS").split(" "))
+    fields = parse_status(client.ask("STATUS"))
     assert fields["faults"] == "none"
     link = station.core.health.link("radio")
     link.failed("rigctld: connection refused")
-    fields = dict(pair.split("=", 1) for pair in client.ask("STATUS").split(" "))
+    fields = parse_status(client.ask("STATUS"))
     assert fields["faults"] == "radio"
     assert fields["radio_fault"].startswith("rigctld:_connection_refused_(1_failure_in_")
     link.succeeded()
-    fields = dict(pair.split("=", 1) for pair in client.ask("STATUS").split(" "))
+    fields = parse_status(client.ask("STATUS"))
     assert fields["faults"] == "none" and "radio_fault" not in fields
