@@ -85,7 +85,7 @@ def test_z_toggles_utc_and_local_time_with_the_zone_always_named() -> None:
             assert utc_aos in static_text(app, "passes") and "Passes (UTC)" in screen_text(app)
             assert f"Next pass {ISS_PASS.aos:%m-%d} AOS {ISS_PASS.aos:%H:%M:%S}" in static_text(app, "state")
             await pilot.press("f4")
-            await pilot.pause(0.3)
+            await settle(app, pilot, until=lambda: "UTC" not in static_text(app, "state"))
             local, local_aos = now.astimezone(sydney), ISS_PASS.aos.astimezone(sydney)
             zone = local.tzname()
             assert zone == "AEST"
@@ -94,10 +94,10 @@ def test_z_toggles_utc_and_local_time_with_the_zone_always_named() -> None:
             assert f"Passes ({zone})" in screen_text(app)
             # InstantTrack's Z, typed on the command line, and F4 toggle back and forth.
             await pilot.press("Z", "enter")
-            await pilot.pause(0.3)
+            await settle(app, pilot, until=lambda: f"{now:%m-%d %H:%M:%S} UTC" in static_text(app, "state"))
             assert f"{now:%m-%d %H:%M:%S} UTC" in static_text(app, "state")
             await pilot.press("f3", "f4")
-            await pilot.pause(0.3)
+            await settle(app, pilot, until=lambda: "UTC" not in static_text(app, "state"))
             assert zone in static_text(app, "state")
 
     asyncio.run(scenario())

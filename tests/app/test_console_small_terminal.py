@@ -29,11 +29,11 @@ def test_typed_commands_still_reach_the_station_after_f1_and_f3() -> None:
     async def scenario(app, pilot, station) -> None:
         await pilot.press("f1")
         await pilot.press(*"TUNE OFF", "enter")
-        await pilot.pause(0.1)
+        await settle(app, pilot, until=lambda: not station.core.state.snapshot().dde_output)
         assert not station.core.state.snapshot().dde_output
         await pilot.press("f3")
         await pilot.press(*"TUNE ON", "enter")
-        await pilot.pause(0.1)
+        await settle(app, pilot, until=lambda: station.core.state.snapshot().dde_output)
         assert station.core.state.snapshot().dde_output
         assert isinstance(app.focused, Input)
 
@@ -63,10 +63,10 @@ def test_page_keys_scroll_the_shown_log_while_typing_stays_possible() -> None:
         bottom = incoming.scroll_y
         assert bottom > 0
         await pilot.press("pageup")
-        await pilot.pause(0.2)
+        await settle(app, pilot, until=lambda: incoming.scroll_y < bottom)
         assert incoming.scroll_y < bottom
         await pilot.press("pagedown", "pagedown")
-        await pilot.pause(0.2)
+        await settle(app, pilot, until=lambda: incoming.scroll_y == bottom)
         assert incoming.scroll_y == bottom
         assert isinstance(app.focused, Input)
 

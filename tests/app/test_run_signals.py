@@ -22,6 +22,7 @@ from nfwserver.tcp.status_line import parse_status
 from tests.conftest import DATA, ROOT
 from tests.easycomm.test_easycomm_pty import Pty
 from tests.hamlib_daemons import free_port
+from tests.waiting import wait_for
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 
@@ -111,21 +112,12 @@ def station(tmp_path):
         st.stop()
 
 
-def _until(predicate, timeout_s: float) -> bool:
-    deadline = time.monotonic() + timeout_s
-    while not predicate():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.05)
-    return True
-
-
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
 def test_sigterm_and_sigint_stop_the_station_cleanly_within_5_s(station, sig) -> None:
     st = station()
     st.wait_serving()
     assert st.ask("SAT=694") == "OK"  # a run-time choice: the state file must keep it
-    assert _until(lambda: "694" in (st.state.read_text() if st.state.exists() else ""), 5.0)
+    wait_for(lambda: "694" in (st.state.read_text() if st.state.exists() else ""), 5.0, "the saved choice")
     st.pty.lines(0.5)  # what EasyComm wrote so far
     st.proc.send_signal(sig)
     started = time.monotonic()
@@ -167,15 +159,15 @@ def test_sighup_reloads_the_configuration_and_the_station_keeps_serving(station)
     assert st.status()["name"] == "ISS"
     st.write_config('[satellites]\nnames = { 25544 = "ZARYA" }\n')
     st.proc.send_signal(signal.SIGHUP)
-    assert _until(lambda: st.status()["name"] == "ZARYA", 5.0), st.status()
+    wait_for(lambda: st.status()["name"] == "ZARYA", 5.0, "the reloaded name")
     # A half-written file on SIGHUP is refused: the running configuration stays, STATUS says why.
     st.config.write_text("")
     st.proc.send_signal(signal.SIGHUP)
-    assert _until(lambda: "config" in st.status()["faults"], 5.0), st.status()
+    wait_for(lambda: "config" in st.status()["faults"], 5.0, "the config fault")
     assert st.status()["name"] == "ZARYA" and st.proc.poll() is None
     st.write_config('[satellites]\nnames = { 25544 = "ZARYA" }\n')
     st.proc.send_signal(signal.SIGHUP)
-    assert _until(lambda: "config" not in st.status()["faults"], 5.0), st.status()
+    wait_for(lambda: "config" not in st.status()["faults"], 5.0, "the config fault to clear")
     st.proc.send_signal(signal.SIGTERM)
     err = st.finish()
     assert st.proc.returncode == 0 and "Traceback" not in err, err

@@ -12,7 +12,8 @@ import pytest
 from nfwserver.commands.help_text import help_lines, markdown, poke_epilog
 from nfwserver.commands.table import COMMANDS, Face
 from tests.dde.conftest import CATALOG
-from tests.tcp.conftest import LineClient, wait_for
+from tests.tcp.conftest import LineClient
+from tests.waiting import wait_for
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -79,10 +79,10 @@ def test_the_console_refuses_the_poke_and_its_picker_searches_without_crashing()
         async with app.run_test(size=(100, 30)) as pilot:
             await settle(app, pilot)
             await pilot.press(*"SAT=²", "enter")
-            await pilot.pause(0.2)
+            await settle(app, pilot, until=lambda: "REFUSED" in log_text(app, "incoming"))
             assert "REFUSED (SAT needs a catalog number, got '\\xb2')" in " ".join(log_text(app, "incoming").split())
             await pilot.press("f2", "²")
-            await pilot.pause(0.2)
+            await settle(app, pilot, until=lambda: type(app.screen).__name__ == "SatellitePicker")
             await pilot.press("escape")
             await pilot.pause()
             assert app.is_running and station.core.state.catalog_number == ISS

@@ -9,7 +9,8 @@ from nfwserver.core.events import Direction
 from nfwserver.tcp import NovaTcpServer
 from nfwserver.tcp.status_line import parse_status
 from tests.dde.conftest import CATALOG, make_station
-from tests.tcp.conftest import LOOPBACK_ONLY, LineClient, wait_for
+from tests.tcp.conftest import LOOPBACK_ONLY, LineClient
+from tests.waiting import wait_for
 
 SO_50 = 27607  # not in visual.txt: a catalog number the station does not know
 OTHER = 694  # ATLAS-CENT-2, in visual.txt

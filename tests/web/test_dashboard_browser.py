@@ -8,7 +8,8 @@ from selenium.common.exceptions import NoAlertPresentException
 from selenium.webdriver.common.by import By
 
 from tests.dde.conftest import NOVA
-from tests.web.conftest import TOKEN, console_errors, open_page, read_page, wait_for
+from tests.waiting import wait_for
+from tests.web.conftest import TOKEN, console_errors, open_page, read_page
 
 
 def test_the_page_shows_the_published_nova_string_and_its_values(browser, web_station) -> None:
