@@ -1,4 +1,5 @@
-"""The tests' waits fail when what they wait for never comes (issue 36 item 10)."""
+"""The tests' waits fail when what they wait for never comes (issue 36 item 10), and their screen checks see what
+the screen text hides (item 12)."""
 
 from __future__ import annotations
 
@@ -42,5 +43,29 @@ def test_settle_fails_when_the_screen_never_shows_it() -> None:
             await settle(app, pilot, until=lambda: True)  # at once
             with pytest.raises(WaitTimeout):
                 await settle(app, pilot, until=lambda: False, limit_s=0.2)
+
+    asyncio.run(scenario())
+
+
+def test_off_screen_sees_a_widget_the_screen_text_hides() -> None:
+    """A 300-column widget on an 80-column terminal: every row of the screen's text is still 80 characters
+    (so a row-length check cannot fail); the widget's region shows it."""
+    from textual.app import ComposeResult
+    from textual.widgets import Static
+
+    from tests.app.console_helpers import off_screen, screen_text
+
+    class Wide(App[None]):
+        CSS = "#wide { width: 300; }"
+
+        def compose(self) -> ComposeResult:
+            yield Static("x" * 300, id="wide")
+
+    async def scenario() -> None:
+        app = Wide()
+        async with app.run_test(size=(80, 24)) as pilot:
+            await pilot.pause()
+            assert all(len(row) <= 80 for row in screen_text(app).splitlines())
+            assert off_screen(app) == ["Static#wide Region(x=0, y=0, width=300, height=1)"]
 
     asyncio.run(scenario())

@@ -20,6 +20,14 @@ def log_text(app: App, pane: str) -> str:
     return "\n".join(strip.text.rstrip() for strip in log.lines)
 
 
+def off_screen(app: App) -> list[str]:
+    """The widgets laid out beyond the terminal's edges.  The screen's text cannot tell: the compositor clips a
+    300-column widget to an 80-column terminal, whose rows are then still 80 characters."""
+    width, height = app.size
+    return [f"{type(w).__name__}#{w.id} {w.region}" for w in app.screen.query("*")
+            if w.display and (w.region.right > width or w.region.bottom > height)]
+
+
 def static_text(app: App, widget_id: str) -> str:
     return str(app.query_one(f"#{widget_id}", Static).render())
 
