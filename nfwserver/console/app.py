@@ -36,7 +36,7 @@ from textual.widgets import Footer, Input, RichLog, Static
 
 from nfwserver.commands.actions import NO_ROTOR
 from nfwserver.commands.parsing import parse_request
-from nfwserver.commands.table import Face, Target
+from nfwserver.commands.table import Face, Target, escape_for_log
 from nfwserver.console.command_port import ConsolePort
 from nfwserver.console.pass_view import STALE_DAYS, PassSearch, next_pass_text, pass_table, search_passes
 from nfwserver.console.picker import SatellitePicker
@@ -56,7 +56,6 @@ from nfwserver.console.state_view import (
 from nfwserver.console.time_display import TimeDisplay
 from nfwserver.core.events import Direction, Event
 from nfwserver.core.faces import CountsClients, WritesLines
-from nfwserver.core.nova_protocol import escape_for_log
 from nfwserver.core.station_core import StationCore
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.rotor.coupling import FLIP_MODES, RotorCoupling

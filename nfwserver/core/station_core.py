@@ -133,9 +133,7 @@ class StationCore:
 
     def set_tune(self, on: bool, source: str = "console") -> None:
         """Nova's TUNE ON/OFF: switch the DDE output."""
-        if on:
-            self.tracker.enable_call()
-        else:
+        if not on:
             self.tracker.dde_output_off()
         if self.state.set_dde_output(on):
             self._note(f"TUNE {'ON' if on else 'OFF'}", source)
@@ -151,15 +149,12 @@ class StationCore:
                 log.warning("%s (from %s)", reason, escape_for_log(source))
                 self._note(reason, source, accepted=False)
                 return reason
-            self.tracker.enable_call()
         if self.state.set_tracking(on):
             self._note(f"TRACK {'ON' if on else 'OFF'}", source)
         return None
 
     def set_radio_tuning(self, on: bool, source: str = "console") -> None:
         """OrbitDRV's Enable/Disable Tuning: Doppler updates to the radio."""
-        if on:
-            self.tracker.enable_call()
         if self.state.set_radio_tuning(on):
             self._note(f"radio Doppler tuning {'on' if on else 'off'}", source)
 

@@ -100,10 +100,6 @@ class Tracker:
             return self._status(snap, self._last)
 
     # -- what commands tell the tracker --------------------------------------------------------
-    def enable_call(self) -> None:
-        """An OrbitDRV enable call (TRACK ON, TUNE ON, radio tuning on).  Nothing is latched, so there is
-        nothing to reset: the next tick computes as every tick does."""
-
     def selection_changed(self) -> None:
         """A new AutoTracking satellite: never serve the old one's string."""
         with self._lock:

@@ -13,8 +13,9 @@ import asyncio
 import pytest
 
 from nfwserver.cli.arguments import time_value
+from nfwserver.commands.parsing import parse_poke
+from nfwserver.commands.table import CommandError
 from nfwserver.console.app import NfwConsole
-from nfwserver.core.nova_protocol import PokeError, parse_poke
 from nfwserver.dialects.predict_listing import atol
 from nfwserver.fake_dde import DdeError
 from nfwserver.tracking.elements import load_elements
@@ -30,7 +31,7 @@ NOT_ASCII = ["²", "٣", "５", "१", "①", "٢٥٥٤٤", "2554٤"]
 @pytest.mark.parametrize("value", NOT_ASCII)
 @pytest.mark.parametrize("command", ["SAT", "ANTAZ", "ANTEL"])
 def test_the_grammar_refuses_digits_other_than_ascii(command: str, value: str) -> None:
-    with pytest.raises(PokeError) as refused:
+    with pytest.raises(CommandError) as refused:
         parse_poke(f"{command}={value}")
     assert refused.value.bad_argument
     assert ("catalog number" if command == "SAT" else "number of degrees") in str(refused.value)
