@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from nfwserver.cli.arguments import number_in
+from nfwserver.cli.errors import CliError, load_config_or_fail
 
 
 def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -49,7 +50,6 @@ def run_path(args: argparse.Namespace) -> int:
 
 
 def run_init(args: argparse.Namespace) -> int:
-    from nfwserver.cli import CliError
     from nfwserver.config import default_config_path
     from nfwserver.config.render import template
     from nfwserver.storage import atomic_write_text
@@ -78,14 +78,9 @@ def run_show(args: argparse.Namespace) -> int:
     """Every key with its effective value; "default" stores resolved to the paths actually used."""
     from nfwserver.app.element_store import default_store_path
     from nfwserver.app.session_state import default_state_path
-    from nfwserver.cli import CliError
-    from nfwserver.config import ConfigError, load_config
     from nfwserver.config.render import show
 
-    try:
-        config = load_config(args.config)
-    except ConfigError as exc:
-        raise CliError(f"configuration refused: {exc}") from None
+    config = load_config_or_fail(args.config)
     notes = {}
     if config.elements.store == "default":
         notes["elements.store"] = f"default: {default_store_path()}"
@@ -112,7 +107,6 @@ def _written(path: str | None) -> dict[str, Any]:
 
 
 def _edited(text: str, section: str, key: str, value: Any, path: Path) -> str:
-    from nfwserver.cli import CliError
     from nfwserver.config import ConfigError
     from nfwserver.config.edit import set_key
 
@@ -124,7 +118,6 @@ def _edited(text: str, section: str, key: str, value: Any, path: Path) -> str:
 
 def run_set(args: argparse.Namespace) -> int:
     """``config set SECTION.KEY VALUE``: edit, validate the whole file, write atomically."""
-    from nfwserver.cli import CliError
     from nfwserver.config import ConfigError, default_config_path
     from nfwserver.config.edit import parse_value, split_key
     from nfwserver.config.loader import read_config_text

@@ -21,6 +21,7 @@ import logging
 import sys
 
 from nfwserver.cli.arguments import number_in, satellite_value, time_value
+from nfwserver.cli.errors import CliError, say
 from nfwserver.cli.simulate_pokes import MAX_DURATION_S, commands_of, observe_poke, poke_value
 from nfwserver.cli.simulated_clients import CLIENTS, Link, SimulatedClient, parse_link
 from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs
@@ -99,7 +100,6 @@ def _first_sat(pokes: list[tuple[float, str]]) -> float | None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from nfwserver.cli import CliError
 
     pokes = sorted(args.poke, key=lambda p: p[0])
     late = [command for offset, command in pokes if offset > args.duration]
@@ -117,17 +117,16 @@ def run(args: argparse.Namespace) -> int:
         origin = "--sat" if args.sat is not None else "[server] satellite"
         if args.sat is not None:
             raise CliError(f"satellite {wanted} is not in the catalog")
-        print(f"nfwserver: {origin} {wanted} is not in the catalog", file=sys.stderr)
+        say(f"{origin} {wanted} is not in the catalog")
     if sat is not None:
         server.select_satellite(sat.catalog_number, source="simulate")
     else:
         sat_poke = _first_sat(pokes)
         if sat_poke is None:
-            print("nfwserver: no --sat given and no [server] satellite in the catalog: no AutoTracking satellite, "
-                  "so nothing is published", file=sys.stderr)
+            say("no --sat given and no [server] satellite in the catalog: no AutoTracking satellite, so nothing is "
+                "published")
         elif sat_poke > 0:
-            print(f"nfwserver: no satellite until the SAT= poke at {sat_poke:g} s: nothing is published before it",
-                  file=sys.stderr)
+            say(f"no satellite until the SAT= poke at {sat_poke:g} s: nothing is published before it")
     auto_tune = not _client_tunes(pokes)
     return _simulate(args, server, clock, pokes, auto_tune)
 
@@ -195,7 +194,7 @@ def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock
             try:
                 client.start()
             except DdeError as exc:
-                print(f"nfwserver: {link}: {exc}", file=sys.stderr)
+                say(f"{link}: {exc}")
 
     try:
         run_virtual(server, clock, args.duration, before_tick=before_tick)

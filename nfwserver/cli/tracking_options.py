@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import argparse
 import logging
-import sys
 from datetime import datetime, timezone
 from functools import cached_property
 from typing import TYPE_CHECKING
 
 from nfwserver.cli.arguments import number_in, observer_value, parse_time_text
+from nfwserver.cli.errors import CliError, load_config_or_fail, say
 
 if TYPE_CHECKING:  # imported when the options are resolved: `--help` and parsing stay light
     from nfwserver.config import Config
@@ -44,7 +44,6 @@ class TrackingInputs:
 
     @cached_property
     def _given_observer(self) -> Observer | None:
-        from nfwserver.cli import CliError
         from nfwserver.tracking.observer import parse_observer
 
         observer = getattr(self._args, "observer", None)
@@ -58,7 +57,6 @@ class TrackingInputs:
     @cached_property
     def horizon(self) -> HorizonTable:
         """``--horizon``, else flat with ``--observer``, else the configured table."""
-        from nfwserver.cli import CliError
         from nfwserver.config.files import read_regular_file
         from nfwserver.tracking.horizon import HorizonTable, parse_horizon
 
@@ -85,7 +83,7 @@ class TrackingInputs:
             config = self.config()
             observer = config.observer
             if not config.observer_configured:
-                warn(f"no observer configured: using {observer}; set [observer] location in {config_file(config)} "
+                say(f"no observer configured: using {observer}; set [observer] location in {config_file(config)} "
                      "(`nfwserver config init` writes a starting file) or give --observer")
         return observer
 
@@ -154,11 +152,6 @@ def format_time(when: datetime) -> str:
             f"{when.second:02d}.{when.microsecond // 1000:03d}Z")
 
 
-def warn(message: str) -> None:
-    """One diagnostic line on stderr."""
-    print(f"nfwserver: {message}", file=sys.stderr)
-
-
 def config_file(config: Config) -> str:
     """The configuration file ``config`` came from, or the file the user would create."""
     if not config.source.startswith("<"):
@@ -169,19 +162,13 @@ def config_file(config: Config) -> str:
 
 
 def _load_config(args: argparse.Namespace) -> Config:
-    from nfwserver.cli import CliError
-    from nfwserver.config import ConfigError, load_config
 
-    try:
-        return load_config(getattr(args, "config", None))
-    except ConfigError as exc:
-        raise CliError(f"configuration refused: {exc}") from None
+    return load_config_or_fail(getattr(args, "config", None))
 
 
 def _catalog_from_files(paths: list[str], inputs: TrackingInputs) -> Catalog:
     from nfwserver.app.element_sources import SourceError, read_file
     from nfwserver.app.station_catalog import source_limits
-    from nfwserver.cli import CliError
     from nfwserver.tracking.catalog import Catalog
     from nfwserver.tracking.elements import load_elements
 
@@ -197,7 +184,7 @@ def _catalog_from_files(paths: list[str], inputs: TrackingInputs) -> Catalog:
         if len(result.sets) > limits.max_sets:
             raise CliError(str(limits.too_many(path)))
         for rejection in result.rejected:
-            warn(f"skipped element set: {rejection}")
+            say(f"skipped element set: {rejection}")
         if not result.sets:
             empty.append(_why_no_sets(path, data, len(result.rejected)))
         sets.extend(result.sets)
@@ -218,11 +205,10 @@ def _why_no_sets(path: str, data: bytes | str, refused: int) -> str:
 
 def _station_catalog(config: Config) -> Catalog:
     from nfwserver.app.station_catalog import configured_store, load_station_catalog
-    from nfwserver.cli import CliError
 
     catalog, fetched = load_station_catalog(config)
     for problem in fetched.failed:
-        warn(f"element source unavailable: {problem}")
+        say(f"element source unavailable: {problem}")
     if not len(catalog):
         store = configured_store(config)
         where = f"the stored catalog {store.path} is empty" if store is not None else "no stored catalog"
