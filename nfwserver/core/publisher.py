@@ -23,6 +23,7 @@ from datetime import timedelta
 
 from nfwserver.clock import Clock, VirtualClock
 from nfwserver.core.station_core import StationCore
+from nfwserver.ratelimited_log import RateLimitedLog
 
 log = logging.getLogger(__name__)
 
@@ -51,6 +52,7 @@ class Publisher:
         self.core = core
         self.clock = clock
         self.stats = PublishStats()
+        self._failures = RateLimitedLog(log, clock, 60.0)  #: a tick that raises: one line, then a count a minute
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
 
@@ -86,7 +88,7 @@ class Publisher:
                 self.core.tick()
             except Exception:
                 self.stats.failures += 1
-                log.exception("publish tick failed")
+                self._failures.log(logging.ERROR, "tick", "publish tick failed", exc_info=True)
             self.stats.record(late)
             k += 1
             behind = self.clock.monotonic() - (t0 + k / rate)
@@ -111,6 +113,7 @@ def run_virtual(
     rate = core.state.rate_hz
     period = 1.0 / rate
     count = int(math.floor(duration_s * rate + 1e-9)) + 1
+    failures = RateLimitedLog(log, clock, 60.0)
     for k in range(count):
         offset = k * period
         clock.set(start + timedelta(seconds=offset))
@@ -119,5 +122,5 @@ def run_virtual(
         try:
             core.tick(clock.now())
         except Exception:
-            log.exception("publish tick failed")
+            failures.log(logging.ERROR, "tick", "publish tick failed", exc_info=True)
     return count

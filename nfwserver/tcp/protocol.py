@@ -39,6 +39,7 @@ stream with the peer as ``client``.
 from __future__ import annotations
 
 import enum
+import logging
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
@@ -48,8 +49,11 @@ from nfwserver.commands.table import Face, Target
 from nfwserver.core.events import Direction
 from nfwserver.core.nova_protocol import format_azimuth, format_elevation, format_range_rate
 from nfwserver.core.station_core import StationCore
+from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.tcp.greeting import GREETING as GREETING  # the server sends it
 from nfwserver.tcp.status_line import format_status
+
+log = logging.getLogger(__name__)
 
 StatusFields = Callable[[], Mapping[str, object]]
 
@@ -107,6 +111,7 @@ class NovaTcpProtocol:
     def __init__(self, core: StationCore, extra: StatusFields | None = None) -> None:
         self.core = core
         self.extra = extra
+        self._extra_failures = RateLimitedLog(log, core.clock, 60.0)  #: a broken STATUS field: logged whole
 
     def record(self, peer: str, text: str, detail: str = "") -> None:
         """An event for a line that is not a station command (the core records those)."""
@@ -162,4 +167,6 @@ class NovaTcpProtocol:
                 fields.update(self.extra())
             except Exception as exc:  # a broken extra field must not cost the client its answer
                 fields["extra_error"] = type(exc).__name__
+                self._extra_failures.log(logging.ERROR, "extra", "STATUS fields of the devices failed",
+                                         exc_info=True)
         return format_status(fields)

@@ -190,7 +190,7 @@ class NovaTcpServer:
                         self._service(key.data, mask)
                 self._deliver()
             except Exception:  # keep serving whatever one connection did
-                log.exception("TCP server loop failed; carrying on")
+                self._refusals.log(logging.ERROR, "loop", "TCP server loop failed; carrying on", exc_info=True)
 
     def _next_timeout(self) -> float | None:
         """Real seconds until something on the clock is due (an idle deadline, the end of the accept
@@ -301,7 +301,8 @@ class NovaTcpServer:
                     reply = self.protocol.handle(item.decode("ascii", errors="replace"), client.peer,
                                                  rate_key=f"tcp {client.address}")
                 except Exception:
-                    log.exception("TCP command from %s failed", client.peer)
+                    self._refusals.log(logging.ERROR, f"failed:{client.address}", "TCP command from %s failed",
+                                       client.peer, exc_info=True)
                     reply = Reply(("ERROR internal error",))
             if reply is None:
                 continue
