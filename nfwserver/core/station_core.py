@@ -100,8 +100,8 @@ class StationCore:
         self.rotor_configured: bool | None = None
         #: the rotor's command port for FLIP and PARK (set by the station; None: no rotor)
         self.rotor: RotorControl | None = None
-        #: who chose the selected satellite: "config", "saved-state", or the source of the command
-        self.selected_by = "config" if satellite is not None else ""
+        if satellite is not None:
+            self.state.set_selected_by("config")
         if satellite is not None and not self.select_satellite(satellite, source="startup"):
             log.warning("satellite %s is not in the catalog; no satellite selected", satellite)
 
@@ -163,11 +163,20 @@ class StationCore:
         sat = self.state.catalog.get(catalog_number)
         if sat is None:
             return False
-        if self.state.select(catalog_number):
+        if self.state.select(catalog_number, by=source):
             self.tracker.selection_changed()
             self._note(f"satellite {catalog_number} {sat.dde_name} selected", source)
-            self.selected_by = source
         return True
+
+    @property
+    def selected_by(self) -> str:
+        """Who chose the selected satellite: "config", "saved-state", or the source of the command (read with
+        the selection itself from :meth:`StationState.snapshot` where both are shown)."""
+        return self.state.snapshot().selected_by
+
+    @selected_by.setter
+    def selected_by(self, source: str) -> None:
+        self.state.set_selected_by(source)
 
     def clear_satellite(self) -> None:
         if self.state.select(None):

@@ -149,7 +149,7 @@ class NovaTcpProtocol:
         snap = self.core.snapshot()
         state = snap.state
         fields: dict[str, object] = {
-            "satellite": state.catalog_number, "name": snap.dde_name, "satellite_from": self.core.selected_by,
+            "satellite": state.catalog_number, "name": snap.dde_name, "satellite_from": state.selected_by,
             "tune": state.dde_output,
             "track": state.tracking, "radio_tuning": state.radio_tuning, "status": f"0x{snap.status:04X}",
             "interface": snap.interface_version,
