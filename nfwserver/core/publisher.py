@@ -16,12 +16,12 @@ from __future__ import annotations
 
 import logging
 import math
-import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from datetime import timedelta
 
 from nfwserver.clock import Clock, VirtualClock
+from nfwserver.core.service_thread import ServiceThread
 from nfwserver.core.station_core import StationCore
 from nfwserver.ratelimited_log import RateLimitedLog
 
@@ -45,29 +45,17 @@ class PublishStats:
             del self.lateness_s[: len(self.lateness_s) - self.keep]
 
 
-class Publisher:
+class Publisher(ServiceThread):
     """Runs ``core.tick()`` at the state's rate on a background thread (thread ``nfw-publisher``)."""
 
+    thread_name = "nfw-publisher"
+
     def __init__(self, core: StationCore, clock: Clock) -> None:
+        super().__init__()
         self.core = core
         self.clock = clock
         self.stats = PublishStats()
         self._failures = RateLimitedLog(log, clock, 60.0)  #: a tick that raises: one line, then a count a minute
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
-
-    def start(self) -> None:
-        if self._thread is not None:
-            return
-        self._stop.clear()
-        self._thread = threading.Thread(target=self._run, name="nfw-publisher", daemon=True)
-        self._thread.start()
-
-    def stop(self, timeout: float = 5.0) -> None:
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join(timeout)
-            self._thread = None
 
     def _run(self) -> None:
         t0 = self.clock.monotonic()
