@@ -9,10 +9,12 @@ tracking and control on, exactly as tests/web starts it:
 from __future__ import annotations
 
 import sys
-import time
 from pathlib import Path
 
-from tests.web.conftest import config_text, make_browser, open_page, start_station
+from selenium.webdriver.common.by import By
+
+from tests.waiting import wait_for
+from tests.web.conftest import config_text, make_browser, open_page, read_page, start_station
 
 
 def main(target: str) -> None:
@@ -29,9 +31,13 @@ def main(target: str) -> None:
                 browser.execute_cdp_cmd("Emulation.setDeviceMetricsOverride",
                                          {"width": width, "height": height, "deviceScaleFactor": 2 if mobile else 1,
                                           "mobile": mobile})
-                open_page(browser, web)
+                frames = open_page(browser, web)["frames"]
                 web.advance(1.0)
-                time.sleep(1.0)  # passes and map data arrive after the first frame
+                # passes and map data arrive after the first frame: wait for the pass rows, the satellite's mark
+                # and a frame after the advance
+                wait_for(lambda b=browser, f=frames: b.find_elements(By.CSS_SELECTOR, "#passes tr[data-catalog-number]")
+                         and (page := read_page(b))["frames"] > f and page["marker"] is not None,
+                         15.0, "the pass list, the sky mark and the next frame")
                 browser.save_screenshot(str(Path(target) / name))
             finally:
                 browser.quit()
