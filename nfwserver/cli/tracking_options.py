@@ -167,40 +167,36 @@ def _load_config(args: argparse.Namespace) -> Config:
 
 
 def _catalog_from_files(paths: list[str], inputs: TrackingInputs) -> Catalog:
-    from nfwserver.app.element_sources import SourceError, read_file
+    """The sets of the ``--elements`` files, read and checked as the station reads its element files
+    (:func:`~nfwserver.app.element_sources.read_file` and :func:`~nfwserver.app.element_sources.parse_source`:
+    regular files only, size and set limits, no binary data); a file without sets is named and left out, and
+    none at all is a :class:`CliError` naming each file's reason."""
+    from nfwserver.app.element_sources import SourceError, parse_source, read_file
     from nfwserver.app.station_catalog import source_limits
     from nfwserver.tracking.catalog import Catalog
-    from nfwserver.tracking.elements import load_elements
 
     limits = source_limits(inputs.config().elements)
     sets = []
-    empty: list[str] = []  # why each file gave no set
+    unusable: list[str] = []  # why each file gave no set
     for path in paths:
         try:
             data = read_file(path, limits)
-            result = load_elements(data, source=path)
         except SourceError as exc:
             raise CliError(str(exc)) from None
-        if len(result.sets) > limits.max_sets:
-            raise CliError(str(limits.too_many(path)))
+        try:
+            result = parse_source(data, path, limits)
+        except SourceError as exc:
+            unusable.append(str(exc))
+            continue
         for rejection in result.rejected:
             say(f"skipped element set: {rejection}")
-        if not result.sets:
-            empty.append(_why_no_sets(path, data, len(result.rejected)))
         sets.extend(result.sets)
         del result, data
     if not sets:
-        raise CliError("no usable element sets: " + "; ".join(empty))
+        raise CliError("no usable element sets: " + "; ".join(unusable))
+    for reason in unusable:
+        say(f"left out: {reason}")
     return Catalog(sets, dde_names=inputs.config().dde_names)
-
-
-def _why_no_sets(path: str, data: bytes | str, refused: int) -> str:
-    """One clause saying why ``path`` gave no element set: empty, every set refused, or no set found."""
-    if not data.strip():
-        return f"{path} is empty"
-    if refused:
-        return f"{path}: its {refused} set(s) were refused (reasons above)"
-    return f"{path} holds no TLE, AMSAT or OMM (JSON or CSV) element set"
 
 
 def _station_catalog(config: Config) -> Catalog:
