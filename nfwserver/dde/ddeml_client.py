@@ -120,9 +120,8 @@ class DdemlClient:  # pragma: no cover - Windows only
         delivers XTYP_DISCONNECT) DdeQueryConvInfo reports the conversation terminated or gone."""
         if conv in self.disconnected:
             return True
-        info = ddeml.ConvInfo()
-        info.cb = ctypes.sizeof(ddeml.ConvInfo)
-        if not self.u.DdeQueryConvInfo(conv, ddeml.QID_SYNC, ctypes.byref(info)):
+        info = ddeml.conv_info(self.u, conv)
+        if info is None:
             return True  # DDEML no longer knows the conversation
         return bool(info.wStatus & ddeml.ST_TERMINATED) or not info.wStatus & ddeml.ST_CONNECTED
 

@@ -288,9 +288,8 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
     def _client_vanished(self, hconv: int) -> bool:
         """DDEML no longer knows ``hconv``, or no longer counts it connected, or its client's window
         is gone."""
-        info = ddeml.ConvInfo()
-        info.cb = ctypes.sizeof(ddeml.ConvInfo)
-        if not self.u.DdeQueryConvInfo(hconv, ddeml.QID_SYNC, ctypes.byref(info)):
+        info = ddeml.conv_info(self.u, hconv)
+        if info is None:
             return True
         if not info.wStatus & ddeml.ST_CONNECTED:
             return True
