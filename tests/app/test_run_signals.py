@@ -70,16 +70,11 @@ class Station:
         return parse_status(self.ask("STATUS"))
 
     def wait_serving(self, timeout_s: float = 30.0) -> None:
-        deadline = time.monotonic() + timeout_s
-        while True:
-            assert self.proc.poll() is None, self.finish()
-            try:
-                if self.status().get("tune") == "on":
-                    return
-            except OSError:
-                pass
-            assert time.monotonic() < deadline, "the station never answered"
-            time.sleep(0.1)
+        def serving() -> bool:
+            assert self.proc.poll() is None, self.finish()  # a station that exited fails at once
+            return self.status().get("tune") == "on"
+
+        wait_for(serving, timeout_s, "the station to answer with TUNE ON", interval_s=0.1, tolerate=(OSError,))
 
     def finish(self, timeout_s: float = STOP_WITHIN_S) -> str:
         """Wait for the exit (killing the process if it overstays); stderr."""
