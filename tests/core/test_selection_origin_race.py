@@ -14,6 +14,7 @@ def test_status_pairs_each_satellite_with_its_chooser() -> None:
     station = make_station()
     core = station.core
     chooser = {25544: "face-a", 694: "face-b"}
+    core.select_satellite(694, source="face-b")  # from the start, every selection is one of the two faces'
     stop = threading.Event()
 
     def choose(number: int) -> None:
@@ -26,7 +27,7 @@ def test_status_pairs_each_satellite_with_its_chooser() -> None:
     protocol = NovaTcpProtocol(core)
     try:
         pairs = set()
-        for _ in range(3000):
+        for _ in range(10000):
             fields = parse_status(protocol.status_line())
             pairs.add((fields["satellite"], fields["satellite_from"]))
     finally:
