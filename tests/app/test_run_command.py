@@ -38,10 +38,12 @@ def test_headless_prints_the_log_file_logs_the_start_and_a_status_every_ten_minu
         return log_file.read_text().count(" status: ") if log_file.exists() else 0
 
     def drive() -> None:
-        wait_for(lambda: "outputs:" in (log_file.read_text() if log_file.exists() else ""), 20.0,
-                 "the start line in the log")
-        advance_until(clock, lambda: statuses() >= 2, step_s=30.0, limit_s=1500.0)
-        stop.set()
+        try:
+            wait_for(lambda: "outputs:" in (log_file.read_text() if log_file.exists() else ""), 20.0,
+                     "the start line in the log")
+            advance_until(clock, lambda: statuses() >= 2, step_s=30.0, limit_s=1500.0)
+        finally:
+            stop.set()  # whatever happened, the run must end (a failed wait shows in the asserts below)
 
     driver = threading.Thread(target=drive)
     driver.start()
