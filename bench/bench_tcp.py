@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.realtime_loop import ClientProcess, run_publisher, wait_until
+from bench.realtime_loop import ClientProcess, run_publisher
 from nfwserver.clock import SystemClock, VirtualClock
 from nfwserver.config.schema import TcpConfig
 from nfwserver.core.station_core import StationCore
@@ -21,6 +21,7 @@ from nfwserver.tcp import NovaTcpServer
 from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.observer import Observer
+from tests.waiting import wait_for
 
 ROOT = Path(__file__).resolve().parent.parent
 CATALOG = Catalog(load_element_file(ROOT / "tests" / "data" / "visual.txt").sets)
@@ -78,7 +79,7 @@ def tick_cost(clients: int, ticks: int = 2000, pace_s: float = 0.005) -> tuple[f
     server = NovaTcpServer(core, CONFIG, max_clients=clients + 10)
     server.start()
     watchers = Watchers(server.address, clients) if clients else None
-    wait_until(lambda: server.watcher_count() == clients)
+    wait_for(lambda: server.watcher_count() == clients, 20.0, "the watchers to connect", interval_s=0.001)
     core.set_tune(True)
     costs, sent = [], []
     when = START
@@ -106,7 +107,7 @@ def loop_lateness(clients: int, rate: float, seconds: float) -> tuple[float, flo
     server = NovaTcpServer(core, CONFIG, max_clients=clients + 10)
     server.start()
     watchers = Watchers(server.address, clients)
-    wait_until(lambda: server.watcher_count() == clients)
+    wait_for(lambda: server.watcher_count() == clients, 20.0, "the watchers to connect", interval_s=0.001)
     core.set_tune(True)
     p50, p99, worst, ticks = run_publisher(core, seconds)
     got = min(len(a) for a in watchers.arrivals(str(ticks)))

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from bench import web_process
-from bench.realtime_loop import ClientProcess, run_publisher, wait_until
+from bench.realtime_loop import ClientProcess, run_publisher
 from nfwserver.clock import SystemClock, VirtualClock
 from nfwserver.config.schema import WebConfig
 from nfwserver.core.station_core import StationCore
@@ -27,6 +27,7 @@ from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.observer import Observer
 from nfwserver.web import WebServer
+from tests.waiting import wait_for
 
 ROOT = Path(__file__).resolve().parent.parent
 CATALOG = Catalog(load_element_file(ROOT / "tests" / "data" / "visual.txt").sets)
@@ -92,7 +93,7 @@ def tick_cost(clients: int, ticks: int = 600, pace_s: float = 0.1) -> tuple[floa
     web.start()
     assert web.address is not None
     browsers = Browsers(web.address, clients) if clients else None
-    wait_until(lambda: web.stats.streams == clients)
+    wait_for(lambda: web.stats.streams == clients, 20.0, "the streams to open", interval_s=0.001)
     core.set_tune(True)
     costs, sent = [], {}
     when = START
@@ -123,7 +124,7 @@ def loop_lateness(clients: int, rate: float, seconds: float) -> tuple[float, flo
     web.start()
     assert web.address is not None
     browsers = Browsers(web.address, clients)
-    wait_until(lambda: web.stats.streams == clients)
+    wait_for(lambda: web.stats.streams == clients, 20.0, "the streams to open", interval_s=0.001)
     core.set_tune(True)
     p50, p99, worst, ticks = run_publisher(core, seconds)
     got = min(len(a) for a in browsers.arrivals())

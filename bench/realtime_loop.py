@@ -8,7 +8,6 @@ import json
 import subprocess
 import sys
 import time
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -49,10 +48,3 @@ class ClientProcess:
         result = json.loads(self.proc.stdout.readline())
         self.proc.wait(10)
         return result
-
-
-def wait_until(predicate: Callable[[], bool], timeout: float = 20.0) -> None:
-    """Poll ``predicate`` every millisecond until it holds or ``timeout`` seconds have passed."""
-    deadline = time.monotonic() + timeout
-    while not predicate() and time.monotonic() < deadline:
-        time.sleep(0.001)

@@ -15,6 +15,7 @@ import pytest
 from nfwserver.cli import main
 from tests.app.test_element_presets import provider  # noqa: F401 - a fixture
 from tests.conftest import ROOT
+from tests.waiting import wait_for
 
 README = (ROOT / "README.md").read_text(encoding="utf-8")
 
@@ -145,13 +146,13 @@ def test_the_journey_runs_as_written(provider, tmp_path, capsys) -> None:  # noq
 def _start_station(argv: list[str]) -> subprocess.Popen[bytes]:
     """``nfwserver run`` as a process of its own (headless: its stdout is not a terminal), answering on TCP."""
     import sys
-    import time
 
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     proc = subprocess.Popen([sys.executable, "-m", "nfwserver", *argv], cwd=ROOT, env=env,
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    deadline = time.monotonic() + 30.0
-    while main(["status", "--timeout", "1"]) != 0:
-        assert proc.poll() is None and time.monotonic() < deadline, proc.stderr.read() if proc.stderr else ""
-        time.sleep(0.2)
+    def answers() -> bool:
+        assert proc.poll() is None, proc.stderr.read() if proc.stderr else ""  # an exited station fails at once
+        return main(["status", "--timeout", "1"]) == 0
+
+    wait_for(answers, 30.0, "nfwserver status to reach the station", interval_s=0.2)
     return proc

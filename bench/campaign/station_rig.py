@@ -171,7 +171,7 @@ class StationRig:
         """Names of the station's threads that should run and do not."""
         st = self.station
         wanted = {"publisher": st.publisher._thread, "tcp": st.tcp._thread, "predict": st.predict._thread,
-                  "predict-list": st.predict._lister}
+                  "predict-list": st.predict._lister._thread}
         for name in ("rotor", "radio", "saver"):
             worker = getattr(st, name)
             if worker is not None:

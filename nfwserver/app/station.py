@@ -85,6 +85,7 @@ class Station:
             self.predict = PredictUdpServer(context, config.dialects.predict_host, config.dialects.predict_port)
         self.rotor: RotorCoupling | None = make_rotor(config.rotor, self.core, clock)
         self.core.rotor_configured = self.rotor is not None
+        self.core.rotor = self.rotor  # FLIP and PARK, from every face
         self.radio: RadioCoupling | None = make_radio(config.radio, self.core, clock)
         self.saver = (SessionSaver(self.state_file, config.server.satellite,
                                    self.core.health.link("state-file", Backoff(0.2, 0.4)),
@@ -97,8 +98,7 @@ class Station:
         self.tcp: NovaTcpServer | None = (
             NovaTcpServer(self.core, config.tcp,
                           combined(device_status(self.rotor, self.radio, self.easycomm),
-                                   elements_status(self.core.state, clock, config.elements.stale_days)),
-                          rotor=self.rotor)
+                                   elements_status(self.core.state, clock, config.elements.stale_days)))
             if config.tcp.enabled else None)
         self.web: WebServer | None = (
             WebServer(self.core, config.web, StationParts(self.rotor, self.radio, self.easycomm, self.tcp, self.nova,

@@ -20,16 +20,13 @@ from collections.abc import Sequence
 from nfwserver import __version__
 from nfwserver.blas_threads import single_threaded_blas
 from nfwserver.cli.arguments import COMMANDS, command_word, join_negative_values
+from nfwserver.cli.errors import CliError, say
 
 #: Command modules, in the order their commands appear in ``--help``.
 COMMAND_MODULES: tuple[str, ...] = tuple(dict.fromkeys(module for _, module, _ in COMMANDS))
 
 
 __all__ = ["CliError", "TerminalFormatter", "build_parser", "main", "say"]
-
-
-class CliError(Exception):
-    """A runtime problem to report in one sentence (exit code 1)."""
 
 
 class TerminalFormatter(logging.Formatter):
@@ -45,12 +42,6 @@ class TerminalFormatter(logging.Formatter):
         text = super().format(record)
         where = f" ({record.name})" if self.with_names else ""
         return f"nfwserver: {record.levelname.lower()}{where}: {text}"
-
-
-def say(text: str) -> None:
-    """One diagnostic line on stderr, ``nfwserver: <text>``, in a single write (threads may be logging)."""
-    sys.stderr.write(f"nfwserver: {text}\n")
-    sys.stderr.flush()
 
 
 def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
@@ -106,11 +97,11 @@ def _main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(func(args) or 0)
     except CliError as exc:
-        print(f"nfwserver: {exc}", file=sys.stderr)
+        say(str(exc))
         return 1
     except OSError as exc:  # a file or device the command could not use: one line, the details with -v
         where = f": {exc.filename}" if exc.filename else ""
-        print(f"nfwserver: {exc.strerror or exc}{where}", file=sys.stderr)
+        say(f"{exc.strerror or exc}{where}")
         if args.verbose:
             logging.getLogger("nfwserver").debug("details", exc_info=True)
         return 1

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from nfwserver.cli.arguments import number_in
+from nfwserver.cli.errors import CliError, load_config_or_fail
 
 
 def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -63,7 +64,6 @@ def run_path(args: argparse.Namespace) -> int:
 
 
 def run_init(args: argparse.Namespace) -> int:
-    from nfwserver.cli import CliError
     from nfwserver.config import default_config_path
     from nfwserver.config.render import template
     from nfwserver.config.tokens import TEMPLATE_TOKEN, new_token
@@ -130,14 +130,9 @@ def run_show(args: argparse.Namespace) -> int:
 
     from nfwserver.app.element_store import default_store_path
     from nfwserver.app.session_state import default_state_path
-    from nfwserver.cli import CliError
-    from nfwserver.config import ConfigError, load_config
     from nfwserver.config.render import show
 
-    try:
-        config = load_config(args.config)
-    except ConfigError as exc:
-        raise CliError(f"configuration refused: {exc}") from None
+    config = load_config_or_fail(args.config)
     notes = {}
     if config.elements.store == "default":
         notes["elements.store"] = f"default: {default_store_path()}"
@@ -185,7 +180,6 @@ def _written_through(path: Path) -> Path:
 
 
 def _edited(text: str, section: str, key: str, value: Any, path: Path) -> str:
-    from nfwserver.cli import CliError
     from nfwserver.config import ConfigError
     from nfwserver.config.edit import set_key
 
@@ -197,7 +191,6 @@ def _edited(text: str, section: str, key: str, value: Any, path: Path) -> str:
 
 def run_set(args: argparse.Namespace) -> int:
     """``config set SECTION.KEY VALUE``: edit, validate the whole file, write atomically."""
-    from nfwserver.cli import CliError
     from nfwserver.config import ConfigError, default_config_path
     from nfwserver.config.edit import parse_value, split_key
     from nfwserver.config.loader import read_config_text

@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 
 from nfwserver.cli.arguments import number_in
+from nfwserver.cli.errors import CliError, load_config_or_fail, say
 
 
 def add_station_options(p: argparse.ArgumentParser) -> None:
@@ -40,19 +41,13 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
 
 def station_address(args: argparse.Namespace) -> tuple[str, int]:
     """Host and port of the station: ``--host``/``--port``, else the configuration's ``[tcp]``."""
-    from nfwserver.cli import CliError
-    from nfwserver.config import ConfigError, load_config
     from nfwserver.tcp.client import connect_host
 
-    try:
-        config = load_config(args.config)
-    except ConfigError as exc:
-        raise CliError(f"configuration refused: {exc}") from None
+    config = load_config_or_fail(args.config)
     return args.host or connect_host(config.tcp.host), int(args.port or config.tcp.port)
 
 
 def _ask(args: argparse.Namespace, line: str, until: str | None = None) -> str:
-    from nfwserver.cli import CliError
     from nfwserver.tcp.client import StationUnreachable, ask
 
     host, port = station_address(args)
@@ -65,7 +60,6 @@ def _ask(args: argparse.Namespace, line: str, until: str | None = None) -> str:
 def poke(args: argparse.Namespace) -> int:
     import sys
 
-    from nfwserver.cli import CliError
 
     text = args.text.strip()
     if not text or not text.isascii() or not text.isprintable() or len(text) > 256:
@@ -86,14 +80,14 @@ def poke(args: argparse.Namespace) -> int:
 
 def status(args: argparse.Namespace) -> int:
     """The STATUS line on stdout; a stale element set (``elements_stale=yes``) is also said on stderr."""
-    import sys
+
+    from nfwserver.tcp.status_line import parse_status
 
     line = _ask(args, "STATUS")
     print(line)
-    fields = dict(word.partition("=")[::2] for word in line.split() if "=" in word)
+    fields = parse_status(line)
     if fields.get("elements_stale") == "yes":
         name = fields.get("name", "the selected satellite")
-        print(f"nfwserver: the elements of {name} are {fields.get('elements_age_d', '?')} days old, older than "
-              "[elements] stale_days: positions drift; `nfwserver elements update` fetches current ones",
-              file=sys.stderr)
+        say(f"the elements of {name} are {fields.get('elements_age_d', '?')} days old, older than "
+              "[elements] stale_days: positions drift; `nfwserver elements update` fetches current ones")
     return 0

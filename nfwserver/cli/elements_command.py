@@ -15,6 +15,7 @@ from datetime import datetime, timezone
 from typing import TYPE_CHECKING
 
 from nfwserver.cli.arguments import element_source_value, number_in
+from nfwserver.cli.errors import CliError, load_config_or_fail, say
 from nfwserver.cli.tracking_options import config_file
 from nfwserver.config.element_presets import DEFAULT_PRESET, PRESETS
 
@@ -57,13 +58,8 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
 
 
 def _config(args: argparse.Namespace) -> Config:
-    from nfwserver.cli import CliError
-    from nfwserver.config import ConfigError, load_config
 
-    try:
-        config = load_config(args.config)
-    except ConfigError as exc:
-        raise CliError(f"configuration refused: {exc}") from None
+    config = load_config_or_fail(args.config)
     if args.store:
         config = dataclasses.replace(config, elements=dataclasses.replace(config.elements, store=args.store))
     return config
@@ -71,16 +67,12 @@ def _config(args: argparse.Namespace) -> Config:
 
 def _store(config: Config) -> ElementStore:
     from nfwserver.app.station_catalog import configured_store
-    from nfwserver.cli import CliError
 
     store = configured_store(config)
     if store is None:
         raise CliError(f'no stored catalog: [elements] store is "none" in {config_file(config)}; give --store FILE')
     return store
 
-
-def _say(message: str) -> None:
-    print(f"nfwserver: {message}", file=sys.stderr)
 
 
 def run_update(args: argparse.Namespace) -> int:
@@ -89,7 +81,6 @@ def run_update(args: argparse.Namespace) -> int:
 
     from nfwserver.app.element_sources import SourceError, read_source
     from nfwserver.app.station_catalog import source_limits
-    from nfwserver.cli import CliError
 
     config = _config(args)
     store = _store(config)
@@ -116,12 +107,12 @@ def run_update(args: argparse.Namespace) -> int:
             sets += loaded.sets
             rejected += loaded.rejected
     for message in failed:
-        _say(message)
+        say(message)
     for r in rejected:
-        _say(f"rejected: {r}")
+        say(f"rejected: {r}")
     if not sets:  # every source failed, and each has been reported; the store is as it was
         if store.path.exists():
-            _say(f"the stored catalog {store.path} is unchanged")
+            say(f"the stored catalog {store.path} is unchanged")
         return 1
     try:
         catalog, summary = store.update(sets)
@@ -149,7 +140,7 @@ def _sources(given: list[str], config: Config) -> dict[str, str]:
     configured = {**dict.fromkeys(config.elements.files, ""), **configured_urls(config.elements)}
     if configured:
         return configured
-    _say(f"no element sources configured ([elements] sources, files or urls in {config_file(config)}): "
+    say(f"no element sources configured ([elements] sources, files or urls in {config_file(config)}): "
          f"using the {PRESETS[DEFAULT_PRESET].label} source")
     return preset_urls([DEFAULT_PRESET], mirror)
 
@@ -170,7 +161,7 @@ def run_sources(args: argparse.Namespace) -> int:
         sys.stderr.close()
         return 0
     where = ", ".join(config.elements.sources) or "none"
-    _say(f"* = in [elements] sources of {config_file(config)} ({where}); `nfwserver elements update NAME` "
+    say(f"* = in [elements] sources of {config_file(config)} ({where}); `nfwserver elements update NAME` "
          "fetches one now")
     return 0
 
@@ -183,7 +174,7 @@ def run_list(args: argparse.Namespace) -> int:
     store = configured_store(config)
     catalog, fetched = load_station_catalog(config)
     for problem in fetched.failed:
-        _say(f"element source unavailable: {problem}")
+        say(f"element source unavailable: {problem}")
     now = datetime.now(timezone.utc)
     stored_source = str(store.path) if store is not None else None
     counts = {"stored": 0, "bundled": 0, "file": 0}
@@ -200,10 +191,10 @@ def run_list(args: argparse.Namespace) -> int:
         sys.stderr.close()
         return 0
     where = f"stored catalog {store.path}" if store is not None else 'no stored catalog ([elements] store = "none")'
-    _say(f"{len(catalog)} satellites: {counts['stored']} from the {where}, {counts['file']} from [elements] files, "
+    say(f"{len(catalog)} satellites: {counts['stored']} from the {where}, {counts['file']} from [elements] files, "
          f"{counts['bundled']} from the bundled set")
     if counts["bundled"]:
-        _say(f"the bundled element set is in use ([elements] use_bundled = false in {config_file(config)} "
+        say(f"the bundled element set is in use ([elements] use_bundled = false in {config_file(config)} "
              "turns it off); `nfwserver elements update FILE|URL` stores current sets")
     return 0
 
@@ -232,7 +223,6 @@ def _confirm(question: str) -> bool:
 
 
 def run_prune(args: argparse.Namespace) -> int:
-    from nfwserver.cli import CliError
 
     config = _config(args)
     store = _store(config)
@@ -241,7 +231,7 @@ def run_prune(args: argparse.Namespace) -> int:
     keep = _protected(config)
     plan = store.plan_prune(datetime.now(timezone.utc), args.days, frozenset(keep))
     for es in plan.protected:
-        _say(f"kept {es.catalog_number} {es.name}: {keep[es.catalog_number]}")
+        say(f"kept {es.catalog_number} {es.name}: {keep[es.catalog_number]}")
     removed = plan.removed
     if args.dry_run:
         for es in removed:
@@ -259,14 +249,14 @@ def run_prune(args: argparse.Namespace) -> int:
         if not sys.stdin.isatty():
             raise CliError(f"pruning would remove {what}; give --yes to confirm (--dry-run lists them)")
         if not _confirm(f"remove {what}?"):
-            _say("nothing removed")
+            say("nothing removed")
             return 1
     try:
         kept = store.apply_prune(plan)
     except OSError as exc:
         raise CliError(f"cannot write {store.path}: {exc.strerror or exc}") from None
     for es in plan.decayed:
-        _say(f"removed {es.catalog_number} {es.name}: decayed")
+        say(f"removed {es.catalog_number} {es.name}: decayed")
     print(f"removed {len(plan.decayed)} decayed and {len(plan.old)} older than {args.days:g} days; "
           f"{kept} sets remain in {store.path}")
     return 0

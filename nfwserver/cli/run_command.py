@@ -19,8 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from nfwserver.cli import say
 from nfwserver.cli.control_file import ControlFile, control_path
+from nfwserver.cli.errors import CliError, load_config_or_fail, say
 from nfwserver.cli.signals import StationSignals, signal_actions
 from nfwserver.cli.station_channel import StationChannel, StationInfo
 from nfwserver.cli.station_runner import run_console, serve_headless, start_report
@@ -89,13 +89,9 @@ class RunPlan:
 
 
 def run(args: argparse.Namespace) -> int:
-    from nfwserver.cli import CliError
-    from nfwserver.config import ConfigError, default_config_path, load_config
+    from nfwserver.config import default_config_path
 
-    try:
-        config = load_config(args.config)
-    except ConfigError as exc:
-        raise CliError(f"configuration refused: {exc}") from None
+    config = load_config_or_fail(args.config)
     if args.duration is not None and not args.duration > 0:
         raise CliError("--duration must be positive")
     if getattr(args, "web", False) and not config.web.enabled:
@@ -229,7 +225,6 @@ def serve(config: Config, plan: RunPlan, watch: str | None = None) -> int:
     Without ``plan.stop``, signals and the control file stop it or reload its configuration
     (:mod:`nfwserver.cli.signals`), from before the station starts until it has stopped."""
     from nfwserver.app.station import Station
-    from nfwserver.cli import CliError
     from nfwserver.cli.log_file import LOG_BACKOFF
 
     clock = plan.clock or SystemClock()

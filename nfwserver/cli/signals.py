@@ -26,6 +26,8 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
+from nfwserver.core.service_thread import ServiceThread
+
 log = logging.getLogger("nfwserver")
 
 STOP = "stop"
@@ -47,7 +49,7 @@ def signal_actions(headless: bool) -> dict[signal.Signals, str]:
     return actions
 
 
-class StationSignals:
+class StationSignals(ServiceThread):
     """Calls ``on_stop()`` or ``on_reload()`` for each signal of ``actions`` (see the module docstring).
 
     Owned by the main thread (:meth:`install`, :meth:`stopping`, :meth:`close`); the actions run on the
@@ -55,16 +57,18 @@ class StationSignals:
     already stopping; :meth:`stopping` returns once no action is running any more.
     """
 
+    thread_name = "nfw-signals"
+
     def __init__(self, actions: dict[signal.Signals, str], on_stop: Callable[[], None],
                  on_reload: Callable[[], None]) -> None:
+        super().__init__()
         self.actions = actions
         self._calls = {STOP: on_stop, RELOAD: on_reload}
         self._installed: list[signal.Signals] = []
         self._lock = threading.Lock()
         self._stopping = False
         self._read_fd, self._write_fd = os.pipe()
-        self._thread = threading.Thread(target=self._run, name="nfw-signals", daemon=True)
-        self._thread.start()
+        self.start()  # reads the pipe the handlers write to, from now on
 
     def install(self) -> bool:
         """Install the handlers; False (nothing installed) off the main thread, as when embedded."""
@@ -126,6 +130,6 @@ class StationSignals:
         for sig in self._installed:
             signal.signal(sig, signal.SIG_IGN)
         self._installed.clear()
-        os.close(self._write_fd)
-        self._thread.join(2.0)
+        os.close(self._write_fd)  # the thread reads the end of the pipe and returns
+        self.stop()
         os.close(self._read_fd)

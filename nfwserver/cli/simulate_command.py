@@ -9,8 +9,8 @@ empty string).  ``--link`` watches any served item, the Orbitron, WXtrack and Sa
 included.  Pokes are scheduled with ``--poke 120:SAT=25544`` (sent 120 s in); ``TUNE ON`` is poked
 at the start unless the first TUNE command among the ``--poke`` options is ``TUNE ON`` or is sent at
 0 s (so ``--poke 60:"TUNE OFF"`` shows the feed stopping, and ``--poke 30:"TUNE ON"`` what a client
-gets before it).  Each ``--poke`` is checked with the command table as a DDE client's poke, and what
-it did is said on stderr (:mod:`nfwserver.cli.simulate_pokes`).  The dialects take no pokes (their
+gets before it).  Each ``--poke`` is sent as given, whatever it holds, and what the server did with
+it is said on stderr (:mod:`nfwserver.cli.simulate_pokes`).  The dialects take no pokes (their
 clients never send any), so on a dialect link the commands go to the server directly.
 """
 
@@ -21,7 +21,8 @@ import logging
 import sys
 
 from nfwserver.cli.arguments import number_in, satellite_value, time_value
-from nfwserver.cli.simulate_pokes import MAX_DURATION_S, observe_poke, poke_value
+from nfwserver.cli.errors import CliError, say
+from nfwserver.cli.simulate_pokes import MAX_DURATION_S, commands_of, observe_poke, poke_value
 from nfwserver.cli.simulated_clients import CLIENTS, Link, SimulatedClient, parse_link
 from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs
 from nfwserver.clock import VirtualClock
@@ -65,10 +66,11 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
                    help=f"publish rate, {MIN_RATE_HZ:g}-{MAX_RATE_HZ:g} Hz (default 5)")
     p.add_argument("--sat", type=satellite_value, metavar="CATNR|NAME",
                    help="initial AutoTracking satellite (default: [server] satellite)")
-    p.add_argument("--poke", type=poke_value, action="append", default=[], metavar="[SECONDS:]COMMAND",
-                   help="poke sent by the client at that offset (default 0), one of Nova's commands as a DDE client "
-                        "sends it; repeatable; what it did is printed on stderr. A first TUNE command that is "
-                        "TUNE ON, or is sent at 0 s, replaces the automatic TUNE ON at the start")
+    p.add_argument("--poke", type=poke_value, action="append", default=[], metavar="[SECONDS:]TEXT",
+                   help="poke sent by the client at that offset (default 0): any text, sent as it is (a command the "
+                        "server refuses too); repeatable; what the server did with it is printed on stderr. A "
+                        "first TUNE command that is TUNE ON, or is sent at 0 s, replaces the automatic TUNE ON at "
+                        "the start")
     p.add_argument("--client", choices=CLIENTS, default="hot",
                    help="transaction pattern: hot (hot advise, default), warm (warm advise), wisp (poke, request "
                         "every --poll s, re-poke when AH: is missing), delphi (warm link + request per "
@@ -84,18 +86,20 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
 
 def _client_tunes(pokes: list[tuple[float, str]]) -> bool:
     """True when the first TUNE command among ``pokes`` (sorted by offset) is TUNE ON or is sent at the start:
-    the user then decides when the feed starts, and no TUNE ON is poked for them."""
-    tunes = [(offset, command.upper().split()) for offset, command in pokes
-             if command.upper().split()[:1] == ["TUNE"]]
-    return bool(tunes) and (tunes[0][1][1:] == ["ON"] or tunes[0][0] == 0)
+    the user then decides when the feed starts, and no TUNE ON is poked for them.  The pokes are read as the
+    server reads them (a poke it refuses switches nothing)."""
+    tunes = [(offset, parsed.value) for offset, command in pokes for parsed in commands_of(command)
+             if parsed.command.word == "TUNE"]
+    return bool(tunes) and (tunes[0][1] is True or tunes[0][0] == 0)
 
 
-def _has_sat(pokes: list[tuple[float, str]]) -> float | None:
-    return next((offset for offset, command in pokes if command.upper().replace(" ", "").startswith("SAT=")), None)
+def _first_sat(pokes: list[tuple[float, str]]) -> float | None:
+    """The offset of the first poke holding a ``SAT=`` the server parses."""
+    return next((offset for offset, command in pokes
+                 if any(parsed.command.word == "SAT" for parsed in commands_of(command))), None)
 
 
 def run(args: argparse.Namespace) -> int:
-    from nfwserver.cli import CliError
 
     pokes = sorted(args.poke, key=lambda p: p[0])
     late = [command for offset, command in pokes if offset > args.duration]
@@ -113,17 +117,16 @@ def run(args: argparse.Namespace) -> int:
         origin = "--sat" if args.sat is not None else "[server] satellite"
         if args.sat is not None:
             raise CliError(f"satellite {wanted} is not in the catalog")
-        print(f"nfwserver: {origin} {wanted} is not in the catalog", file=sys.stderr)
+        say(f"{origin} {wanted} is not in the catalog")
     if sat is not None:
         server.select_satellite(sat.catalog_number, source="simulate")
     else:
-        sat_poke = _has_sat(pokes)
+        sat_poke = _first_sat(pokes)
         if sat_poke is None:
-            print("nfwserver: no --sat given and no [server] satellite in the catalog: no AutoTracking satellite, "
-                  "so nothing is published", file=sys.stderr)
+            say("no --sat given and no [server] satellite in the catalog: no AutoTracking satellite, so nothing is "
+                "published")
         elif sat_poke > 0:
-            print(f"nfwserver: no satellite until the SAT= poke at {sat_poke:g} s: nothing is published before it",
-                  file=sys.stderr)
+            say(f"no satellite until the SAT= poke at {sat_poke:g} s: nothing is published before it")
     auto_tune = not _client_tunes(pokes)
     return _simulate(args, server, clock, pokes, auto_tune)
 
@@ -191,7 +194,7 @@ def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock
             try:
                 client.start()
             except DdeError as exc:
-                print(f"nfwserver: {link}: {exc}", file=sys.stderr)
+                say(f"{link}: {exc}")
 
     try:
         run_virtual(server, clock, args.duration, before_tick=before_tick)

@@ -1,11 +1,10 @@
-"""``nfwserver simulate --poke``: checking a scheduled poke with the command table, and saying what it did.
+"""``nfwserver simulate --poke``: a scheduled poke, sent as given, and what the server did with it.
 
-A ``--poke [SECONDS:]COMMAND`` stands for a poke the simulated DDE client sends, so it is parsed as the DDE
-face parses it (:func:`nfwserver.commands.parsing.parse_poke_line` with :attr:`Face.DDE`): a command the
-table does not take is a usage error naming the table's reason.  When the poke is sent, the station core's
-answer (accepted, refused and why, accepted with a note or a warning) and the change it made to the live
-state are reported as one line, e.g. ``t+60 s  poke 'TUNE OFF': accepted; feed off``; offsets are virtual
-seconds from ``--start``.
+A ``--poke [SECONDS:]TEXT`` stands for a poke the simulated DDE client sends: any text, sent as it is, so a
+bad command, a poke of several lines or one with non-ASCII digits shows how the server answers it.  When
+the poke is sent, the station core's answer (accepted, refused and why, accepted with a note or a warning)
+and the change it made to the live state are reported as one line, e.g.
+``t+60 s  poke 'TUNE OFF': accepted; feed off``; offsets are virtual seconds from ``--start``.
 """
 
 from __future__ import annotations
@@ -14,8 +13,8 @@ import argparse
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from nfwserver.commands.parsing import parse_poke_line
-from nfwserver.commands.table import CommandError, Face
+from nfwserver.commands.parsing import Parsed, parse_request
+from nfwserver.commands.table import Face
 from nfwserver.core.events import Direction, Event
 from nfwserver.core.state import StateSnapshot
 from nfwserver.core.station_core import StationCore
@@ -25,23 +24,25 @@ MAX_DURATION_S = 30 * 86400.0
 
 
 def poke_value(text: str) -> tuple[float, str]:
-    """``type=`` for ``--poke``: ``[SECONDS:]COMMAND`` with a non-negative offset and a command the DDE face
-    takes (checked with the command table)."""
+    """``type=`` for ``--poke``: ``[SECONDS:]TEXT``.  Whatever follows the offset is sent as it is (a command
+    the server refuses too, or several lines); only the offset is checked here.  Without a ':' the whole text
+    is the poke, sent at 0 s."""
     offset, sep, command = text.partition(":")
     if not sep:
-        offset, command = "0", text
+        return 0.0, text
     try:
         seconds = float(offset)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: the offset before ':' must be seconds, e.g. 120:SAT=25544"
-                                         ) from None
-    if not 0 <= seconds <= MAX_DURATION_S or not command.strip():
-        raise argparse.ArgumentTypeError(f"{text!r}: give a command after an offset of 0 to {MAX_DURATION_S:.0f} s")
-    try:
-        parse_poke_line(command, Face.DDE)
-    except CommandError as exc:
-        raise argparse.ArgumentTypeError(f"{text!r}: {exc} (a DDE client's poke)") from None
-    return seconds, command.strip()
+        raise argparse.ArgumentTypeError(f"{text!r}: the offset before ':' must be seconds, e.g. 120:SAT=25544 "
+                                         "(0:TEXT sends a TEXT holding ':' at the start)") from None
+    if not 0 <= seconds <= MAX_DURATION_S:
+        raise argparse.ArgumentTypeError(f"{text!r}: the offset must be 0 to {MAX_DURATION_S:.0f} s")
+    return seconds, command
+
+
+def commands_of(command: str) -> tuple[Parsed, ...]:
+    """The station commands a poke of ``command`` holds, as the DDE face parses it (none when it refuses it)."""
+    return parse_request(command, Face.DDE).commands
 
 
 @dataclass(frozen=True)

@@ -58,7 +58,7 @@ class SimulatedClient:
     """One client conversation playing ``kind``'s pattern; driven by :meth:`start` and :meth:`after_tick`."""
 
     def __init__(self, kind: str, conversation: ClientConversation, item: str, emit: Emit,
-                 poll_s: float | None = None, on_refused: Callable[[str, DdeError], None] | None = None) -> None:
+                 poll_s: float | None = None) -> None:
         if kind not in CLIENTS:
             raise ValueError(f"client must be one of {', '.join(CLIENTS)}")
         self.kind = kind
@@ -66,7 +66,6 @@ class SimulatedClient:
         self.item = item
         self.emit = emit
         self.poll_s = poll_s if poll_s is not None else DEFAULT_POLL_S.get(kind)
-        self.on_refused = on_refused
         self._next_request: float | None = None
         conversation.on_receive = self._received
 
@@ -92,13 +91,11 @@ class SimulatedClient:
             self._next_request += self.poll_s  # type: ignore[operator]  # set only when poll_s is (start)
 
     def poke(self, command: str) -> bool:
-        """Poke ``command`` to the item; reported as a ``poke`` transaction (and to ``on_refused``)."""
+        """Poke ``command`` to the item; reported as a ``poke`` transaction."""
         try:
             self.conversation.poke(self.item, command)
-        except DdeError as exc:
+        except DdeError:
             self.emit("poke", f"{command} (refused)")
-            if self.on_refused is not None:
-                self.on_refused(command, exc)
             return False
         self.emit("poke", command)
         return True

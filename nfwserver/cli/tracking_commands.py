@@ -18,7 +18,8 @@ from datetime import datetime, timedelta
 from typing import TYPE_CHECKING, Any
 
 from nfwserver.cli.arguments import number_in, satellite_value, time_value
-from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs, warn
+from nfwserver.cli.errors import CliError, say
+from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs
 
 if TYPE_CHECKING:
     from nfwserver.cli.tracking_options import TrackingInputs
@@ -88,7 +89,6 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
 
 def _pick(catalog: Catalog, text: str) -> Satellite:
     """The satellite ``text`` names (catalog number, DDE or element name); CliError when absent."""
-    from nfwserver.cli import CliError
 
     sat = catalog.find(text)
     if sat is None:
@@ -118,7 +118,7 @@ def _report_unusable(unusable: list[Any], names: Mapping[int, str], at: datetime
     naming up to five by DDE name (``names``, by catalog number)."""
     if unusable:
         shown = ", ".join(names[s.catalog_number] for s in unusable[:5]) + (", ..." if len(unusable) > 5 else "")
-        warn(f"skipped {len(unusable)} object(s) whose position at {format_time(at)} cannot be computed "
+        say(f"skipped {len(unusable)} object(s) whose position at {format_time(at)} cannot be computed "
              f"or is implausibly far (decayed or elements far outside their validity): {shown}")
 
 
@@ -130,8 +130,8 @@ def _report_stale(stale: list[Any], names: Mapping[int, str], at: datetime, stal
         span = f"{min(ages):.0f} to {max(ages):.0f}" if round(min(ages)) != round(max(ages)) else f"{max(ages):.0f}"
         sets, drift = ("1 element set is", "its position drifts") if len(stale) == 1 else \
             (f"{len(stale)} element sets are", "their positions drift")
-        warn(f"{sets} {span} days old at {format_time(at)} (more than [elements] stale_days, {stale_days:g}), "
-             f"so {drift} ({shown}); `nfwserver elements update` fetches newer ones")
+        say(f"{sets} {span} days old at {format_time(at)} (more than [elements] stale_days, {stale_days:g}), "
+            f"so {drift} ({shown}); `nfwserver elements update` fetches newer ones")
 
 
 def _stale_days(inputs: TrackingInputs) -> float:
@@ -152,7 +152,6 @@ def _dde_name_map(items: list[Any], catalog: Catalog, more: Sequence[int] = ()) 
 def run_ephemeris(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from nfwserver.cli import CliError
     from nfwserver.cli.bulk_output import RowWriter
     from nfwserver.cli.output_columns import Flag, Number, Time
     from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError
@@ -175,7 +174,7 @@ def run_ephemeris(args: argparse.Namespace) -> int:
             try:
                 la = calc.compute(sat.satrec, when)
             except PropagationError as exc:
-                print(f"nfwserver: {format_time(when)}: {exc}", file=sys.stderr)
+                say(f"{format_time(when)}: {exc}")
                 continue
             offsets.append(k * args.step)
             rows.append((la.azimuth_deg, la.elevation_deg, la.range_km, la.range_rate_km_s,
@@ -207,7 +206,7 @@ def run_passes(args: argparse.Namespace) -> int:
     if args.format == "table" and not args.wide:
         if not len(cols["catalog_number"]):
             reach = f" reaching {args.min_el:g} deg" if args.min_el else ""
-            warn(f"no passes{reach} of the {searched} satellite(s) in the {args.hours:g} h from "
+            say(f"no passes{reach} of the {searched} satellite(s) in the {args.hours:g} h from "
                  f"{format_time(start)}")
         write_rows(compact_columns(start, cols, [short_names[n] for n in numbers.tolist()], which, args.local),
                    "table", sys.stdout)
@@ -266,7 +265,6 @@ def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str], di
 def _chosen_sets(args: argparse.Namespace, inputs: TrackingInputs, catalog: Catalog) -> list[Any]:
     """The element sets ``passes`` searches: --sat, --group, --favourites; else the configured favourites
     (when there are some and no --elements file or --all was given); else the whole catalog."""
-    from nfwserver.cli import CliError
     from nfwserver.cli.pass_table import matching_names
 
     chosen: dict[int, Any] = {}
@@ -285,7 +283,7 @@ def _chosen_sets(args: argparse.Namespace, inputs: TrackingInputs, catalog: Cata
             raise CliError("no favourites configured: list catalog numbers in [satellites] favourites")
         present = [n for n in favourites if catalog.get(n) is not None]
         if default_favourites and present:
-            warn(f"passes of your {len(present)} favourite(s) ([satellites] favourites); --all for every "
+            say(f"passes of your {len(present)} favourite(s) ([satellites] favourites); --all for every "
                  "satellite")
         chosen.update((n, catalog.get(n)) for n in present)
     if not chosen and not (args.sat or args.group or args.favourites):

@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import argparse
 import logging
-import sys
 from datetime import datetime, timezone
 from functools import cached_property
 from typing import TYPE_CHECKING
 
 from nfwserver.cli.arguments import number_in, observer_value, parse_time_text
+from nfwserver.cli.errors import CliError, load_config_or_fail, say
 
 if TYPE_CHECKING:  # imported when the options are resolved: `--help` and parsing stay light
     from nfwserver.config import Config
@@ -44,7 +44,6 @@ class TrackingInputs:
 
     @cached_property
     def _given_observer(self) -> Observer | None:
-        from nfwserver.cli import CliError
         from nfwserver.tracking.observer import parse_observer
 
         observer = getattr(self._args, "observer", None)
@@ -58,7 +57,6 @@ class TrackingInputs:
     @cached_property
     def horizon(self) -> HorizonTable:
         """``--horizon``, else flat with ``--observer``, else the configured table."""
-        from nfwserver.cli import CliError
         from nfwserver.config.files import read_regular_file
         from nfwserver.tracking.horizon import HorizonTable, parse_horizon
 
@@ -85,7 +83,7 @@ class TrackingInputs:
             config = self.config()
             observer = config.observer
             if not config.observer_configured:
-                warn(f"no observer configured: using {observer}; set [observer] location in {config_file(config)} "
+                say(f"no observer configured: using {observer}; set [observer] location in {config_file(config)} "
                      "(`nfwserver config init` writes a starting file) or give --observer")
         return observer
 
@@ -154,11 +152,6 @@ def format_time(when: datetime) -> str:
             f"{when.second:02d}.{when.microsecond // 1000:03d}Z")
 
 
-def warn(message: str) -> None:
-    """One diagnostic line on stderr."""
-    print(f"nfwserver: {message}", file=sys.stderr)
-
-
 def config_file(config: Config) -> str:
     """The configuration file ``config`` came from, or the file the user would create."""
     if not config.source.startswith("<"):
@@ -169,60 +162,49 @@ def config_file(config: Config) -> str:
 
 
 def _load_config(args: argparse.Namespace) -> Config:
-    from nfwserver.cli import CliError
-    from nfwserver.config import ConfigError, load_config
 
-    try:
-        return load_config(getattr(args, "config", None))
-    except ConfigError as exc:
-        raise CliError(f"configuration refused: {exc}") from None
+    return load_config_or_fail(getattr(args, "config", None))
 
 
 def _catalog_from_files(paths: list[str], inputs: TrackingInputs) -> Catalog:
-    from nfwserver.app.element_sources import SourceError, read_file
+    """The sets of the ``--elements`` files, read and checked as the station reads its element files
+    (:func:`~nfwserver.app.element_sources.read_file` and :func:`~nfwserver.app.element_sources.parse_source`:
+    regular files only, size and set limits, no binary data); a file without sets is named and left out, and
+    none at all is a :class:`CliError` naming each file's reason."""
+    from nfwserver.app.element_sources import SourceError, parse_source, read_file
     from nfwserver.app.station_catalog import source_limits
-    from nfwserver.cli import CliError
     from nfwserver.tracking.catalog import Catalog
-    from nfwserver.tracking.elements import load_elements
 
     limits = source_limits(inputs.config().elements)
     sets = []
-    empty: list[str] = []  # why each file gave no set
+    unusable: list[str] = []  # why each file gave no set
     for path in paths:
         try:
             data = read_file(path, limits)
-            result = load_elements(data, source=path)
         except SourceError as exc:
             raise CliError(str(exc)) from None
-        if len(result.sets) > limits.max_sets:
-            raise CliError(str(limits.too_many(path)))
+        try:
+            result = parse_source(data, path, limits)
+        except SourceError as exc:
+            unusable.append(str(exc))
+            continue
         for rejection in result.rejected:
-            warn(f"skipped element set: {rejection}")
-        if not result.sets:
-            empty.append(_why_no_sets(path, data, len(result.rejected)))
+            say(f"skipped element set: {rejection}")
         sets.extend(result.sets)
         del result, data
     if not sets:
-        raise CliError("no usable element sets: " + "; ".join(empty))
+        raise CliError("no usable element sets: " + "; ".join(unusable))
+    for reason in unusable:
+        say(f"left out: {reason}")
     return Catalog(sets, dde_names=inputs.config().dde_names)
-
-
-def _why_no_sets(path: str, data: bytes | str, refused: int) -> str:
-    """One clause saying why ``path`` gave no element set: empty, every set refused, or no set found."""
-    if not data.strip():
-        return f"{path} is empty"
-    if refused:
-        return f"{path}: its {refused} set(s) were refused (reasons above)"
-    return f"{path} holds no TLE, AMSAT or OMM (JSON or CSV) element set"
 
 
 def _station_catalog(config: Config) -> Catalog:
     from nfwserver.app.station_catalog import configured_store, load_station_catalog
-    from nfwserver.cli import CliError
 
     catalog, fetched = load_station_catalog(config)
     for problem in fetched.failed:
-        warn(f"element source unavailable: {problem}")
+        say(f"element source unavailable: {problem}")
     if not len(catalog):
         store = configured_store(config)
         where = f"the stored catalog {store.path} is empty" if store is not None else "no stored catalog"

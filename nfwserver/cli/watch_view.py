@@ -13,16 +13,12 @@ from dataclasses import dataclass, field
 from datetime import datetime
 
 from nfwserver.core.status import describe
+from nfwserver.tcp.status_line import parse_status as parse_status  # the one STATUS codec
 
 #: STATUS fields turned into JSON numbers and booleans (the rest stay strings).
 _FLOATS = ("az", "el", "rr", "elements_age_d", "rotor_az", "rotor_el")
 _INTS = ("satellite", "interface", "radio_rx", "radio_tx")
 _SWITCHES = ("tune", "track", "radio_tuning")
-
-
-def parse_status(line: str) -> dict[str, str]:
-    """The ``key=value`` pairs of a STATUS line (words without ``=`` are ignored)."""
-    return dict(word.split("=", 1) for word in line.split() if "=" in word)
 
 
 @dataclass(frozen=True)

@@ -22,7 +22,7 @@ from nfwserver.commands.table import (
     commands_for,
 )
 
-__all__ = ["Parsed", "clean_command_text", "parse_line", "parse_poke", "parse_poke_line"]
+__all__ = ["Parsed", "Request", "clean_command_text", "parse_line", "parse_poke", "parse_poke_line", "parse_request"]
 
 
 @dataclass(frozen=True)
@@ -36,6 +36,23 @@ class Parsed:
         """The station command (only for entries whose target is the station)."""
         # the entry's grammar checked the value, of the type Poke takes for that kind
         return Poke(PokeKind(self.command.word), self.value)  # type: ignore[arg-type]
+
+
+@dataclass(frozen=True)
+class Request:
+    """What a face received, parsed once: the commands in it, or why it is not a command."""
+
+    text: str  #: as received
+    face: Face
+    commands: tuple[Parsed, ...]  #: empty when refused
+    error: CommandError | None = None
+
+    @property
+    def target(self) -> Target:
+        """What the text acts on: its entry's target, the station's when no entry is known (a station
+        command's refusal is the station's to count and explain)."""
+        entry = self.commands[0].command if self.commands else (self.error.command if self.error else None)
+        return entry.target if entry is not None else Target.STATION
 
 
 def clean_command_text(text: str) -> str:
@@ -77,9 +94,30 @@ def parse_poke_line(line: str, face: Face = Face.DDE) -> Poke:
 
 def parse_poke(text: str, face: Face = Face.DDE) -> list[Poke]:
     """Nova's station commands in ``text``, one per line; raises :class:`CommandError` unless all parse."""
+    return [parse_poke_line(line, face) for line in _station_lines(text)]
+
+
+def _station_lines(text: str) -> list[str]:
     if len(text) > 4 * MAX_COMMAND_LENGTH:
         raise CommandError(f"poke of {len(text)} characters is too long")
     lines = [p for p in re.split(r"[\r\n\x00]+", text) if clean_command_text(p)]
     if not lines:
         raise CommandError("empty poke")
-    return [parse_poke_line(line, face) for line in lines]
+    return lines
+
+
+def parse_request(text: str, face: Face) -> Request:
+    """``text`` as ``face`` sends it, parsed once; never raises.
+
+    A DDE poke or execute holds Nova's station commands, one per line (CR, LF or NUL between them), all
+    parsed before any is taken; the other faces send one command, of any target the face may use (several
+    lines from them are read as a DDE poke is)."""
+    try:
+        lines = _station_lines(text)
+        if face is Face.DDE or len(lines) > 1:
+            parsed = tuple(parse_line(line, face, Target.STATION) for line in lines)
+        else:
+            parsed = (parse_line(text, face),)
+    except CommandError as exc:
+        return Request(text, face, (), exc)
+    return Request(text, face, parsed)

@@ -3,10 +3,11 @@
 In the spirit of Hamlib's ``rotctl_parse.c``: each :class:`Command` is one entry holding its grammar
 (a whole-line regular expression, keywords in any case, blanks allowed around ``=``), the faces that
 may send it (:class:`Face`), what it acts on (:class:`Target`: the station core, the TCP session, the
-rotor, the console's display), how its argument is checked and converted, and its reply.  The
+rotor, the console's display), how its argument is checked and converted, its reply, and its action
+(:mod:`nfwserver.commands.actions`, run by the station core whichever face sent the command).  The
 parser (:mod:`nfwserver.commands.parsing`), ``HELP`` on TCP, the console's help line,
 ``nfwserver poke --help`` and ``docs/COMMANDS.md`` (:mod:`nfwserver.commands.help_text`) all read
-this table; a new command is one entry here plus its handler on the target.
+this table; a new command is one entry here plus its action.
 
 Numbers are ASCII digits only (``SAT=²`` is refused, never half-read).
 """
@@ -17,7 +18,10 @@ import enum
 import math
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+from nfwserver.commands import actions
+from nfwserver.commands.actions import Action
 
 __all__ = ["COMMANDS", "Command", "CommandError", "Face", "Poke", "PokeKind", "Target", "escape_for_log"]
 
@@ -102,6 +106,8 @@ class Command:
     target: Target
     #: the checked argument from the match (may raise :class:`CommandError`); None for no argument
     convert: Callable[[re.Match[str], Face], object] = lambda match, face: None
+    #: what it does (:mod:`nfwserver.commands.actions`), run by the station core for every face
+    action: Action = field(kw_only=True)
 
     def match(self, text: str) -> re.Match[str] | None:
         return re.fullmatch(self.grammar, text, re.IGNORECASE | re.ASCII)
@@ -156,46 +162,49 @@ _STATION_REPLY = ("DDE: acknowledged, or refused (DDE_FNOTPROCESSED) with the re
 COMMANDS: tuple[Command, ...] = (
     Command("TUNE", r"TUNE\s+(ON|OFF)", "TUNE ON|OFF", "TUNE ON|OFF", "ON or OFF",
             "switch the Nova string feed on or off (DDE advise loops, requests, TCP WATCH and SUMMARY)",
-            _STATION_REPLY, Face.ALL, Target.STATION, _on),
+            _STATION_REPLY, Face.ALL, Target.STATION, _on, action=actions.tune),
     Command("TRACK", r"TRACK\s+(ON|OFF)", "TRACK ON|OFF", "TRACK ON|OFF", "ON or OFF",
             "switch rotor tracking on or off (TRACK ON needs a station and a satellite; without a rotor it is "
             "accepted with a warning)",
             _STATION_REPLY + " (OK warning: <why nothing turns> when the station has no rotor)",
-            Face.ALL, Target.STATION, _on),
+            Face.ALL, Target.STATION, _on, action=actions.track),
     Command("SAT", r"SAT\s*=\s*(.*?)", "SAT=<catalog number>", "SAT=n", "=<catalog number>",
             "select the satellite to track by catalog number; on TCP and the console also by a name that "
             "matches one satellite only; refused when unknown or not computable now",
-            _STATION_REPLY, Face.ALL, Target.STATION, _satellite),
+            _STATION_REPLY, Face.ALL, Target.STATION, _satellite, action=actions.satellite),
     Command("ANTAZ", r"ANTAZ\s*=\s*(\S*)", "ANTAZ=<degrees>", "ANTAZ=deg", "=<degrees>",
             "report the antenna azimuth (-360..720 degrees), as a client with its own rotor read-back does",
-            _STATION_REPLY, Face.ALL, Target.STATION, _degrees("ANTAZ", -360.0, 720.0)),
+            _STATION_REPLY, Face.ALL, Target.STATION, _degrees("ANTAZ", -360.0, 720.0),
+            action=actions.antenna_azimuth),
     Command("ANTEL", r"ANTEL\s*=\s*(\S*)", "ANTEL=<degrees>", "ANTEL=deg", "=<degrees>",
             "report the antenna elevation (-90..180 degrees)",
-            _STATION_REPLY, Face.ALL, Target.STATION, _degrees("ANTEL", -90.0, 180.0)),
+            _STATION_REPLY, Face.ALL, Target.STATION, _degrees("ANTEL", -90.0, 180.0),
+            action=actions.antenna_elevation),
     Command("SUMMARY", r"SUMMARY", "SUMMARY", "SUMMARY", "nothing after it",
             "the Nova string being published (an empty line while the feed is off or nothing can be computed)",
-            "one line", Face.TCP, Target.SESSION),
+            "one line", Face.TCP, Target.SESSION, action=actions.summary),
     Command("STATUS", r"STATUS", "STATUS", "STATUS", "nothing after it",
             "the station's state as key=value pairs: satellite, tune, track, status word, position, faults, "
-            "devices", "one line", Face.TCP, Target.SESSION),
+            "devices", "one line", Face.TCP, Target.SESSION, action=actions.status),
     Command("WATCH", r"WATCH", "WATCH", "WATCH", "nothing after it",
             "stream every published Nova string until the client sends a line (that line ends the stream "
             "and is not executed)", "OK, then one line per published string; OK again for the line that ends it",
-            Face.TCP, Target.SESSION),
+            Face.TCP, Target.SESSION, action=actions.watch),
     Command("HELP", r"HELP", "HELP", "HELP", "nothing after it",
             "list the commands this face takes", "one line per command (TCP: then OK)", Face.TCP | Face.CONSOLE,
-            Target.SESSION),
+            Target.SESSION, action=actions.show_help),
     Command("QUIT", r"QUIT", "QUIT", "QUIT", "nothing after it", "close the connection", "OK, then the server closes",
-            Face.TCP, Target.SESSION),
+            Face.TCP, Target.SESSION, action=actions.quit_session),
     Command("FLIP", r"FLIP(?:\s+(\S+))?", "FLIP AUTO|ON|OFF", "FLIP AUTO|ON|OFF", "AUTO, ON or OFF",
             "FlipAnts' inverted (flip) tracking: forced on, off, or chosen per pass (auto)",
-            "OK, or ERROR no rotor is configured", Face.TCP | Face.CONSOLE | Face.WEB, Target.ROTOR, _flip_mode),
+            f"OK, or ERROR {actions.NO_ROTOR}", Face.TCP | Face.CONSOLE | Face.WEB, Target.ROTOR, _flip_mode,
+            action=actions.flip),
     Command("PARK", r"PARK", "PARK", "PARK", "nothing after it",
             "stop tracking (as TRACK OFF) and send the rotor to its park position ([rotor] park_azimuth_deg and "
-            "park_elevation_deg); TRACK ON resumes", "OK, or ERROR no rotor is configured",
-            Face.TCP | Face.CONSOLE | Face.WEB, Target.ROTOR),
+            "park_elevation_deg); TRACK ON resumes", f"OK, or ERROR {actions.NO_ROTOR}",
+            Face.TCP | Face.CONSOLE | Face.WEB, Target.ROTOR, action=actions.park),
     Command("Z", r"Z", "Z", "Z", "nothing after it", "show times in UTC or in the local zone",
-            "a note in the console", Face.CONSOLE, Target.DISPLAY),
+            "a note in the console", Face.CONSOLE, Target.DISPLAY, action=actions.toggle_zone),
 )
 
 

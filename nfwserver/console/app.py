@@ -34,10 +34,10 @@ from textual.containers import Horizontal, Vertical
 from textual.css.query import NoMatches
 from textual.widgets import Footer, Input, RichLog, Static
 
-from nfwserver.commands.help_text import help_lines
-from nfwserver.commands.parsing import parse_line
-from nfwserver.commands.rotor_commands import NO_ROTOR, run_rotor_command
-from nfwserver.commands.table import CommandError, Face, Target
+from nfwserver.commands.actions import NO_ROTOR
+from nfwserver.commands.parsing import parse_request
+from nfwserver.commands.table import Face, Target, escape_for_log
+from nfwserver.console.command_port import ConsolePort
 from nfwserver.console.pass_view import STALE_DAYS, PassSearch, next_pass_text, pass_table, search_passes
 from nfwserver.console.picker import SatellitePicker
 from nfwserver.console.reflow_log import ReflowLog
@@ -56,7 +56,6 @@ from nfwserver.console.state_view import (
 from nfwserver.console.time_display import TimeDisplay
 from nfwserver.core.events import Direction, Event
 from nfwserver.core.faces import CountsClients, WritesLines
-from nfwserver.core.nova_protocol import escape_for_log
 from nfwserver.core.station_core import StationCore
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.rotor.coupling import FLIP_MODES, RotorCoupling
@@ -118,6 +117,7 @@ class NfwConsole(App[None]):
         self.failure: BaseException | None = None  #: the exception that stopped the console, if one did
         self._queue: collections.deque[Event] = collections.deque(maxlen=2000)
         self._lock = threading.Lock()
+        self._port = ConsolePort(self._note, self.action_toggle_zone)  #: HELP's and Z's target
         self._unsubscribe: Callable[[], None] | None = None
         self._search: PassSearch | None = None
         self._search_key: tuple[Any, ...] | None = None
@@ -273,37 +273,23 @@ class NfwConsole(App[None]):
     def on_input_submitted(self, message: Input.Submitted) -> None:
         text = message.value.strip()
         message.input.value = ""
-        if not text:
-            return
-        try:
-            parsed = parse_line(text, Face.CONSOLE)
-        except CommandError as exc:  # the core records and explains station commands' refusals
-            if exc.command is not None and exc.command.target is Target.ROTOR and self.rotor is None:
-                self._note(f"{NO_ROTOR} ([rotor] backend), so there is no rotor to command")
-            elif exc.command is not None and exc.command.target is not Target.STATION:
-                self._note(str(exc), "red")
-            else:
-                self._station_command(text)
-        else:
-            target = parsed.command.target
-            if target is Target.DISPLAY:
-                self.action_toggle_zone()
-            elif target is Target.ROTOR:
-                why = run_rotor_command(parsed, self.rotor, self.core, "console")
-                if why is not None:
-                    self._note(f"{why} ([rotor] backend), so there is no rotor to command")
-            elif target is Target.SESSION:  # HELP
-                for line in help_lines(Face.CONSOLE):
-                    self._note(line, "cyan")
-            else:
-                self._station_command(text)
+        if text:
+            self._run(text)
+
+    def _run(self, text: str) -> None:
+        """Parse ``text`` as the console's and hand it to the core, which runs it through the command table
+        (the core records and explains station commands' refusals; the console notes the others')."""
+        request = parse_request(text, Face.CONSOLE)
+        result = self.core.execute(request, source="console", session=self._port, display=self._port)
+        if request.target is Target.STATION:
+            if result.warning and result.note:
+                self._note(f"warning: {result.note}")
+        elif result.note == NO_ROTOR:
+            self._note(f"{NO_ROTOR} ([rotor] backend), so there is no rotor to command")
+        elif not result.accepted:
+            self._note(result.note or "refused", "red")
         self._drain()
         self._refresh_state()
-
-    def _station_command(self, text: str) -> None:
-        result = self.core.command(text, source="console", face=Face.CONSOLE)
-        if result.warning and result.note:
-            self._note(f"warning: {result.note}")
 
     def action_pick_satellite(self) -> None:
         if isinstance(self.screen, SatellitePicker):
@@ -313,7 +299,7 @@ class NfwConsole(App[None]):
 
     def _picked(self, catalog_number: int | None) -> None:
         if catalog_number is not None:
-            self.core.command(f"SAT={catalog_number}", source="console")
+            self._run(f"SAT={catalog_number}")
         self.query_one("#poke", Input).focus()
         self._drain()
         self._refresh_state()
@@ -358,21 +344,10 @@ class NfwConsole(App[None]):
         self._refresh_state()
 
     def action_toggle_tune(self) -> None:
-        self.core.command("TUNE OFF" if self.core.snapshot().state.dde_output else "TUNE ON", source="console")
+        self._run("TUNE OFF" if self.core.snapshot().state.dde_output else "TUNE ON")
 
     def action_cycle_flip(self) -> None:
-        if self.rotor is None:
-            self._set_flip("")
-            return
+        """The next flip mode (auto, on, off), as the command ``FLIP <mode>`` typed on the input line."""
         order = list(FLIP_MODES)
-        self._set_flip(order[(order.index(self.rotor.flip_mode) + 1) % len(order)])
-
-    def _set_flip(self, mode: str) -> None:
-        if self.rotor is None:
-            self._note("no rotor is configured ([rotor] backend), so there is no flip mode to set")
-        elif mode not in FLIP_MODES:
-            self._note(f"flip mode must be one of {', '.join(FLIP_MODES)}: FLIP AUTO, FLIP ON or FLIP OFF", "red")
-        else:
-            self.rotor.set_flip_mode(mode)
-        self._drain()
-        self._refresh_state()
+        current = self.rotor.flip_mode if self.rotor is not None else order[-1]
+        self._run(f"FLIP {order[(order.index(current) + 1) % len(order)]}")

@@ -12,20 +12,12 @@ Outgoing string (one per publish tick, after ``TUNE ON``)::
 
 Incoming pokes (any item of the topic): ``TUNE ON``, ``TUNE OFF``, ``TRACK ON``, ``TRACK OFF``,
 ``SAT=<catalog number>``, ``ANTAZ=<deg>``, ``ANTEL=<deg>``: their grammar is the command table's
-(:mod:`nfwserver.commands`), re-exported here under the names the DDE side has always used.
+(:mod:`nfwserver.commands`).
 """
 
 from __future__ import annotations
 
-from nfwserver.commands.parsing import clean_command_text as clean_poke_text
-from nfwserver.commands.parsing import parse_poke, parse_poke_line
-from nfwserver.commands.table import MAX_COMMAND_LENGTH as MAX_POKE_LENGTH
-from nfwserver.commands.table import CommandError as PokeError
-from nfwserver.commands.table import Poke, PokeKind, escape_for_log
-
-__all__ = ["MAX_NAME_LENGTH", "MAX_POKE_LENGTH", "Poke", "PokeError", "PokeKind", "clean_poke_text",
-           "escape_for_log", "format_azimuth", "format_elevation", "format_nova", "format_range_rate",
-           "parse_poke", "parse_poke_line"]
+__all__ = ["MAX_NAME_LENGTH", "format_azimuth", "format_elevation", "format_nova", "format_range_rate"]
 
 MAX_NAME_LENGTH = 12
 

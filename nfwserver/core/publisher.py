@@ -16,13 +16,14 @@ from __future__ import annotations
 
 import logging
 import math
-import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from datetime import timedelta
 
 from nfwserver.clock import Clock, VirtualClock
+from nfwserver.core.service_thread import ServiceThread
 from nfwserver.core.station_core import StationCore
+from nfwserver.ratelimited_log import RateLimitedLog
 
 log = logging.getLogger(__name__)
 
@@ -44,28 +45,17 @@ class PublishStats:
             del self.lateness_s[: len(self.lateness_s) - self.keep]
 
 
-class Publisher:
+class Publisher(ServiceThread):
     """Runs ``core.tick()`` at the state's rate on a background thread (thread ``nfw-publisher``)."""
 
+    thread_name = "nfw-publisher"
+
     def __init__(self, core: StationCore, clock: Clock) -> None:
+        super().__init__()
         self.core = core
         self.clock = clock
         self.stats = PublishStats()
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
-
-    def start(self) -> None:
-        if self._thread is not None:
-            return
-        self._stop.clear()
-        self._thread = threading.Thread(target=self._run, name="nfw-publisher", daemon=True)
-        self._thread.start()
-
-    def stop(self, timeout: float = 5.0) -> None:
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join(timeout)
-            self._thread = None
+        self._failures = RateLimitedLog(log, clock, 60.0)  #: a tick that raises: one line, then a count a minute
 
     def _run(self) -> None:
         t0 = self.clock.monotonic()
@@ -86,7 +76,7 @@ class Publisher:
                 self.core.tick()
             except Exception:
                 self.stats.failures += 1
-                log.exception("publish tick failed")
+                self._failures.log(logging.ERROR, "tick", "publish tick failed", exc_info=True)
             self.stats.record(late)
             k += 1
             behind = self.clock.monotonic() - (t0 + k / rate)
@@ -111,6 +101,7 @@ def run_virtual(
     rate = core.state.rate_hz
     period = 1.0 / rate
     count = int(math.floor(duration_s * rate + 1e-9)) + 1
+    failures = RateLimitedLog(log, clock, 60.0)
     for k in range(count):
         offset = k * period
         clock.set(start + timedelta(seconds=offset))
@@ -119,5 +110,5 @@ def run_virtual(
         try:
             core.tick(clock.now())
         except Exception:
-            log.exception("publish tick failed")
+            failures.log(logging.ERROR, "tick", "publish tick failed", exc_info=True)
     return count

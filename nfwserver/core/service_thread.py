@@ -11,6 +11,8 @@ import threading
 
 
 class ServiceThread:
+    """See the module docstring."""
+
     thread_name = "nfw-thread"
 
     def __init__(self) -> None:
@@ -20,6 +22,11 @@ class ServiceThread:
 
     def _run(self) -> None:
         raise NotImplementedError
+
+    @property
+    def running(self) -> bool:
+        """Started and not stopped since."""
+        return self._thread is not None
 
     def start(self) -> None:
         if self._thread is None:

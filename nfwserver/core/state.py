@@ -57,6 +57,8 @@ class StateSnapshot:
     radio_tuning: bool  #: OrbitDRV "tuning enabled": the radio receives Doppler updates
     antenna: AntennaPosition
     channels: Mapping[int, Channel] = field(default_factory=dict)
+    #: who chose the selected satellite ("config", "saved-state", or the source of the command), read with it
+    selected_by: str = ""
 
 
 class StationState:
@@ -72,6 +74,7 @@ class StationState:
         self._ut1_utc_s = float(ut1_utc_s)
         self._rate_hz = check_rate(rate_hz)
         self._channels: Mapping[int, Channel] = MappingProxyType(dict(channels or {}))
+        self._selected_by = ""
         self._catalog_number: int | None = None
         self._dde_output = False
         self._tracking = False
@@ -126,7 +129,8 @@ class StationState:
         with self._lock:
             return StateSnapshot(self.generation, self._catalog, self._observer, self._horizon, self._ut1_utc_s,
                                  self._rate_hz, self._catalog_number, self.selected(), self._dde_output,
-                                 self._tracking, self._radio_tuning, self._antenna, self._channels)
+                                 self._tracking, self._radio_tuning, self._antenna, self._channels,
+                                 self._selected_by)
 
     # -- changing ----------------------------------------------------------------------------
     def _set(self, name: str, value: object) -> bool:
@@ -149,8 +153,19 @@ class StationState:
             self._channels = MappingProxyType(dict(channels))
             self.generation += 1
 
-    def select(self, catalog_number: int | None) -> bool:
-        return self._set("_catalog_number", catalog_number)
+    def select(self, catalog_number: int | None, by: str | None = None) -> bool:
+        """Select ``catalog_number``; when that changes the selection, ``by`` (when given) records who chose it in
+        the same step, so a reader never sees one satellite with another's chooser."""
+        with self._lock:
+            changed = self._set("_catalog_number", catalog_number)
+            if changed and by is not None:
+                self._selected_by = by
+            return changed
+
+    def set_selected_by(self, by: str) -> None:
+        """Record who chose the current selection (a choice that selected what was already selected)."""
+        with self._lock:
+            self._selected_by = by
 
     def set_dde_output(self, on: bool) -> bool:
         return self._set("_dde_output", bool(on))

@@ -2,12 +2,15 @@
 
 :class:`StationCore` is what every output adapter is given.  Adapters read the state
 (:attr:`StationCore.state`), subscribe to ticks (:meth:`StationCore.subscribe`) and talk back
-through narrow ports: :meth:`command` (Nova's commands, from DDE pokes, TCP lines, the console),
-:meth:`select_satellite`, :meth:`report_antenna_position`, :meth:`set_radio_tuning`.  No adapter
-keeps its own copy of the station.
+through narrow ports: :meth:`execute` (every command, as a face parsed it:
+:func:`nfwserver.commands.parsing.parse_request`; :meth:`command` parses text for a caller that has
+only text), :meth:`select_satellite`, :meth:`report_antenna_position`, :meth:`set_radio_tuning`.  No
+adapter keeps its own copy of the station.
 
-Commands follow Nova's grammar (:mod:`nfwserver.core.nova_protocol`): ``TUNE ON|OFF`` (the DDE
-output), ``TRACK ON|OFF`` (autotracking), ``SAT=<catalog number>``, ``ANTAZ=<deg>``, ``ANTEL=<deg>``.
+Every command is run through its entry's action in the command table (:mod:`nfwserver.commands`):
+Nova's ``TUNE ON|OFF`` (the DDE output), ``TRACK ON|OFF`` (autotracking), ``SAT=<catalog number>``,
+``ANTAZ=<deg>``, ``ANTEL=<deg>`` on the station; ``FLIP``/``PARK`` on the rotor; the TCP session's and
+the console's own commands on the session or display the face passes.
 ``TRACK ON`` is an OrbitDRV enable call: "ignored if the station or satellite parameters have not
 been set".  It is then acknowledged (a client without error handling must not die on it) but does
 nothing, and the reason is logged, recorded in the event stream and returned in
@@ -23,9 +26,9 @@ from datetime import datetime
 
 from nfwserver.channels.channel import Channel
 from nfwserver.clock import Clock
-from nfwserver.commands.parsing import parse_poke
-from nfwserver.commands.table import CommandError as PokeError
-from nfwserver.commands.table import Face, Poke, PokeKind, escape_for_log
+from nfwserver.commands.actions import NO_ROTOR, DisplayPort, RotorControl, SessionPort, Targets
+from nfwserver.commands.parsing import Parsed, Request, parse_request
+from nfwserver.commands.table import Face, Target, escape_for_log
 from nfwserver.core.events import Direction, EventLog
 from nfwserver.core.sample import TickSample
 from nfwserver.core.state import DEFAULT_RATE_HZ, StateSnapshot, StationState
@@ -95,8 +98,10 @@ class StationCore:
         self._refusals = RateLimitedLog(log, clock, 60.0)
         #: whether the station drives a rotor itself (set by the station; None: not known, no warning)
         self.rotor_configured: bool | None = None
-        #: who chose the selected satellite: "config", "saved-state", or the source of the command
-        self.selected_by = "config" if satellite is not None else ""
+        #: the rotor's command port for FLIP and PARK (set by the station; None: no rotor)
+        self.rotor: RotorControl | None = None
+        if satellite is not None:
+            self.state.set_selected_by("config")
         if satellite is not None and not self.select_satellite(satellite, source="startup"):
             log.warning("satellite %s is not in the catalog; no satellite selected", satellite)
 
@@ -128,9 +133,7 @@ class StationCore:
 
     def set_tune(self, on: bool, source: str = "console") -> None:
         """Nova's TUNE ON/OFF: switch the DDE output."""
-        if on:
-            self.tracker.enable_call()
-        else:
+        if not on:
             self.tracker.dde_output_off()
         if self.state.set_dde_output(on):
             self.tracker.refresh_text()  # a request right after TUNE ON gets the string, not ""
@@ -147,15 +150,12 @@ class StationCore:
                 log.warning("%s (from %s)", reason, escape_for_log(source))
                 self._note(reason, source, accepted=False)
                 return reason
-            self.tracker.enable_call()
         if self.state.set_tracking(on):
             self._note(f"TRACK {'ON' if on else 'OFF'}", source)
         return None
 
     def set_radio_tuning(self, on: bool, source: str = "console") -> None:
         """OrbitDRV's Enable/Disable Tuning: Doppler updates to the radio."""
-        if on:
-            self.tracker.enable_call()
         if self.state.set_radio_tuning(on):
             self._note(f"radio Doppler tuning {'on' if on else 'off'}", source)
 
@@ -164,11 +164,20 @@ class StationCore:
         sat = self.state.catalog.get(catalog_number)
         if sat is None:
             return False
-        if self.state.select(catalog_number):
+        if self.state.select(catalog_number, by=source):
             self.tracker.selection_changed()
             self._note(f"satellite {catalog_number} {sat.dde_name} selected", source)
-            self.selected_by = source
         return True
+
+    @property
+    def selected_by(self) -> str:
+        """Who chose the selected satellite: "config", "saved-state", or the source of the command (read with
+        the selection itself from :meth:`StationState.snapshot` where both are shown)."""
+        return self.state.snapshot().selected_by
+
+    @selected_by.setter
+    def selected_by(self, source: str) -> None:
+        self.state.set_selected_by(source)
 
     def clear_satellite(self) -> None:
         if self.state.select(None):
@@ -196,65 +205,59 @@ class StationCore:
         numbers = ", ".join(str(s.catalog_number) for s in found[:5]) + (", ..." if len(found) > 5 else "")
         return None, f"{len(found)} satellites are named '{shown}' ({numbers}); use the catalog number"
 
-    def check(self, pokes: Iterable[Poke]) -> tuple[list[Poke], str | None]:
-        """Validate commands as a whole before any takes effect: each ``SAT=`` resolved to a catalog number
-        of a satellite that can be computed now; returns the resolved commands, or the refusal reason."""
+    def check(self, commands: Iterable[Parsed]) -> tuple[list[Parsed], str | None]:
+        """Validate station commands as a whole before any takes effect: each ``SAT=`` resolved to a catalog
+        number of a satellite that can be computed now; returns the resolved commands, or the refusal reason."""
         resolved = []
-        for poke in pokes:
-            if poke.kind is PokeKind.SAT:
-                sat, why = self._satellite_for(poke.value if isinstance(poke.value, str) else int(poke.value))
+        for parsed in commands:
+            if parsed.command.word == "SAT":
+                value = parsed.value
+                sat, why = self._satellite_for(value if isinstance(value, (int, str)) else str(value))
                 if sat is None:
                     return [], f"{why}; keeping the current one"
                 problem = self.tracker.why_not_computable(sat)
                 if problem is not None:
                     return [], (f"satellite {sat.catalog_number} {sat.dde_name} cannot be computed now ({problem}); "
                                 "keeping the current one")
-                poke = Poke(PokeKind.SAT, sat.catalog_number)
-            resolved.append(poke)
+                parsed = Parsed(parsed.command, sat.catalog_number)
+            resolved.append(parsed)
         return resolved, None
-
-    def apply(self, pokes: Iterable[Poke], source: str) -> tuple[str | None, str | None, str | None]:
-        """Apply commands atomically: all are checked (:meth:`check`) before the first takes effect, so a
-        refused command changes nothing.  Returns (refusal reason, why an accepted command had no effect,
-        warning on a command that took effect)."""
-        resolved, reason = self.check(pokes)
-        if reason is not None:
-            return reason, None, None
-        note = warning = None
-        for poke in resolved:
-            if poke.kind is PokeKind.TUNE:
-                self.set_tune(bool(poke.value), source)
-            elif poke.kind is PokeKind.TRACK:
-                ignored = self.set_track(bool(poke.value), source)
-                note = ignored or note
-                if poke.value and ignored is None and self.rotor_configured is False:
-                    warning = ("TRACK ON with no rotor configured: nothing turns here ([rotor] backend); "
-                               "DDE clients that drive their own rotor still follow the feed")
-            elif poke.kind is PokeKind.SAT:
-                self.select_satellite(int(poke.value), source)
-            elif poke.kind is PokeKind.ANTAZ:
-                self.report_antenna_position(float(poke.value), None, source)
-            elif poke.kind is PokeKind.ANTEL:
-                self.report_antenna_position(None, float(poke.value), source)
-        return None, note, warning
 
     def command(self, text: str, source: str = "console", conversation: int | None = None,
                 face: Face = Face.DDE, rate_key: str | None = None) -> CommandResult:
-        """Handle one command string (a poke, a TCP line, the console's command line) sent by ``face``.
+        """Parse ``text`` as ``face`` sends it and run it (:meth:`execute`): for a caller that holds only text."""
+        return self.execute(parse_request(text, face), source, conversation=conversation, rate_key=rate_key)
 
-        A refusal is logged once a minute at most per ``rate_key`` (default: ``source``); a network face
-        passes the peer's address, so reconnecting does not start the count afresh."""
+    def execute(self, request: Request, source: str = "console", conversation: int | None = None,
+                rate_key: str | None = None, session: SessionPort | None = None,
+                display: DisplayPort | None = None) -> CommandResult:
+        """Run a parsed request from ``source`` through its entries' actions (the command table's).
+
+        Station commands are atomic: all are checked (:meth:`check`) before the first takes effect, so a
+        refused poke changes nothing; each is an event, sets the bad function/subfunction bits when refused,
+        and a refusal is logged once a minute at most per ``rate_key`` (default: ``source``; a network face
+        passes the peer's address, so reconnecting does not start the count afresh).  The other commands act
+        on the rotor (:attr:`rotor`), the sender's ``session`` or the console's ``display``; their face
+        records them."""
+        targets = Targets(self, self.rotor, session, display)
+        if request.target is not Target.STATION:
+            return self._run_other(request, targets, source)
+        reason = note = warning = None
         bits = 0
-        warning = None
-        try:
-            reason, note, warning = self.apply(parse_poke(text, face), source)
+        if request.error is not None:
+            reason = str(request.error)
+            bits = StatusBit.BAD_SUBFUNCTION if request.error.bad_argument else StatusBit.BAD_FUNCTION
+        else:
+            resolved, reason = self.check(request.commands)
             if reason is not None:
                 bits = StatusBit.BAD_SUBFUNCTION
-        except PokeError as exc:
-            reason, note = str(exc), None
-            bits = StatusBit.BAD_SUBFUNCTION if exc.bad_argument else StatusBit.BAD_FUNCTION
+            for parsed in resolved:
+                outcome = parsed.command.action(targets, parsed.value, source)
+                note = outcome.note or note
+                warning = outcome.warning or warning
         self.tracker.note_command(int(bits))
         accepted = reason is None
+        text = request.text
         self.events.add(self.clock.now(), Direction.IN, "poke", text, conversation=conversation, client=source,
                         accepted=accepted, detail=reason or note or warning or "")
         if not accepted:
@@ -263,3 +266,17 @@ class StationCore:
         if accepted and note is None and warning is not None:
             return CommandResult(True, warning, self.tracker.status_word(), warning=True)
         return CommandResult(accepted, reason or note, self.tracker.status_word())
+
+    def _run_other(self, request: Request, targets: Targets, source: str) -> CommandResult:
+        """A rotor, session or display command: refused without a rotor for a rotor command, or with the
+        parser's reason; else its action's outcome."""
+        error = request.error
+        if error is not None:
+            no_rotor = error.command is not None and error.command.target is Target.ROTOR and self.rotor is None
+            return CommandResult(False, NO_ROTOR if no_rotor else str(error), self.tracker.status_word())
+        parsed = request.commands[0]
+        outcome = parsed.command.action(targets, parsed.value, source)
+        if outcome.refused is not None:
+            return CommandResult(False, outcome.refused, self.tracker.status_word())
+        return CommandResult(True, outcome.note or outcome.warning, self.tracker.status_word(),
+                             warning=outcome.note is None and outcome.warning is not None)

@@ -9,6 +9,7 @@ thread with the newest sample, skipping any that arrived while it was busy.
 from __future__ import annotations
 
 import logging
+import threading
 from datetime import datetime
 
 from nfwserver.clock import Clock, SystemClock
@@ -28,6 +29,7 @@ class TickWorker(ServiceThread):
         #: A failure repeated every tick is logged (with its traceback) once, then counted.
         self.warnings = RateLimitedLog(log, clock if clock is not None else SystemClock())
         super().__init__()
+        self._pending_lock = threading.Lock()  #: the hand-over of the newest sample between the two threads
         self._pending: TickSample | None = None
         #: the time of the newest sample fully processed (how far behind the ticks the device is)
         self.processed_time: datetime | None = None
@@ -36,15 +38,22 @@ class TickWorker(ServiceThread):
         raise NotImplementedError
 
     def on_tick(self, sample: TickSample) -> None:
-        """Tick listener: remember the newest sample (cheap, never blocks)."""
-        self._pending = sample
+        """Tick listener: remember the newest sample (cheap: waits only for the worker taking the previous one)."""
+        with self._pending_lock:
+            self._pending = sample
         self._wake.set()
+
+    def _take(self) -> TickSample | None:
+        """The newest sample, once: a sample arriving while it is taken is kept for the next turn, never lost."""
+        with self._pending_lock:
+            sample, self._pending = self._pending, None
+        return sample
 
     def _run(self) -> None:
         while not self._stop.is_set():
             self._wake.wait(0.5)
             self._wake.clear()
-            sample, self._pending = self._pending, None
+            sample = self._take()
             if sample is not None:
                 try:
                     self.process(sample)

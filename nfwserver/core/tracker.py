@@ -44,6 +44,7 @@ from nfwserver.core.sample import TickSample
 from nfwserver.core.state import StateSnapshot, StationState
 from nfwserver.core.status import ArithmeticErrorCode, StatusBit
 from nfwserver.health.link_health import LinkHealth
+from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.tracking.catalog import Satellite
 from nfwserver.tracking.look_angles import LookAngleCalculator, LookAngles, PropagationError
 
@@ -69,6 +70,8 @@ class Tracker:
         self._computed_generation = -1
         self._error = ArithmeticErrorCode.NONE
         self._command_bits = 0
+        #: per-tick failures (a listener, a satellite without a health link): one line, then a count a minute
+        self._faults = RateLimitedLog(log, clock, 60.0)
 
     # -- subscribers -------------------------------------------------------------------------
     def subscribe(self, listener: TickListener) -> Callable[[], None]:
@@ -101,10 +104,6 @@ class Tracker:
             return self._status(snap, self._last)
 
     # -- what commands tell the tracker --------------------------------------------------------
-    def enable_call(self) -> None:
-        """An OrbitDRV enable call (TRACK ON, TUNE ON, radio tuning on).  Nothing is latched, so there is
-        nothing to reset: the next tick computes as every tick does."""
-
     def selection_changed(self) -> None:
         """A new AutoTracking satellite: never serve the old one's string; the new one's is there at once."""
         self.refresh_text()
@@ -203,7 +202,8 @@ class Tracker:
             self.health.failed(f"cannot compute {sat.dde_name} (arithmetic error {int(code):02X}): {reason}",
                                logging.ERROR)
         else:
-            log.error("cannot compute %s at %s: %s", sat.dde_name, when.isoformat(), reason)
+            self._faults.error(f"compute:{sat.catalog_number}", "cannot compute %s at %s: %s", sat.dde_name,
+                               when.isoformat(), reason)
         if self._error != code:
             self.events.add(when, Direction.INFO, "note",
                             f"arithmetic error {int(code):02X} for {sat.dde_name}: {reason}", accepted=False)
@@ -237,6 +237,7 @@ class Tracker:
             try:
                 listener(sample)
             except Exception:
-                log.exception("tick listener %r failed", listener)
+                self._faults.log(logging.ERROR, f"listener:{id(listener)}", "tick listener %r failed", listener,
+                                 exc_info=True)
         return sample
 

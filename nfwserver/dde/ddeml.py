@@ -156,6 +156,13 @@ def _declare(dll: object, name: str, restype: object, *argtypes: object) -> None
     fn.restype, fn.argtypes = restype, list(argtypes)
 
 
+def conv_info(u: User32, hconv: int) -> ConvInfo | None:  # pragma: no cover - Windows only
+    """DdeQueryConvInfo(``hconv``, QID_SYNC): the conversation's CONVINFO, or None when DDEML no longer knows it."""
+    info = ConvInfo()
+    info.cb = ctypes.sizeof(ConvInfo)
+    return info if u.DdeQueryConvInfo(hconv, QID_SYNC, ctypes.byref(info)) else None
+
+
 def load_user32() -> User32:  # pragma: no cover - Windows only
     """user32 with the DDEML prototypes set; raises OSError off Windows."""
     if sys.platform != "win32":

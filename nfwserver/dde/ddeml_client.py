@@ -20,12 +20,17 @@ step, so the client pumps messages for ``settle_s`` seconds before each transact
 from __future__ import annotations
 
 import ctypes
+import logging
 import time
 from collections import Counter
 from collections.abc import Callable
 
+from nfwserver.clock import SystemClock
 from nfwserver.dde import ddeml
 from nfwserver.dde.clipboard import ANSI_CODEPAGE, CF_TEXT, decode_text, encode_text
+from nfwserver.ratelimited_log import RateLimitedLog
+
+log = logging.getLogger(__name__)
 
 
 class DdeRefused(OSError):
@@ -46,6 +51,8 @@ class DdemlClient:  # pragma: no cover - Windows only
         self._wintypes = wintypes
         self.ansi = ansi
         self.settle_s = settle_s
+        self.callback_failures = 0  #: callbacks that raised (answered as unhandled, and logged)
+        self._failures = RateLimitedLog(log, SystemClock(), 60.0)
         inst = wintypes.DWORD(0)
         self._callback = ddeml.CALLBACK_TYPE(self._on_callback)
         init = self.u.DdeInitializeA if ansi else self.u.DdeInitializeW
@@ -101,7 +108,10 @@ class DdemlClient:  # pragma: no cover - Windows only
                 return ddeml.DDE_FACK
             if utype == ddeml.XTYP_DISCONNECT:
                 self.disconnected.add(hconv or 0)
-        except Exception:  # a DDEML callback must not raise
+        except Exception:  # a DDEML callback must not raise: counted, logged (a line a minute at most), unhandled
+            self.callback_failures += 1
+            self._failures.log(logging.ERROR, "callback", "DDEML client callback failed (type 0x%04X)", utype,
+                               exc_info=True)
             return None
         return None
 
@@ -110,9 +120,8 @@ class DdemlClient:  # pragma: no cover - Windows only
         delivers XTYP_DISCONNECT) DdeQueryConvInfo reports the conversation terminated or gone."""
         if conv in self.disconnected:
             return True
-        info = ddeml.ConvInfo()
-        info.cb = ctypes.sizeof(ddeml.ConvInfo)
-        if not self.u.DdeQueryConvInfo(conv, ddeml.QID_SYNC, ctypes.byref(info)):
+        info = ddeml.conv_info(self.u, conv)
+        if info is None:
             return True  # DDEML no longer knows the conversation
         return bool(info.wStatus & ddeml.ST_TERMINATED) or not info.wStatus & ddeml.ST_CONNECTED
 

@@ -24,11 +24,14 @@ import logging
 import threading
 from collections.abc import Callable, Iterable
 
+from nfwserver.commands.parsing import parse_request
+from nfwserver.commands.table import Face
 from nfwserver.core.events import Direction
 from nfwserver.core.sample import TickSample
 from nfwserver.core.station_core import StationCore
 from nfwserver.dde.clipboard import TEXT_FORMATS, decode_text, encode_text, format_name
 from nfwserver.dde.transport import ConversationId, DdeServerTransport, PokeResult
+from nfwserver.ratelimited_log import RateLimitedLog
 
 log = logging.getLogger(__name__)
 
@@ -52,6 +55,7 @@ class NovaDdeService:
         self._conversations: dict[ConversationId, str] = {}
         self._loops: set[tuple[ConversationId, str, int]] = set()
         self._transports: list[DdeServerTransport] = []
+        self._post_failures = RateLimitedLog(log, core.clock, 60.0)  #: per tick: one line, then a count a minute
         self._encoded: tuple[str, dict[int, bytes]] = ("", {})
         self._unsubscribe: Callable[[], None] | None = None
 
@@ -97,7 +101,8 @@ class NovaDdeService:
                 try:
                     transport.post_advise(self.topic, item)
                 except Exception:
-                    log.exception("posting advise on %s failed", item)
+                    self._post_failures.log(logging.ERROR, f"post:{item}", "posting advise on %s failed", item,
+                                            exc_info=True)
         self.core.events.add(sample.time, Direction.OUT, "publish", sample.text, detail=f"{loops} advise loop(s)")
 
     def _data(self, fmt: int) -> tuple[str, bytes]:
@@ -139,7 +144,7 @@ class NovaDdeService:
         return data
 
     def _command(self, conv: ConversationId, text: str) -> PokeResult:
-        result = self.core.command(text, source=self._label(conv), conversation=conv)
+        result = self.core.execute(parse_request(text, Face.DDE), source=self._label(conv), conversation=conv)
         return PokeResult.FACK if result.accepted else PokeResult.FNOTPROCESSED
 
     def on_poke(self, conv: ConversationId, topic: str, item: str, fmt: int, data: bytes) -> PokeResult:

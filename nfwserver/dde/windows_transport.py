@@ -89,7 +89,6 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
         self._failures = 0
         #: DdePostAdvise calls on the DDE thread (each runs one XTYP_ADVREQ per advise loop)
         self.post_advise_stats = PostAdviseStats()
-        self.dropped = 0  #: conversations dropped because their client vanished without disconnecting
         self._dispatcher: DdemlDispatcher | None = None
         self._poster: AdvisePoster | None = None  #: chosen on the DDE thread at start (module docstring)
         self._thread = threading.Thread(target=self._run, name="nfw-ddeml", daemon=True)
@@ -282,7 +281,6 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
             poster.conversation_ended(hconv)
             dispatcher.drop(hconv)
             dropped += 1
-            self.dropped += 1
             log.warning("DDE client of %s is gone without disconnecting (DdePostAdvise: DMLERR 0x%04X): "
                         "conversation dropped", name, err)
         return dropped
@@ -290,9 +288,8 @@ class WindowsDdeTransport:  # pragma: no cover - Windows only
     def _client_vanished(self, hconv: int) -> bool:
         """DDEML no longer knows ``hconv``, or no longer counts it connected, or its client's window
         is gone."""
-        info = ddeml.ConvInfo()
-        info.cb = ctypes.sizeof(ddeml.ConvInfo)
-        if not self.u.DdeQueryConvInfo(hconv, ddeml.QID_SYNC, ctypes.byref(info)):
+        info = ddeml.conv_info(self.u, hconv)
+        if info is None:
             return True
         if not info.wStatus & ddeml.ST_CONNECTED:
             return True

@@ -109,10 +109,9 @@ class WinePoster:  # pragma: no cover - Windows (Wine) only
         """Whether the conversation's client window belongs to this process (True if unknown)."""
         from ctypes import wintypes
 
-        info = ddeml.ConvInfo()
-        info.cb = ctypes.sizeof(ddeml.ConvInfo)
+        info = ddeml.conv_info(self.u, hconv)
         pid = wintypes.DWORD(0)
-        if not self.u.DdeQueryConvInfo(hconv, ddeml.QID_SYNC, ctypes.byref(info)) or not info.hwndPartner:
+        if info is None or not info.hwndPartner:
             return True
         self.u.GetWindowThreadProcessId(info.hwndPartner, ctypes.byref(pid))
         return pid.value in (0, self.k.GetCurrentProcessId())

@@ -14,9 +14,10 @@ from __future__ import annotations
 import logging
 import queue
 import socket
-import threading
+from collections.abc import Callable
 from typing import Any
 
+from nfwserver.core.service_thread import ServiceThread
 from nfwserver.dialects.predict_protocol import END_OF_LISTING, PredictContext, PredictProtocol
 from nfwserver.listen_errors import bind_failure
 
@@ -28,21 +29,47 @@ LISTING_QUEUE = 8  #: listings waiting for the listing thread, at most
 _STOP = object()
 
 
-class PredictUdpServer:
+class _ListingThread(ServiceThread):
+    """``nfw-predict-list``: sends the queued listings one at a time; stopped with a marker in the queue."""
+
+    thread_name = "nfw-predict-list"
+
+    def __init__(self, run: Callable[[], None], listings: queue.Queue[Any]) -> None:
+        super().__init__()
+        self._listings_run, self._listings = run, listings
+
+    def _run(self) -> None:
+        self._listings_run()
+
+    def stop(self) -> None:
+        if self.running:
+            while True:  # make room for the stop marker: waiting listings are abandoned
+                try:
+                    self._listings.get_nowait()
+                except queue.Empty:
+                    break
+            self._listings.put(_STOP)
+        super().stop()
+
+
+class PredictUdpServer(ServiceThread):
     """The UDP listener and its listing thread.  Construction does no I/O; :meth:`start` binds the socket
     (raising :class:`OSError` when the port is taken, with nothing left running) and starts the threads."""
 
+    thread_name = "nfw-predict"
+
     def __init__(self, context: PredictContext, host: str = "127.0.0.1", port: int = DEFAULT_PORT) -> None:
+        super().__init__()
         self.protocol = PredictProtocol(context)
         self.host, self.port = host, port
         self.sock: socket.socket | None = None
         self.address: tuple[str, int] = (host, port)
-        self._stop = threading.Event()
         self._listings: queue.Queue[Any] = queue.Queue(maxsize=LISTING_QUEUE)
-        self._thread = threading.Thread(target=self._run, name="nfw-predict", daemon=True)
-        self._lister = threading.Thread(target=self._run_listings, name="nfw-predict-list", daemon=True)
+        self._lister = _ListingThread(self._run_listings, self._listings)
 
     def start(self) -> None:
+        if self.running:
+            return
         sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         try:
             sock.bind((self.host, self.port))
@@ -54,7 +81,7 @@ class PredictUdpServer:
         self.sock = sock
         self.address = sock.getsockname()
         log.info("PREDICT protocol on UDP %s:%d", *self.address)
-        self._thread.start()
+        super().start()
         self._lister.start()
 
     def _send(self, payload: bytes, peer: tuple[str, int]) -> None:
@@ -100,17 +127,8 @@ class PredictUdpServer:
                 self._send(datagram, peer)
 
     def stop(self) -> None:
-        self._stop.set()
-        if self._thread.is_alive():
-            self._thread.join(2.0)
-        if self._lister.is_alive():
-            while True:  # make room for the stop marker: waiting listings are abandoned
-                try:
-                    self._listings.get_nowait()
-                except queue.Empty:
-                    break
-            self._listings.put(_STOP)
-            self._lister.join(2.0)
+        super().stop()  # the receiving loop looks at the stop flag at least every 0.2 s (its socket timeout)
+        self._lister.stop()
         if self.sock is not None:
             self.sock.close()
             self.sock = None

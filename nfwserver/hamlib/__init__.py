@@ -1,6 +1,8 @@
 """Hamlib's daemons (rotctld, rigctld) over TCP: the line client and the command table.
 """
 
+from typing import TYPE_CHECKING
+
 from nfwserver.lazy_exports import lazy_exports
 
 _EXPORTS = {
@@ -11,3 +13,15 @@ _EXPORTS = {
 }
 __all__ = sorted(_EXPORTS)
 __getattr__ = lazy_exports(__name__, _EXPORTS)
+
+if TYPE_CHECKING:  # the names as type checkers see them; at run time each module loads on first use
+    from nfwserver.hamlib.commands import HamlibCommand as HamlibCommand
+    from nfwserver.hamlib.connection import (
+        HamlibConnection as HamlibConnection,
+    )
+    from nfwserver.hamlib.connection import (
+        HamlibError as HamlibError,
+    )
+    from nfwserver.hamlib.connection import (
+        HamlibUnavailable as HamlibUnavailable,
+    )

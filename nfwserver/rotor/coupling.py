@@ -238,15 +238,16 @@ class RotorCoupling(TickWorker):
     # -- per tick --------------------------------------------------------------------------
     def process(self, sample: TickSample) -> None:
         """One tick's work (the worker's step; tests call it directly)."""
-        with self._lock:
+        with self._lock:  # one look at what other threads asked for
             retry, self._retry_asked = self._retry_asked, False
             park, self._park_asked = self._park_asked, False
+            parked_at = self._parked_at
+            if parked_at is not None and sample.time > parked_at:
+                self._parked_at = None  # a sample from after the PARK: its tracking flag is current from now on
         if retry:
             self.driver.retry_now()
         if park:
             self._park_now()
-        with self._lock:
-            parked_at = self._parked_at
         if parked_at is not None and sample.time <= parked_at and sample.tracking:
             sample = replace(sample, tracking=False)  # computed before PARK's TRACK OFF: not followed
         if sample.tracking and not self._track_on_seen:

@@ -17,7 +17,8 @@ Nova's commands    ``TUNE ON|OFF``, ``TRACK ON|OFF``, ``SAT=n``, ``ANTAZ=deg``, 
                    tracking needs to know it is not happening.  DDE clients still get an
                    acknowledgement for it; only this protocol reports it.
 ``STATUS``         one line of ``key=value`` pairs separated by single blanks (values never
-                   contain blanks): satellite, name, satellite_from (who chose it: config,
+                   contain blanks; :mod:`nfwserver.tcp.status_line` writes and reads it):
+                   satellite, name, satellite_from (who chose it: config,
                    saved-state, or the client that sent SAT=), tune, track, radio_tuning, status (the
                    status word, hex), interface (version), az/el/rr/ah of the last tick when
                    there is a position, then the fields of the ``extra`` callable (rotor and
@@ -38,17 +39,21 @@ stream with the peer as ``client``.
 from __future__ import annotations
 
 import enum
+import logging
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 from nfwserver.commands.help_text import help_lines
-from nfwserver.commands.parsing import clean_command_text, parse_line
-from nfwserver.commands.rotor_commands import RotorControl, run_rotor_command
-from nfwserver.commands.table import CommandError, Face, Target
+from nfwserver.commands.parsing import clean_command_text, parse_request
+from nfwserver.commands.table import Face, Target
 from nfwserver.core.events import Direction
 from nfwserver.core.nova_protocol import format_azimuth, format_elevation, format_range_rate
 from nfwserver.core.station_core import StationCore
+from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.tcp.greeting import GREETING as GREETING  # the server sends it
+from nfwserver.tcp.status_line import format_status
+
+log = logging.getLogger(__name__)
 
 StatusFields = Callable[[], Mapping[str, object]]
 
@@ -65,82 +70,76 @@ class Reply:
     action: Action = Action.REPLY
 
 
-def _value(value: object) -> str:
-    """A STATUS value without blanks or control characters."""
-    if isinstance(value, bool):
-        return "on" if value else "off"
-    if value is None:
-        return "-"
-    text = "".join(ch if ch.isprintable() and not ch.isspace() else "_" for ch in str(value))
-    return text or "-"
-
-
 def _one_line(text: str) -> str:
     """``text`` as one printable line (a reason may quote what the client sent)."""
     return " ".join("".join(ch if ch.isprintable() else " " for ch in text).split())
 
 
+class _Session:
+    """The session commands' target for one line from ``peer``: each action leaves its reply here."""
+
+    def __init__(self, protocol: NovaTcpProtocol, peer: str) -> None:
+        self.protocol = protocol
+        self.peer = peer
+        self.reply: Reply | None = None
+
+    def summary(self) -> None:
+        text = self.protocol.core.current_text()
+        self.protocol.record(self.peer, "SUMMARY", text)
+        self.reply = Reply((text,))
+
+    def status(self) -> None:
+        self.protocol.record(self.peer, "STATUS")
+        self.reply = Reply((self.protocol.status_line(),))
+
+    def watch(self) -> None:
+        self.protocol.record(self.peer, "WATCH")
+        self.reply = Reply(("OK",), Action.WATCH)
+
+    def help(self) -> None:
+        self.protocol.record(self.peer, "HELP")
+        self.reply = Reply(help_lines(Face.TCP) + ("OK",))
+
+    def quit(self) -> None:
+        self.protocol.record(self.peer, "QUIT")
+        self.reply = Reply(("OK",), Action.QUIT)
+
+
 class NovaTcpProtocol:
     """Answers one line at a time for the station ``core``; ``extra`` adds STATUS fields."""
 
-    def __init__(self, core: StationCore, extra: StatusFields | None = None,
-                 rotor: RotorControl | None = None) -> None:
+    def __init__(self, core: StationCore, extra: StatusFields | None = None) -> None:
         self.core = core
         self.extra = extra
-        self.rotor = rotor  #: the rotor's command port (None without a rotor)
+        self._extra_failures = RateLimitedLog(log, core.clock, 60.0)  #: a broken STATUS field: logged whole
 
-    def _record(self, peer: str, text: str, detail: str = "") -> None:
+    def record(self, peer: str, text: str, detail: str = "") -> None:
+        """An event for a line that is not a station command (the core records those)."""
         self.core.events.add(self.core.clock.now(), Direction.IN, "request", text, client=peer, accepted=True,
                              detail=detail)
 
     def handle(self, line: str, peer: str, rate_key: str | None = None) -> Reply | None:
         """The reply to ``line`` (without its terminator) from ``peer``; None for a blank line.
 
-        ``rate_key`` groups the refusal log lines of one client across its connections (its address)."""
+        The line is parsed once and run by the core through the command table; ``rate_key`` groups the
+        refusal log lines of one client across its connections (its address)."""
         if not line.strip():  # blank, including lines of only VT, FF or the 0x1C-0x1F separators
             return None
-        try:
-            parsed = parse_line(line, Face.TCP)
-        except CommandError as exc:
-            if exc.command is not None and exc.command.target is Target.ROTOR and self.rotor is None:
-                self._record(peer, clean_command_text(line))
-                return Reply(("ERROR no rotor is configured",))
-            if exc.command is not None and exc.command.target is not Target.STATION:
-                self._record(peer, clean_command_text(line), str(exc))
-                return Reply((f"ERROR {_one_line(str(exc))}",))
-            return self._station(line, peer, rate_key)  # the core records and rate-limits the refusal
-        entry = parsed.command
-        if entry.target is Target.STATION:
-            return self._station(line, peer, rate_key)
-        if entry.target is Target.ROTOR:
-            self._record(peer, clean_command_text(line))
-            why = run_rotor_command(parsed, self.rotor, self.core, peer)
-            return Reply(("OK",) if why is None else (f"ERROR {why}",))
-        return self._session(entry.word, peer)
-
-    def _station(self, line: str, peer: str, rate_key: str | None) -> Reply:
-        result = self.core.command(line, source=peer, face=Face.TCP, rate_key=rate_key)
+        request = parse_request(line, Face.TCP)
+        target = request.target
+        if target is Target.ROTOR or (target is Target.SESSION and request.error is not None):
+            no_rotor = target is Target.ROTOR and self.core.rotor is None
+            detail = str(request.error) if request.error is not None and not no_rotor else ""
+            self.record(peer, clean_command_text(line), detail)  # the session's actions record their own
+        session = _Session(self, peer)
+        result = self.core.execute(request, source=peer, rate_key=rate_key, session=session)
+        if session.reply is not None:
+            return session.reply
         if result.ok:
             return Reply(("OK",))
         if result.accepted and result.warning:
             return Reply((f"OK warning: {_one_line(result.note or '')}",))
         return Reply((f"ERROR {_one_line(result.note or 'refused')}",))
-
-    def _session(self, word: str, peer: str) -> Reply:
-        if word == "SUMMARY":
-            text = self.core.current_text()
-            self._record(peer, "SUMMARY", text)
-            return Reply((text,))
-        self._record(peer, word)
-        if word == "STATUS":
-            return Reply((self.status_line(),))
-        if word == "WATCH":
-            return Reply(("OK",), Action.WATCH)
-        if word == "QUIT":
-            return Reply(("OK",), Action.QUIT)
-        if word == "HELP":
-            return Reply(help_lines(Face.TCP) + ("OK",))
-        raise AssertionError(f"the TCP face has no handler for {word}")  # a table entry without one
 
     @staticmethod
     def too_long(limit: int) -> Reply:
@@ -150,7 +149,7 @@ class NovaTcpProtocol:
         snap = self.core.snapshot()
         state = snap.state
         fields: dict[str, object] = {
-            "satellite": state.catalog_number, "name": snap.dde_name, "satellite_from": self.core.selected_by,
+            "satellite": state.catalog_number, "name": snap.dde_name, "satellite_from": state.selected_by,
             "tune": state.dde_output,
             "track": state.tracking, "radio_tuning": state.radio_tuning, "status": f"0x{snap.status:04X}",
             "interface": snap.interface_version,
@@ -168,4 +167,6 @@ class NovaTcpProtocol:
                 fields.update(self.extra())
             except Exception as exc:  # a broken extra field must not cost the client its answer
                 fields["extra_error"] = type(exc).__name__
-        return " ".join(f"{_value(key)}={_value(value)}" for key, value in fields.items())
+                self._extra_failures.log(logging.ERROR, "extra", "STATUS fields of the devices failed",
+                                         exc_info=True)
+        return format_status(fields)

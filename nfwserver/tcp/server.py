@@ -34,14 +34,13 @@ import errno
 import logging
 import selectors
 import socket
-import threading
 from collections import Counter, deque
 from collections.abc import Callable
 
-from nfwserver.commands.rotor_commands import RotorControl
 from nfwserver.config.schema import TcpConfig
 from nfwserver.core.events import Direction
 from nfwserver.core.sample import TickSample
+from nfwserver.core.service_thread import ServiceThread
 from nfwserver.core.station_core import StationCore
 from nfwserver.health.link_health import Backoff
 from nfwserver.listen_errors import bind_failure
@@ -70,16 +69,19 @@ PUBLISHED_BACKLOG = 256  #: published strings waiting for the loop (it normally 
 CRLF = b"\r\n"
 
 
-class NovaTcpServer:
+class NovaTcpServer(ServiceThread):
     """See the module docstring.  ``extra`` adds fields to ``STATUS``; ``send_buffer_bytes`` sets
     SO_SNDBUF on accepted sockets (None: the system's default)."""
 
+    thread_name = "nfw-tcp"
+
     def __init__(self, core: StationCore, config: TcpConfig, extra: StatusFields | None = None, *,
                  output_limit: int = DEFAULT_OUTPUT_LIMIT, send_buffer_bytes: int | None = None,
-                 max_clients: int | None = None, rotor: RotorControl | None = None) -> None:
+                 max_clients: int | None = None) -> None:
+        super().__init__()
         self.core = core
         self.config = config
-        self.protocol = NovaTcpProtocol(core, extra, rotor)
+        self.protocol = NovaTcpProtocol(core, extra)
         self.output_limit = output_limit
         self.send_buffer_bytes = send_buffer_bytes
         self.max_clients = max_clients if max_clients is not None else config.max_clients
@@ -91,8 +93,6 @@ class NovaTcpServer:
         self._watching: set[Connection] = set()
         self._published: deque[str] = deque(maxlen=PUBLISHED_BACKLOG)
         self._wake_pending = False
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
         self._selector: selectors.BaseSelector | None = None
         self._listener: socket.socket | None = None
         self._wake_r: socket.socket | None = None
@@ -111,12 +111,12 @@ class NovaTcpServer:
     def wake(self) -> None:
         """Let the loop look at the clock now (idle connections, the accept back-off): for a clock that
         does not run by itself."""
-        self._wake()
+        self._ring()
 
     # -- life cycle --------------------------------------------------------------------------------
     def start(self) -> None:
         """Bind ``[tcp] host``/``port`` and serve on thread ``nfw-tcp``; OSError when it cannot bind."""
-        if self._thread is not None:
+        if self.running:
             return
         try:
             listener = bind_listener(self.config.host, self.config.port)
@@ -130,22 +130,19 @@ class NovaTcpServer:
         self._selector = selectors.DefaultSelector()
         self._selector.register(listener, selectors.EVENT_READ, "listen")
         self._selector.register(self._wake_r, selectors.EVENT_READ, "wake")
-        self._stop.clear()
         self._unsubscribe = self.core.subscribe(self.on_tick)
-        self._thread = threading.Thread(target=self._run, name="nfw-tcp", daemon=True)
-        self._thread.start()
+        super().start()
         log.info("Nova TCP server listening on %s port %d", *self.address)
 
     def stop(self) -> None:
-        if self._thread is None:
+        if not self.running:
             return
         if self._unsubscribe is not None:
             self._unsubscribe()
             self._unsubscribe = None
         self._stop.set()
-        self._wake()
-        self._thread.join(5.0)
-        self._thread = None
+        self._ring()
+        super().stop()
         for client in list(self._clients):
             self._close(client, "server stopping")
         for sock in (self._listener, self._wake_r, self._wake_w):
@@ -166,9 +163,10 @@ class NovaTcpServer:
         self._published.append(sample.text)
         if not self._wake_pending:
             self._wake_pending = True
-            self._wake()
+            self._ring()
 
-    def _wake(self) -> None:
+    def _ring(self) -> None:
+        """Wake the select loop (a byte on its socket pair)."""
         try:
             if self._wake_w is not None:
                 self._wake_w.send(b"\0")
@@ -191,7 +189,7 @@ class NovaTcpServer:
                         self._service(key.data, mask)
                 self._deliver()
             except Exception:  # keep serving whatever one connection did
-                log.exception("TCP server loop failed; carrying on")
+                self._refusals.log(logging.ERROR, "loop", "TCP server loop failed; carrying on", exc_info=True)
 
     def _next_timeout(self) -> float | None:
         """Real seconds until something on the clock is due (an idle deadline, the end of the accept
@@ -305,7 +303,8 @@ class NovaTcpServer:
                     reply = self.protocol.handle(item.decode("ascii", errors="replace"), client.peer,
                                                  rate_key=f"tcp {client.address}")
                 except Exception:
-                    log.exception("TCP command from %s failed", client.peer)
+                    self._refusals.log(logging.ERROR, f"failed:{client.address}", "TCP command from %s failed",
+                                       client.peer, exc_info=True)
                     reply = Reply(("ERROR internal error",))
             if reply is None:
                 continue

@@ -15,6 +15,8 @@ from nfwserver.tracking.sgp4_selfcheck import ensure_working_sgp4  # noqa: E402
 
 SGP4_CHOICE = ensure_working_sgp4()  # before any tracking module imports sgp4's classes
 
+from typing import TYPE_CHECKING  # noqa: E402
+
 from nfwserver.lazy_exports import lazy_exports  # noqa: E402
 
 _EXPORTS = {
@@ -34,3 +36,24 @@ _EXPORTS = {
 }
 __all__ = sorted(_EXPORTS)
 __getattr__ = lazy_exports(__name__, _EXPORTS)
+
+if TYPE_CHECKING:  # the names as type checkers see them; at run time each module loads on first use
+    from nfwserver.tracking.catalog import Catalog as Catalog
+    from nfwserver.tracking.catalog import Satellite as Satellite
+    from nfwserver.tracking.doppler import doppler_shift_hz as doppler_shift_hz
+    from nfwserver.tracking.elements import (
+        ElementSet as ElementSet,
+    )
+    from nfwserver.tracking.elements import (
+        load_element_file as load_element_file,
+    )
+    from nfwserver.tracking.elements import (
+        load_elements as load_elements,
+    )
+    from nfwserver.tracking.horizon import HorizonTable as HorizonTable
+    from nfwserver.tracking.look_angles import LookAngleCalculator as LookAngleCalculator
+    from nfwserver.tracking.look_angles import LookAngles as LookAngles
+    from nfwserver.tracking.observer import Observer as Observer
+    from nfwserver.tracking.observer import parse_observer as parse_observer
+    from nfwserver.tracking.passes import Pass as Pass
+    from nfwserver.tracking.passes import find_passes as find_passes

@@ -6,10 +6,10 @@ station's stream) when ``[web] control`` is off or its token is weak (checked be
 when the token is missing or wrong (:func:`~nfwserver.config.tokens.token_matches`, constant time), or
 when the line is not one of the commands the table lets the web face send (:attr:`Face.WEB`: ``TUNE``,
 ``TRACK``, ``SAT``, ``ANTAZ``/``ANTEL``, ``FLIP``, ``PARK``).  The line is parsed by the command table
-(:func:`~nfwserver.commands.parsing.parse_line`, which also bounds its length); a station command goes
-to :meth:`~nfwserver.core.station_core.StationCore.command` as the web face's, a rotor command to
-:func:`~nfwserver.commands.rotor_commands.run_rotor_command` as TCP and the console run it, with the
-browser's address as the source; the reply is their answer.  The control switch and the token are read
+(:func:`~nfwserver.commands.parsing.parse_request`, once, which also bounds its length) and run through
+the table's actions by :meth:`~nfwserver.core.station_core.StationCore.execute`, as every face's commands
+are, with the browser's address as the source; the reply is the station's answer (a rotor command acts on
+the station's rotor, or is refused without one).  The control switch and the token are read
 from :attr:`Control.config` at every request, so a changed ``[web]`` section applies at once.
 """
 
@@ -18,9 +18,8 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass
 
-from nfwserver.commands.parsing import Parsed, parse_line
-from nfwserver.commands.rotor_commands import RotorControl, run_rotor_command
-from nfwserver.commands.table import Command, CommandError, Face, Target, commands_for, escape_for_log
+from nfwserver.commands.parsing import parse_request
+from nfwserver.commands.table import Command, Face, Target, commands_for, escape_for_log
 from nfwserver.config.schema import WebConfig
 from nfwserver.config.tokens import token_matches, weak_token_reason
 from nfwserver.core.events import Direction
@@ -60,10 +59,9 @@ def _open(config: WebConfig) -> bool:
 class Control:
     """Checks and runs control requests; called on the HTTP connection threads."""
 
-    def __init__(self, core: StationCore, config: WebConfig, rotor: RotorControl | None = None) -> None:
-        self.core = core
+    def __init__(self, core: StationCore, config: WebConfig) -> None:
+        self.core = core  #: runs every command; FLIP and PARK act on its rotor (:attr:`StationCore.rotor`)
         self.config = config  #: replaced whole when the configuration changes (read once per request)
-        self.rotor = rotor  #: the rotor's command port (FLIP, PARK); None without a rotor
         self._refusals = RateLimitedLog(log, core.clock, 60.0)
 
     @property
@@ -94,28 +92,13 @@ class Control:
             return self.refuse(peer, 403, "missing or wrong token", shown)
         if not isinstance(text, str) or "\n" in text or "\r" in text:
             return self.refuse(peer, 400, "command must be one line", shown)
-        try:
-            parsed = parse_line(text, Face.WEB)
-        except CommandError as exc:
-            if exc.command is None and not exc.bad_argument:
-                usages = ", ".join(c.short for c in _page_commands())
-                return self.refuse(peer, 400, f"not a station command ({usages}): {exc}", text)
-            if exc.command is not None and exc.command.target is Target.ROTOR:
-                return self.refuse(peer, 409, str(exc), text)
-            return self._refused_by_station(text, peer, str(exc))
-        if parsed.command.target is Target.ROTOR:
-            return self._rotor(parsed, text, peer)
-        result = self.core.command(text, source=peer, face=Face.WEB)
+        parsed = parse_request(text, Face.WEB)
+        error = parsed.error
+        if error is not None and error.command is None and not error.bad_argument:
+            usages = ", ".join(c.short for c in _page_commands())
+            return self.refuse(peer, 400, f"not a station command ({usages}): {error}", text)
+        result = self.core.execute(parsed, source=peer)  # station commands are recorded there, like any face's
+        if parsed.target is not Target.STATION:  # FLIP, PARK: the face records them, as TCP and the console do
+            self.core.events.add(self.core.clock.now(), Direction.IN, "poke", escape_for_log(text), client=peer,
+                                 accepted=result.accepted, detail="" if result.accepted else result.note or "")
         return ControlReply(200 if result.accepted else 409, result.accepted, result.note or "OK")
-
-    def _refused_by_station(self, text: str, peer: str, why: str) -> ControlReply:
-        """A command the table knows but refuses as written (``SAT=abc``): the station's answer, 409."""
-        result = self.core.command(text, source=peer, face=Face.WEB)  # logs and records it like any face
-        return ControlReply(409, False, result.note or why)
-
-    def _rotor(self, parsed: Parsed, text: str, peer: str) -> ControlReply:
-        """``FLIP``/``PARK``: run as every face runs them."""
-        why = run_rotor_command(parsed, self.rotor, self.core, peer)
-        self.core.events.add(self.core.clock.now(), Direction.IN, "poke", escape_for_log(text), client=peer,
-                             accepted=why is None, detail=why or "")
-        return ControlReply(200, True, "OK") if why is None else ControlReply(409, False, why)

@@ -139,7 +139,7 @@ class WebServer:
         self.send_buffer_bytes = send_buffer_bytes
         self.stats = WebStats()
         self.hub = FrameHub()
-        self.control = Control(core, config, self.parts.rotor)
+        self.control = Control(core, config)
         self.board = PassBoard(core.state, core.clock, self.parts.favourites, self.parts.rotor)
         self.address: tuple[str, int] | None = None
         self._follower = EventFollower(core.events)

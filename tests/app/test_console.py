@@ -22,7 +22,8 @@ def test_pokes_outgoing_strings_and_state_changes_show() -> None:
             assert "TUNE ON ok" in log_text(app, "incoming")
             assert "TUNE ON" in static_text(app, "state")
             station.run(2.0)  # 11 ticks at 5 Hz of virtual time
-            await pilot.pause(0.3)
+            await settle(app, pilot, until=lambda: sum(" ISS AZ:" in line for line in log_text(app, "outgoing")
+                                                       .splitlines()) >= 11 and "AZ " in static_text(app, "state"))
             outgoing = [line for line in log_text(app, "outgoing").splitlines() if " ISS AZ:" in line]
             assert len(outgoing) == 11  # one per tick (each may wrap onto a second line in the pane)
             assert "AZ " in static_text(app, "state") and "ISS (25544)" in static_text(app, "state")
@@ -30,10 +31,11 @@ def test_pokes_outgoing_strings_and_state_changes_show() -> None:
             await pilot.pause()
             assert "SAT=99999 REFUSED" in log_text(app, "incoming")
             await pilot.press(*"TUNE OFF", "enter")
-            await pilot.pause(0.3)
+            await settle(app, pilot, until=lambda: "TUNE OFF" in static_text(app, "state"))
             assert "TUNE OFF" in static_text(app, "state")
+            shown = static_text(app, "state")
             station.run(1.0)
-            await pilot.pause(0.3)
+            await settle(app, pilot, until=lambda: static_text(app, "state") != shown)  # the second drawn
             assert sum(" ISS AZ:" in line for line in log_text(app, "outgoing").splitlines()) == 11  # none new
             client = station.system.connect("NFW32", "NFW_DATA")
             client.poke("NFW_SERVER", "TRACK ON")
@@ -50,7 +52,8 @@ def test_pokes_outgoing_strings_and_state_changes_show() -> None:
             await pilot.press("f2")
             await pilot.pause()
             await pilot.press("down", "enter")
-            await pilot.pause(0.3)
+            await settle(app, pilot, until=lambda: station.core.state.catalog_number != 25544
+                         and "ok" in log_text(app, "incoming").splitlines()[-1])
             picked = station.core.snapshot()
             assert picked.catalog_number != 25544 and f"({picked.catalog_number})" in static_text(app, "state")
             assert f"SAT={picked.catalog_number} ok" in log_text(app, "incoming")

@@ -61,7 +61,8 @@ def test_markup_in_names_is_shown_literally_everywhere() -> None:
             await pilot.pause()
             assert "X [/bold] Y" in screen_text(app)
             await pilot.press("enter")
-            await pilot.pause(0.3)
+            await settle(app, pilot, until=lambda: station.core.state.catalog_number != ISS
+                         and "X [/bold] Y" in static_text(app, "state"))
             other = station.core.state.catalog_number
             assert other != ISS and station.core.state.catalog.get(other).name == "X [/bold] Y"
             assert f"SAT={other} ok" in log_text(app, "incoming")
@@ -114,7 +115,7 @@ def test_a_rotctld_reporting_nan_does_not_stop_the_console(nan_rotctld) -> None:
     async def scenario() -> None:
         app = NfwConsole(station.core, rotor=rotor)
         async with app.run_test(size=(120, 36)) as pilot:
-            await pilot.pause(0.6)
+            await settle(app, pilot, until=lambda: "Rotor:" in static_text(app, "state"))
             state = static_text(app, "state")
             assert state.startswith("Satellite ISS") and "Rotor:" in state
             await pilot.press(*"TUNE ON", "enter")
@@ -128,6 +129,7 @@ def test_a_rotctld_reporting_nan_does_not_stop_the_console(nan_rotctld) -> None:
 def test_rotor_flip_state_events_and_the_flip_commands() -> None:
     station = make_station()
     rotor = make_rotor(RotorConfig(backend="sim"), station.core, station.clock)
+    station.core.rotor = rotor  # as the station sets it
 
     async def scenario() -> None:
         app = NfwConsole(station.core, rotor=rotor)
@@ -135,14 +137,15 @@ def test_rotor_flip_state_events_and_the_flip_commands() -> None:
             await pilot.pause()
             assert "flip auto (normal)" in static_text(app, "state")
             await pilot.press("ctrl+f")
-            await pilot.pause(0.3)
+            await settle(app, pilot, until=lambda: "flip on (inverted)" in static_text(app, "state")
+                         and "[rotor] flip mode on" in log_text(app, "incoming"))
             assert rotor.flip_mode == "on" and "flip on (inverted)" in static_text(app, "state")
             assert "[rotor] flip mode on" in log_text(app, "incoming")
             await pilot.press(*"FLIP OFF", "enter")
-            await pilot.pause(0.3)
+            await settle(app, pilot, until=lambda: "flip off (normal)" in static_text(app, "state"))
             assert rotor.flip_mode == "off" and "flip off (normal)" in static_text(app, "state")
             await pilot.press(*"FLIP SIDEWAYS", "enter")
-            await pilot.pause(0.3)
+            await settle(app, pilot, until=lambda: "FLIP needs" in log_text(app, "incoming"))
             assert rotor.flip_mode == "off"
             assert "FLIP needs AUTO, ON or OFF" in " ".join(log_text(app, "incoming").split())
 
@@ -192,7 +195,7 @@ def test_picker_searches_15000_objects_preselects_and_closes_on_escape() -> None
             await pilot.pause()
             assert not isinstance(app.screen, SatellitePicker) and station.core.state.catalog_number == ISS
             await pilot.press("f2", *"43017", "enter")
-            await pilot.pause(0.3)
+            await settle(app, pilot, until=lambda: station.core.state.catalog_number == 43017)
             assert station.core.state.catalog_number == 43017
 
     asyncio.run(scenario())
@@ -214,7 +217,8 @@ def test_pass_searches_run_off_the_ui_thread(monkeypatch) -> None:
     async def scenario() -> None:
         app = NfwConsole(station.core, favourites=(ISS,))
         async with app.run_test(size=(120, 36)) as pilot:
-            await pilot.pause(0.3)
+            await settle(app, pilot, until=lambda: threads and "searching..." in static_text(app, "passes"),
+                         workers=False)
             assert threads and threads[0] is not threading.main_thread()
             assert "searching..." in static_text(app, "passes")
             await pilot.press(*"TUNE ON", "enter")  # keys are handled while the search is still running

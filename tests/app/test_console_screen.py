@@ -17,7 +17,7 @@ from skyfield.api import EarthSatellite, load, wgs84
 
 from nfwserver.channels.channel import Channel
 from nfwserver.console.app import NfwConsole
-from tests.app.console_helpers import log_text, screen_text, settle, static_text
+from tests.app.console_helpers import log_text, off_screen, screen_text, settle, static_text
 from tests.dde.conftest import CATALOG, ISS, ISS_PASS, OBSERVER, dead_iss_text, make_station
 
 LONG_HINT = ("no observer configured: using 0.000000,0.000000 (Greenwich). Set [observer] location in "
@@ -35,7 +35,7 @@ def test_80x24_notes_wrap_footer_shows_ctrl_d_and_every_pane_is_there() -> None:
             await settle(app, pilot)
             screen = screen_text(app)
             rows = screen.splitlines()
-            assert len(rows) == 24 and all(len(row) <= 80 for row in rows)
+            assert len(rows) == 24 and not off_screen(app), off_screen(app)
             assert "^d Doppler" in rows[-1]  # Ctrl+D in the footer from the start
             assert "Satellite ISS (25544)" in screen and "Passes (UTC)" in screen
             assert "Satellite  Date  AOS   Max LOS" in screen
@@ -85,7 +85,7 @@ def test_z_toggles_utc_and_local_time_with_the_zone_always_named() -> None:
             assert utc_aos in static_text(app, "passes") and "Passes (UTC)" in screen_text(app)
             assert f"Next pass {ISS_PASS.aos:%m-%d} AOS {ISS_PASS.aos:%H:%M:%S}" in static_text(app, "state")
             await pilot.press("f4")
-            await pilot.pause(0.3)
+            await settle(app, pilot, until=lambda: "UTC" not in static_text(app, "state"))
             local, local_aos = now.astimezone(sydney), ISS_PASS.aos.astimezone(sydney)
             zone = local.tzname()
             assert zone == "AEST"
@@ -94,10 +94,10 @@ def test_z_toggles_utc_and_local_time_with_the_zone_always_named() -> None:
             assert f"Passes ({zone})" in screen_text(app)
             # InstantTrack's Z, typed on the command line, and F4 toggle back and forth.
             await pilot.press("Z", "enter")
-            await pilot.pause(0.3)
+            await settle(app, pilot, until=lambda: f"{now:%m-%d %H:%M:%S} UTC" in static_text(app, "state"))
             assert f"{now:%m-%d %H:%M:%S} UTC" in static_text(app, "state")
             await pilot.press("f3", "f4")
-            await pilot.pause(0.3)
+            await settle(app, pilot, until=lambda: "UTC" not in static_text(app, "state"))
             assert zone in static_text(app, "state")
 
     asyncio.run(scenario())

@@ -7,7 +7,7 @@ import asyncio
 from textual.widgets import Input
 
 from nfwserver.console.app import NfwConsole
-from tests.app.console_helpers import log_text, screen_text, settle
+from tests.app.console_helpers import log_text, off_screen, screen_text, settle, static_text
 from tests.dde.conftest import ISS, make_station
 
 
@@ -29,11 +29,11 @@ def test_typed_commands_still_reach_the_station_after_f1_and_f3() -> None:
     async def scenario(app, pilot, station) -> None:
         await pilot.press("f1")
         await pilot.press(*"TUNE OFF", "enter")
-        await pilot.pause(0.1)
+        await settle(app, pilot, until=lambda: not station.core.state.snapshot().dde_output)
         assert not station.core.state.snapshot().dde_output
         await pilot.press("f3")
         await pilot.press(*"TUNE ON", "enter")
-        await pilot.pause(0.1)
+        await settle(app, pilot, until=lambda: station.core.state.snapshot().dde_output)
         assert station.core.state.snapshot().dde_output
         assert isinstance(app.focused, Input)
 
@@ -45,10 +45,15 @@ def test_the_outgoing_pane_wraps_whole_nova_strings() -> None:
         station.run(1.0)
         await pilot.press("f1")
         await settle(app, pilot)
-        shown = screen_text(app)
-        assert "AH:" in shown  # wrapped onto a second line, not cut off at the pane's edge
-        assert all(len(line) <= 80 for line in shown.splitlines())
-        assert "AH:" in log_text(app, "outgoing")
+        assert not off_screen(app), off_screen(app)
+        pane = app.query_one("#outgoing")
+        width = pane.scrollable_content_region.width
+        rows = log_text(app, "outgoing").splitlines()
+        assert rows and all(len(row) <= width for row in rows)  # wrapped inside the pane
+        nova = station.core.current_text()
+        assert len(nova) > width, (nova, width)  # it has to wrap to be seen whole
+        assert " ".join(nova.split()) in " ".join(" ".join(rows).split()), rows  # whole, not cut at the edge
+        assert "AH:" in screen_text(app)  # the wrapped end of the string is on screen, not cut at the pane's edge
 
     _run(scenario)
 
@@ -63,10 +68,10 @@ def test_page_keys_scroll_the_shown_log_while_typing_stays_possible() -> None:
         bottom = incoming.scroll_y
         assert bottom > 0
         await pilot.press("pageup")
-        await pilot.pause(0.2)
+        await settle(app, pilot, until=lambda: incoming.scroll_y < bottom)
         assert incoming.scroll_y < bottom
         await pilot.press("pagedown", "pagedown")
-        await pilot.pause(0.2)
+        await settle(app, pilot, until=lambda: incoming.scroll_y == bottom)
         assert incoming.scroll_y == bottom
         assert isinstance(app.focused, Input)
 
@@ -87,14 +92,18 @@ def test_the_footer_shows_every_key_at_80_columns() -> None:
 def test_the_header_rewraps_when_the_terminal_is_resized() -> None:
     async def scenario(app, pilot, station) -> None:
         narrow = screen_text(app)
+        narrow_rows = app.query_one("#state").content_region.height
         await pilot.resize_terminal(140, 40)
         await settle(app, pilot)
-        wide = screen_text(app).splitlines()
-        assert all(len(line) <= 140 for line in wide)
+        assert not off_screen(app), off_screen(app)
         state = app.query_one("#state")
         assert state.size.width > 100
-        lines_narrow = sum(1 for line in narrow.splitlines()[:12] if line.startswith("│"))
-        lines_wide = sum(1 for line in wide[:12] if line.startswith("│"))
-        assert lines_wide <= lines_narrow
+        # Rewrapped to the new width: every line of the header now fits in one row (none is longer than the
+        # pane), so the pane has exactly as many rows as the header has lines.
+        lines = static_text(app, "state").splitlines()
+        assert max(len(line) for line in lines) <= state.content_region.width
+        assert state.content_region.height == len(lines), (state.content_region, lines)
+        assert state.content_region.height < narrow_rows  # the lines wrapped at 80 columns are one row each now
+        assert narrow != screen_text(app)
 
     _run(scenario)

@@ -19,9 +19,11 @@ from nfwserver.clock import VirtualClock
 from nfwserver.config import load_config
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.rotor.coupling import angular_distance
+from nfwserver.tcp.status_line import parse_status
 from tests.conftest import DATA, ROOT
 from tests.dde.conftest import ISS_PASS
 from tests.hamlib_daemons import HamlibDaemon, free_port
+from tests.waiting import wait_for
 
 
 def _config(tmp_path: Path, tcp_port: int, rotor_port: int | None = None) -> Path:
@@ -37,7 +39,7 @@ def _config(tmp_path: Path, tcp_port: int, rotor_port: int | None = None) -> Pat
 
 
 def _fields(line: str) -> dict[str, str]:
-    return dict(pair.split("=", 1) for pair in line.split(" "))
+    return parse_status(line)
 
 
 @pytest.mark.hamlib
@@ -94,10 +96,11 @@ def test_nfwserver_run_headless_serves_tcp_with_start_up_tune_and_track(tmp_path
                              "--config", str(path), "--log-file", str(tmp_path / "log.txt")],
                             cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     try:
-        deadline = time.monotonic() + 30.0
-        while main(["status", "--config", str(path), "--timeout", "1"]) != 0:
-            assert proc.poll() is None and time.monotonic() < deadline, proc.stderr.read().decode()
-            time.sleep(0.2)
+        def answers() -> bool:
+            assert proc.poll() is None, proc.stderr.read().decode()  # a station that exited fails at once
+            return main(["status", "--config", str(path), "--timeout", "1"]) == 0
+
+        wait_for(answers, 30.0, "nfwserver status to reach the station", interval_s=0.2)
         fields = _fields(capsys.readouterr().out.strip())
         assert (fields["satellite"], fields["name"], fields["tune"], fields["track"]) == ("25544", "ISS", "on", "on")
         assert main(["poke", "--config", str(path), "summary"]) == 0

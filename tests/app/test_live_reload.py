@@ -18,6 +18,7 @@ from nfwserver.config import parse_config
 from nfwserver.console.app import NfwConsole
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tracking.observer import parse_observer
+from tests.app.console_helpers import settle
 from tests.conftest import DATA, advance_until
 from tests.dde.conftest import CATALOG, ISS, ISS_PASS
 from tests.tracking.skyfield_oracle import skyfield_look_angles
@@ -79,5 +80,5 @@ def test_a_new_observer_reaches_dde_predict_rotor_and_console_on_the_next_tick()
 async def _console_state(station: Station) -> str:
     app = NfwConsole(station.core, favourites=(ISS,), clients=station.nova.client_count)
     async with app.run_test(size=(140, 40)) as pilot:
-        await pilot.pause(0.3)
+        await settle(app, pilot, until=lambda: "AZ " in str(app.query_one("#state", Static).render()))
         return str(app.query_one("#state", Static).render())

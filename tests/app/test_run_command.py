@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import threading
-import time
 from pathlib import Path
 
 from nfwserver.cli.run_command import RunPlan, serve
@@ -15,6 +14,7 @@ from nfwserver.fake_dde import FakeDdeSystem
 from tests.app.headless_run import serve_once
 from tests.conftest import advance_until
 from tests.dde.conftest import ISS_PASS
+from tests.waiting import wait_for
 
 CONFIG = '[observer]\nlocation = "JO02ae"\n[server]\nsatellite = 25544\nstate_file = "none"\n'
 
@@ -24,13 +24,6 @@ def _config(tmp_path: Path, text: str = CONFIG):
     path.write_text(text)
     return load_config(str(path))
 
-
-def _wait_real(predicate, seconds: float = 20.0) -> bool:
-    """Poll ``predicate`` (bounded; the station runs on threads of its own)."""
-    deadline = time.monotonic() + seconds
-    while not predicate() and time.monotonic() < deadline:
-        time.sleep(0.01)
-    return predicate()
 
 
 def test_headless_prints_the_log_file_logs_the_start_and_a_status_every_ten_minutes(tmp_path, capsys) -> None:
@@ -45,9 +38,12 @@ def test_headless_prints_the_log_file_logs_the_start_and_a_status_every_ten_minu
         return log_file.read_text().count(" status: ") if log_file.exists() else 0
 
     def drive() -> None:
-        _wait_real(lambda: "outputs:" in (log_file.read_text() if log_file.exists() else ""))
-        advance_until(clock, lambda: statuses() >= 2, step_s=30.0, limit_s=1500.0)
-        stop.set()
+        try:
+            wait_for(lambda: "outputs:" in (log_file.read_text() if log_file.exists() else ""), 20.0,
+                     "the start line in the log")
+            advance_until(clock, lambda: statuses() >= 2, step_s=30.0, limit_s=1500.0)
+        finally:
+            stop.set()  # whatever happened, the run must end (a failed wait shows in the asserts below)
 
     driver = threading.Thread(target=drive)
     driver.start()
@@ -99,7 +95,8 @@ def test_a_console_failure_is_reported_in_one_sentence_and_the_station_keeps_ser
     def drive() -> None:
         # Once the console has failed and the run carries on headless, a DDE client still gets the feed.
         try:
-            assert _wait_real(lambda: log_file.exists() and "outputs:" in log_file.read_text())
+            wait_for(lambda: log_file.exists() and "outputs:" in log_file.read_text(), 20.0,
+                     "the start line in the log")
             client = system.connect("NFW32", "NFW_DATA")
             client.on_receive = lambda r: received.append(r.text) if r.kind == "data" else None
             client.start_advise("NFW_SERVER", CF_TEXT, hot=True)

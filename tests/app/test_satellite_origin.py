@@ -11,6 +11,7 @@ from nfwserver.clock import VirtualClock
 from nfwserver.config import load_config
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tcp.protocol import NovaTcpProtocol
+from nfwserver.tcp.status_line import parse_status
 from tests.app.headless_run import serve_once
 from tests.dde.conftest import ISS_PASS
 
@@ -34,7 +35,7 @@ def _start(tmp_path, configured: int, saved: dict | None, capsys) -> tuple[str, 
     station.start()
     try:
         line = NovaTcpProtocol(station.core).status_line()
-        status = dict(pair.split("=", 1) for pair in line.split(" "))
+        status = parse_status(line)
         status["hint"] = station.selection_note
     finally:
         station.stop()

@@ -12,6 +12,7 @@ from nfwserver.config import load_config
 from nfwserver.console.pass_view import PassSearch, pass_table
 from nfwserver.console.time_display import TimeDisplay
 from nfwserver.fake_dde import FakeDdeSystem
+from nfwserver.tcp.status_line import parse_status
 from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.observer import Observer
@@ -24,7 +25,7 @@ ISS = next(s for s in load_element_file(DATA / "visual.txt").sets if s.catalog_n
 
 
 def _fields(line: str) -> dict[str, str]:
-    return dict(word.partition("=")[::2] for word in line.split())
+    return parse_status(line)
 
 
 def test_status_says_how_old_the_selected_satellites_elements_are(tmp_path, capsys) -> None:

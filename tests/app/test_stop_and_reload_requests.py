@@ -17,13 +17,7 @@ from nfwserver.app.config_watcher import ConfigWatcher
 from nfwserver.cli.control_file import ControlFile, control_path
 from nfwserver.cli.signals import RELOAD, STOP, StationSignals, signal_actions
 from nfwserver.clock import SystemClock
-
-
-def _until(predicate, timeout_s: float = 5.0) -> bool:
-    deadline = time.monotonic() + timeout_s
-    while not predicate() and time.monotonic() < deadline:
-        time.sleep(0.01)
-    return predicate()
+from tests.waiting import wait_for
 
 
 def test_sighup_reloads_when_headless_and_stops_under_the_console() -> None:
@@ -44,12 +38,12 @@ def test_real_signals_become_one_stop_and_reloads_and_later_ones_are_only_noted(
         with caplog.at_level(logging.INFO, logger="nfwserver"):
             assert signals.install()
             os.kill(os.getpid(), signal.SIGHUP)
-            assert _until(lambda: calls == ["reload"])
+            assert wait_for(lambda: calls == ["reload"])
             os.kill(os.getpid(), signal.SIGTERM)
-            assert _until(lambda: calls == ["reload", "stop"])
+            assert wait_for(lambda: calls == ["reload", "stop"])
             os.kill(os.getpid(), signal.SIGINT)  # a second Ctrl+C while stopping: no KeyboardInterrupt
             os.kill(os.getpid(), signal.SIGHUP)  # and no reload once stopping
-            assert _until(lambda: caplog.text.count("already stopping") == 2)
+            assert wait_for(lambda: caplog.text.count("already stopping") == 2)
             assert calls == ["reload", "stop"]
             signals.close()
             os.kill(os.getpid(), signal.SIGINT)  # after the run: ignored, the process exits cleanly
@@ -83,12 +77,12 @@ def test_the_control_file_asks_for_reload_and_stop_and_is_removed(tmp_path: Path
         time.sleep(0.05)
         assert path.exists() and got == []
         path.write_text("RELOAD\n")
-        assert _until(lambda: len(got) == 1) and not path.exists()
+        assert wait_for(lambda: len(got) == 1) and not path.exists()
         path.write_text("halt now\n")
-        assert _until(lambda: not path.exists())
+        assert wait_for(lambda: not path.exists())
         assert "'halt' is not a request" in caplog.text
         path.write_text("stop")
-        assert _until(lambda: len(got) == 2)
+        assert wait_for(lambda: len(got) == 2)
     finally:
         control.stop()
     assert got == [("reload", f"control file {path}"), ("stop", f"control file {path}")]
@@ -109,10 +103,10 @@ def test_a_requested_read_applies_the_file_even_when_it_looks_unchanged(tmp_path
         time.sleep(0.05)
         assert applied == []
         watcher.request()
-        assert _until(lambda: applied == [27607])
+        assert wait_for(lambda: applied == [27607])
         path.write_text("# being saved\n")
         watcher.request()
-        assert _until(lambda: len(refused) == 1) and applied == [27607]
+        assert wait_for(lambda: len(refused) == 1) and applied == [27607]
     finally:
         watcher.stop()
 

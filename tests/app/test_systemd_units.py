@@ -10,14 +10,15 @@ import signal
 import socket
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
 
 from nfwserver.cli.signals import RELOAD, STOP, signal_actions
+from nfwserver.tcp.status_line import parse_status
 from tests.conftest import DATA, ROOT
 from tests.hamlib_daemons import free_port
+from tests.waiting import wait_for
 
 UNITS = ROOT / "contrib" / "systemd"
 LAUNCHER = ROOT / "tools" / "wine" / "nfwserver"
@@ -86,19 +87,7 @@ def _status(port: int) -> dict[str, str]:
         reader = sock.makefile("rb")
         reader.readline()
         sock.sendall(b"STATUS\r\n")
-        return dict(pair.split("=", 1) for pair in reader.readline().decode().split())
-
-
-def _until(predicate, timeout_s: float) -> bool:
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        try:
-            if predicate():
-                return True
-        except OSError:
-            pass
-        time.sleep(0.1)
-    return False
+        return parse_status(reader.readline().decode())
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
@@ -126,11 +115,11 @@ def test_the_linux_units_commands_start_reload_stop_and_fail_as_documented(tmp_p
     proc = subprocess.Popen(command, cwd=ROOT, env=env, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                             stderr=subprocess.PIPE)
     try:
-        assert _until(lambda: _status(port)["tune"] == "on", 30.0)
+        wait_for(lambda: _status(port)["tune"] == "on", 30.0, "the station to serve with TUNE ON", tolerate=(OSError,))
         config.write_text(body + '[satellites]\nnames = { 25544 = "ZARYA" }\n')
         reload = shlex.split(service["ExecReload"][0].replace("$MAINPID", str(proc.pid)))
         assert subprocess.run(reload).returncode == 0  # systemctl reload
-        assert _until(lambda: _status(port)["name"] == "ZARYA", 5.0)
+        wait_for(lambda: _status(port)["name"] == "ZARYA", 5.0, "the reloaded name", tolerate=(OSError,))
         proc.send_signal(signal.Signals[service["KillSignal"][0]])  # systemctl stop
         assert proc.wait(float(service["TimeoutStopSec"][0])) == 0  # a clean stop: no restart
     finally:

@@ -10,7 +10,6 @@ import socket
 import subprocess
 import sys
 import threading
-import time
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
@@ -26,6 +25,7 @@ from nfwserver.fake_dde import FakeDdeSystem
 from tests.conftest import DATA, ROOT
 from tests.dde.conftest import ISS_PASS
 from tests.hamlib_daemons import free_port
+from tests.waiting import wait_for
 
 
 def _config(tmp_path: Path, tcp_port: int) -> Path:
@@ -42,11 +42,7 @@ def _config(tmp_path: Path, tcp_port: int) -> Path:
 def _station(path: Path, clock: VirtualClock) -> Station:
     station = Station(load_config(str(path)), clock, transport=FakeDdeSystem().server_transport())
     station.start()
-    deadline = time.monotonic() + 10.0
-    while not station.core.current_text():  # the first tick on the virtual clock
-        assert time.monotonic() < deadline
-        clock.advance(0.2)
-        time.sleep(0.01)
+    wait_for(lambda: station.core.current_text() or clock.advance(0.2), 10.0, "the first tick on the virtual clock")
     return station
 
 
@@ -92,11 +88,8 @@ def test_watch_reconnects_when_the_station_stops_and_returns(tmp_path) -> None:
     thread = threading.Thread(target=watcher.run, daemon=True)
 
     def step_until(predicate) -> None:
-        deadline = time.monotonic() + 20.0
-        while not predicate():
-            assert time.monotonic() < deadline, [plain_line(u) for u in updates[-3:]]
-            watch_clock.advance(0.5)
-            time.sleep(0.01)
+        wait_for(lambda: predicate() or watch_clock.advance(0.5), 20.0,
+                 lambda: f"the watcher's updates; the last: {[plain_line(u) for u in updates[-3:]]}")
 
     thread.start()
     try:

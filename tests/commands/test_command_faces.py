@@ -12,7 +12,8 @@ import pytest
 from nfwserver.commands.help_text import help_lines, markdown, poke_epilog
 from nfwserver.commands.table import COMMANDS, Face
 from tests.dde.conftest import CATALOG
-from tests.tcp.conftest import LineClient, wait_for
+from tests.tcp.conftest import LineClient
+from tests.waiting import wait_for
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -67,7 +68,7 @@ def test_flip_with_a_rotor_checks_the_argument(tcp_station, client) -> None:
         def request_park(self) -> None:
             modes.append("park")
 
-    server.protocol.rotor = Rotor()
+    server.core.rotor = Rotor()
     assert client.ask("FLIP sideways") == "ERROR FLIP needs AUTO, ON or OFF"
     assert client.ask("flip On") == "OK"
     assert modes == ["on"]

@@ -21,8 +21,9 @@ def test_console_help_flip_name_and_track_warning() -> None:
         async with app.run_test(size=(120, 40)) as pilot:
             await settle(app, pilot)
             for text in ("help", "flip on", "SAT=oao 2", "TRACK ON"):
+                shown = len(log_text(app, "incoming").splitlines())
                 await pilot.press(*text, "enter")
-                await pilot.pause(0.1)
+                await settle(app, pilot, until=lambda shown=shown: len(log_text(app, "incoming").splitlines()) > shown)
             shown = " ".join(log_text(app, "incoming").split())
             for line in help_lines(Face.CONSOLE):
                 assert " ".join(line.split()) in shown

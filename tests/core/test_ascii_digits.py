@@ -13,8 +13,9 @@ import asyncio
 import pytest
 
 from nfwserver.cli.arguments import time_value
+from nfwserver.commands.parsing import parse_poke
+from nfwserver.commands.table import CommandError
 from nfwserver.console.app import NfwConsole
-from nfwserver.core.nova_protocol import PokeError, parse_poke
 from nfwserver.dialects.predict_listing import atol
 from nfwserver.fake_dde import DdeError
 from nfwserver.tracking.elements import load_elements
@@ -30,7 +31,7 @@ NOT_ASCII = ["²", "٣", "５", "१", "①", "٢٥٥٤٤", "2554٤"]
 @pytest.mark.parametrize("value", NOT_ASCII)
 @pytest.mark.parametrize("command", ["SAT", "ANTAZ", "ANTEL"])
 def test_the_grammar_refuses_digits_other_than_ascii(command: str, value: str) -> None:
-    with pytest.raises(PokeError) as refused:
+    with pytest.raises(CommandError) as refused:
         parse_poke(f"{command}={value}")
     assert refused.value.bad_argument
     assert ("catalog number" if command == "SAT" else "number of degrees") in str(refused.value)
@@ -79,10 +80,10 @@ def test_the_console_refuses_the_poke_and_its_picker_searches_without_crashing()
         async with app.run_test(size=(100, 30)) as pilot:
             await settle(app, pilot)
             await pilot.press(*"SAT=²", "enter")
-            await pilot.pause(0.2)
+            await settle(app, pilot, until=lambda: "REFUSED" in log_text(app, "incoming"))
             assert "REFUSED (SAT needs a catalog number, got '\\xb2')" in " ".join(log_text(app, "incoming").split())
             await pilot.press("f2", "²")
-            await pilot.pause(0.2)
+            await settle(app, pilot, until=lambda: type(app.screen).__name__ == "SatellitePicker")
             await pilot.press("escape")
             await pilot.pause()
             assert app.is_running and station.core.state.catalog_number == ISS

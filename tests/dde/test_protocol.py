@@ -8,16 +8,13 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from nfwserver.commands.parsing import parse_poke
+from nfwserver.commands.table import CommandError, Poke, PokeKind, escape_for_log
 from nfwserver.core.nova_protocol import (
-    Poke,
-    PokeError,
-    PokeKind,
-    escape_for_log,
     format_azimuth,
     format_elevation,
     format_nova,
     format_range_rate,
-    parse_poke,
 )
 
 NOVA = re.compile(r"^\S{1,12} AZ:\d{1,3}\.\d EL:-?\d{1,2}\.\d RR:-?\d+\.\d{10} AH:[YN]$")
@@ -86,7 +83,7 @@ _NOT_NOVA = "not a Nova command (TUNE ON|OFF, TRACK ON|OFF, SAT=n, ANTAZ=deg, AN
 ])
 def test_bad_pokes_are_refused_with_a_reason(text: str, reason: str) -> None:
     # The reason is what the console, the event log and a TCP client see: it names what was wrong.
-    with pytest.raises(PokeError) as info:
+    with pytest.raises(CommandError) as info:
         parse_poke(text)
     assert str(info.value) == reason
 
@@ -95,7 +92,7 @@ def test_bad_pokes_are_refused_with_a_reason(text: str, reason: str) -> None:
 def test_any_text_either_parses_or_raises_poke_error(text: str) -> None:
     try:
         pokes = parse_poke(text)
-    except PokeError:
+    except CommandError:
         return
     assert pokes and all(isinstance(p, Poke) for p in pokes)
 

@@ -18,6 +18,7 @@ from nfwserver.easycomm.output import open_serial
 from tests.conftest import advance_until
 from tests.dde.conftest import CATALOG, ISS, ISS_PASS, OBSERVER, make_station
 from tests.tracking.skyfield_oracle import skyfield_look_angles
+from tests.waiting import wait_for
 
 C_KM_S = 299792.458
 NOVA_LINE = re.compile(r"^AZ(\d{1,3}\.\d) EL(-?\d{1,2}\.\d) UP(-?\d+\.\d{10}) XXX DN000000000 XXX$")
@@ -63,10 +64,7 @@ def _output(station, path: Path, uplink: str = "range-rate", **kw) -> EasyCommOu
 def _start(output: EasyCommOutput) -> None:
     """Start the worker and let it open the port and settle into its wait (it opens at once)."""
     output.start()
-    deadline = time.monotonic() + 5.0
-    while not output.connected and time.monotonic() < deadline:
-        time.sleep(0.001)
-    assert output.connected
+    wait_for(lambda: output.connected, 5.0, "the port to open", interval_s=0.001)
     time.sleep(0.05)
 
 
@@ -75,9 +73,7 @@ def _step(station, output: EasyCommOutput) -> None:
     station.core.tick()
     written = output.lines_written
     station.clock.advance(0.5)  # one period of the 2 Hz schedule
-    deadline = time.monotonic() + 5.0
-    while output.lines_written == written and time.monotonic() < deadline:
-        time.sleep(0.001)
+    wait_for(lambda: output.lines_written != written, 5.0, "the line of that tick", interval_s=0.001)
     assert output.lines_written == written + 1
 
 

@@ -21,6 +21,7 @@ from nfwserver.rotor.tracks import SatelliteTracks
 from tests.dde.conftest import CATALOG, OBSERVER, state_for
 from tests.hamlib_daemons import HamlibDaemon
 from tests.rotor.conftest import pass_crossing_north
+from tests.waiting import wait_for
 
 pytestmark = pytest.mark.hamlib
 CATNR, CROSSING = pass_crossing_north()
@@ -57,13 +58,12 @@ def test_a_real_pass_segment_is_followed_by_the_dummy_rotor() -> None:
             run_virtual(server, clock, 0.8)
             time.sleep(0.1)
         target_el, target_az = driver.positions()[2:]
-        deadline = time.monotonic() + 12.0  # bounded wait for the 6 deg/s dummy to arrive
-        while time.monotonic() < deadline:
+        def arrived() -> tuple[float, float] | None:
             az, el = (float(v) for v in daemon.query("p", 2))
-            if abs(((az - target_az) + 180) % 360 - 180) < 1.0 and abs(el - target_el) < 1.0:
-                break
-            time.sleep(0.2)
-        assert abs(((az - target_az) + 180) % 360 - 180) < 1.0 and abs(el - target_el) < 1.0
+            on_target = abs(((az - target_az) + 180) % 360 - 180) < 1.0 and abs(el - target_el) < 1.0
+            return (az, el) if on_target else None
+
+        az, el = wait_for(arrived, 12.0, "the 6 deg/s dummy rotor to reach the target", interval_s=0.2)
         assert -180.0 <= az <= 450.0
         assert abs(az) < 60  # crossed north near 0 on the short branch, not by a swing to 360
         assert not driver.status().bits & KctStatusBit.CARD_ABSENT
@@ -130,7 +130,8 @@ def test_park_stops_tracking_and_sends_the_rotor_to_its_park_position_until_trac
         run_virtual(core, clock, 1.0)
         target_el, target_az = driver.positions()[2:]
         assert target_el is not None and target_el > 10  # following the satellite near its TCA
-        server = NovaTcpServer(core, LOOPBACK_ONLY, rotor=coupling)
+        core.rotor = coupling  # as the station sets it
+        server = NovaTcpServer(core, LOOPBACK_ONLY)
         server.start()
         client = LineClient(server.address)
         try:
@@ -166,11 +167,14 @@ def test_an_outage_of_rotctld_is_not_taken_for_a_stall() -> None:
             clock.advance(1.0)
             driver.service()
         daemon.restart()
-        deadline = time.monotonic() + 5.0
-        while driver.rotor_position() is None or not driver.backend_reachable:
+        def back() -> bool:
+            if driver.rotor_position() is not None and driver.backend_reachable:
+                return True
             clock.advance(0.2)
             driver.service()
-            assert time.monotonic() < deadline, "rotctld did not come back"
+            return False
+
+        wait_for(back, 5.0, "rotctld to come back", interval_s=0.0)
         clock.advance(0.2)
         driver.service()
         assert not driver.stalled

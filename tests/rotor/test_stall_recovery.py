@@ -8,7 +8,6 @@ into a real rotctld through a loopback proxy that refuses moves (``RPRT -1``), a
 from __future__ import annotations
 
 import logging
-import time
 from datetime import timedelta
 
 from nfwserver.app.status_fields import device_status
@@ -21,6 +20,7 @@ from tests.dde.conftest import CATALOG, ISS, ISS_PASS, OBSERVER
 from tests.hamlib_daemons import HamlibDaemon
 from tests.hamlib_fault_proxy import FaultProxy
 from tests.rotor.conftest import rotor_station
+from tests.waiting import wait_for
 
 GEOMETRY = RotorGeometry.preset("overlap-450")
 STALLED = KctStatusBit.AZ_STALLED | KctStatusBit.EL_STALLED
@@ -125,11 +125,9 @@ def test_refusals_from_a_real_rotctld_stall_the_rotor_until_it_accepts_and_moves
                 clock.advance(0.2)
             assert driver.stalled and proxy.set_commands_relayed == relayed
             clock.advance(1.0)
-            deadline = time.monotonic() + 5.0  # the real rotor turns at 6 deg/s of real time
-            while not driver.health.ok and time.monotonic() < deadline:
-                driver.service()
-                time.sleep(0.05)
-            assert driver.health.ok and not driver.stalled
+            # the real rotor turns at 6 deg/s of real time
+            wait_for(lambda: driver.service() or driver.health.ok, 5.0, "the rotor link to be well", interval_s=0.05)
+            assert not driver.stalled
             assert proxy.set_commands_relayed > relayed
         finally:
             proxy.close()

@@ -72,13 +72,3 @@ def client(tcp_station) -> Iterator[LineClient]:
     assert c.read_line() == b"Hello, this is Nova for Windows.\r\n"
     yield c
     c.close()
-
-
-def wait_for(predicate, timeout: float = 5.0) -> bool:
-    """Poll ``predicate`` for up to ``timeout`` real seconds (the server's thread is real)."""
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.005)
-    return True

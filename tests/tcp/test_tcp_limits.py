@@ -12,7 +12,8 @@ import pytest
 
 from nfwserver.tcp import NovaTcpServer
 from tests.dde.conftest import make_station
-from tests.tcp.conftest import LOOPBACK_ONLY, LineClient, wait_for
+from tests.tcp.conftest import LOOPBACK_ONLY, LineClient
+from tests.waiting import wait_for
 
 GREETING = b"Hello, this is Nova for Windows.\r\n"
 LOOPBACK_NET = dataclasses.replace(LOOPBACK_ONLY, allow=("127.0.0.0/8",), max_per_address=3, max_clients=5,

@@ -13,7 +13,8 @@ import numpy as np
 
 from nfwserver.tcp import NovaTcpServer
 from tests.dde.conftest import ISS, make_station
-from tests.tcp.conftest import LOOPBACK_ONLY, LineClient, wait_for
+from tests.tcp.conftest import LOOPBACK_ONLY, LineClient
+from tests.waiting import wait_for
 
 #: these tests load one server from one address: the per-address cap is not what they look at
 ONE_BUSY_ADDRESS = dataclasses.replace(LOOPBACK_ONLY, max_per_address=4096)
@@ -84,16 +85,14 @@ def test_fifty_watchers_get_every_string_while_a_stalled_one_is_dropped(caplog) 
             started = time.perf_counter()
             station.core.tick()
             costs.append(time.perf_counter() - started)
-            deadline = time.monotonic() + 5.0
-            while server.stats.delivered < k and time.monotonic() < deadline:
-                time.sleep(0.0001)
-            assert server.stats.delivered == k, "the server fell behind"
+            wait_for(lambda k=k: server.stats.delivered >= k, 5.0, f"string {k} to be delivered", interval_s=0.0001)
+            assert server.stats.delivered == k
             if dropped_at is None and server.stats.dropped:
                 dropped_at = k
             if dropped_at is not None and k >= dropped_at + 50:
                 break
         assert dropped_at is not None, "the stalled client was never dropped"
-        assert wait_for(lambda: all(readers.count(c) == len(published) for c in watchers), timeout=20.0)
+        assert wait_for(lambda: all(readers.count(c) == len(published) for c in watchers), timeout_s=20.0)
         readers.close()
         assert all(readers.lines(c) == published for c in watchers)
         assert len(published) == k and all(p.startswith("ISS AZ:") for p in published)
@@ -155,8 +154,8 @@ def test_ten_thousand_hostile_lines_disturb_nobody() -> None:
             station.run(0.0)  # one tick between bursts
         hostile.sock.sendall(b"\n")
         expected = _expected_replies(stream)
-        assert wait_for(lambda: readers.count(hostile) == expected, timeout=60.0), (readers.count(hostile), expected)
-        assert wait_for(lambda: readers.count(watcher) == len(published), timeout=10.0)
+        assert wait_for(lambda: readers.count(hostile) == expected, timeout_s=60.0), (readers.count(hostile), expected)
+        assert wait_for(lambda: readers.count(watcher) == len(published), timeout_s=10.0)
         assert readers.lines(watcher) == published and len(published) == 20
         readers.close()
         assert server.client_count() == 2  # the hostile client is still served, the watcher never noticed

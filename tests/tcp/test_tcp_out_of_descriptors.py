@@ -16,6 +16,7 @@ import time
 from pathlib import Path
 
 from tests.tcp.conftest import LineClient
+from tests.waiting import wait_for
 
 ROOT = Path(__file__).resolve().parents[2]
 CHILD = textwrap.dedent("""
@@ -51,26 +52,26 @@ def test_out_of_descriptors_rests_the_listener_and_recovers() -> None:
         port = int(child.stdout.readline())
         for _ in range(12):  # more than the child has descriptors for: the rest wait in its backlog
             clients.append(LineClient(("127.0.0.1", port)))
-        time.sleep(0.3)  # let the child hit EMFILE
+        def status() -> str:
+            child.stdin.write("status\n")
+            child.stdin.flush()
+            return child.stdout.readline()
+
+        # the child has hit EMFILE once its STATUS shows the fault
+        wait_for(lambda: "tcp-accept_fault=cannot_accept_connections" in status(), 10.0, "the tcp-accept fault",
+                 interval_s=0.05)
         cpu_before = _cpu_seconds(child.pid)
-        time.sleep(1.0)
+        time.sleep(1.0)  # the window the CPU is measured over
         spent = _cpu_seconds(child.pid) - cpu_before
         assert spent < 0.3, f"the accept loop used {spent:.2f} s of CPU in 1 s while out of descriptors"
-        child.stdin.write("status\n")
-        child.stdin.flush()
-        status = child.stdout.readline()
-        assert "tcp-accept_fault=cannot_accept_connections" in status, status
+        assert "tcp-accept_fault=cannot_accept_connections" in status()
         for c in clients:
             c.close()
         clients.clear()
-        deadline = time.monotonic() + 10.0  # the fault clears at the end of its back-off (<= 5 s), with no
-        while True:                          # peer waiting: the server finds a spare descriptor itself
-            child.stdin.write("status\n")
-            child.stdin.flush()
-            if "faults=none" in child.stdout.readline():
-                break
-            assert time.monotonic() < deadline, "tcp-accept still shown with descriptors free"
-            time.sleep(0.2)
+        # the fault clears at the end of its back-off (<= 5 s), with no peer waiting: the server finds a spare
+        # descriptor itself
+        wait_for(lambda: "faults=none" in status(), 10.0, "tcp-accept to clear with descriptors free",
+                 interval_s=0.2)
         late = LineClient(("127.0.0.1", port))
         clients.append(late)
         assert late.read_line(timeout=10.0) == b"Hello, this is Nova for Windows.\r\n"

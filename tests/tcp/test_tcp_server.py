@@ -7,8 +7,10 @@ import pytest
 from nfwserver.config.schema import TcpConfig
 from nfwserver.core.events import Direction
 from nfwserver.tcp import NovaTcpServer
+from nfwserver.tcp.status_line import parse_status
 from tests.dde.conftest import CATALOG, make_station
-from tests.tcp.conftest import LOOPBACK_ONLY, LineClient, wait_for
+from tests.tcp.conftest import LOOPBACK_ONLY, LineClient
+from tests.waiting import wait_for
 
 SO_50 = 27607  # not in visual.txt: a catalog number the station does not know
 OTHER = 694  # ATLAS-CENT-2, in visual.txt
@@ -103,7 +105,7 @@ def test_status_is_one_line_of_key_values(tcp_station, client) -> None:
     server.protocol.extra = lambda: {"rotor": "ok", "rotor_az": "12.5", "note": "two words"}
     station.core.set_tune(True)
     station.run(0.4)
-    fields = dict(pair.split("=", 1) for pair in client.ask("STATUS").split(" "))
+    fields = parse_status(client.ask("STATUS"))
     sample = station.core.tracker.last_sample
     assert fields["satellite"] == "25544" and fields["name"] == "ISS"
     assert (fields["tune"], fields["track"], fields["radio_tuning"]) == ("on", "off", "off")
@@ -207,7 +209,8 @@ def test_flip_sets_the_rotors_inverted_tracking_mode(tcp_station, client) -> Non
 
     assert client.ask("FLIP ON") == "ERROR no rotor is configured"  # this station has no rotor
     clock, core, _, _, coupling, _ = rotor_station(ISS_PASS.aos, RotorGeometry.preset("north-stop+flip"))
-    server = NovaTcpServer(core, LOOPBACK_ONLY, rotor=coupling)
+    core.rotor = coupling  # as the station sets it
+    server = NovaTcpServer(core, LOOPBACK_ONLY)
     server.start()
     try:
         with_rotor = LineClient(server.address)
@@ -223,13 +226,13 @@ def test_flip_sets_the_rotors_inverted_tracking_mode(tcp_station, client) -> Non
 
 def test_status_names_every_failing_link_while_its_fault_lasts(tcp_station, client) -> None:
     station, _ = tcp_station
-    fields = dict(pair.split("=", 1) for pair in client.ask("STATUS").split(" "))
+    fields = parse_status(client.ask("STATUS"))
     assert fields["faults"] == "none"
     link = station.core.health.link("radio")
     link.failed("rigctld: connection refused")
-    fields = dict(pair.split("=", 1) for pair in client.ask("STATUS").split(" "))
+    fields = parse_status(client.ask("STATUS"))
     assert fields["faults"] == "radio"
     assert fields["radio_fault"].startswith("rigctld:_connection_refused_(1_failure_in_")
     link.succeeded()
-    fields = dict(pair.split("=", 1) for pair in client.ask("STATUS").split(" "))
+    fields = parse_status(client.ask("STATUS"))
     assert fields["faults"] == "none" and "radio_fault" not in fields

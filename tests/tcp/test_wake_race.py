@@ -10,7 +10,8 @@ them).  Here the publisher's tick is made to land exactly inside the drain.
 from __future__ import annotations
 
 from nfwserver.tcp import NovaTcpServer
-from tests.tcp.conftest import LineClient, wait_for
+from tests.tcp.conftest import LineClient
+from tests.waiting import wait_for
 
 
 class _TickDuringDrain:

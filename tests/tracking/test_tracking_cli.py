@@ -229,10 +229,12 @@ def test_passes_leaves_out_an_object_unusable_at_the_start_and_says_so(capsys, t
 
 @pytest.mark.parametrize(("content", "why"), [
     ("", "{path} is empty"),
-    ("<html><body>404 Not Found</body></html>\n", "{path} holds no TLE, AMSAT or OMM (JSON or CSV) element set"),
+    ("<html><body>404 Not Found</body></html>\n", "{path} holds no element sets"),
     ("1 25544U 98067A   26128.50000000  .00016717  00000-0  10270-3 0  9990\n"
      "2 25544  51.6400 208.9163 0006317  69.9862  25.2906 15.54225995 12345\n",
-     "{path}: its 1 set(s) were refused (reasons above)"),
+     "{path} holds no element sets (first problem: line 1: line 1 checksum is 0, computed 9)"),
+    # read as the station reads its element files (#36 item 3): binary data is refused as such
+    ("\x00\x01\x02 PNG " * 40, "{path} is not a text file of element sets (it holds binary data)"),
 ])
 def test_an_element_file_without_a_usable_set_is_named_with_the_reason(capsys, tmp_path, content, why) -> None:
     path = tmp_path / "elements.txt"
@@ -240,3 +242,11 @@ def test_an_element_file_without_a_usable_set_is_named_with_the_reason(capsys, t
     assert main(["passes", "--elements", str(path), "--observer", "52.2,0.12"]) == 1
     last = capsys.readouterr().err.strip().splitlines()[-1]
     assert last == "nfwserver: no usable element sets: " + why.format(path=path)
+
+
+def test_an_element_file_left_out_beside_good_ones_is_named(capsys, tmp_path) -> None:
+    empty = tmp_path / "empty.txt"
+    empty.write_text("")
+    assert main(["passes", "--elements", str(DATA / "visual.txt"), "--elements", str(empty), "--observer",
+                 "52.2,0.12", "--hours", "1"]) == 0
+    assert f"nfwserver: left out: {empty} is empty" in capsys.readouterr().err.splitlines()

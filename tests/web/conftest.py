@@ -26,6 +26,7 @@ from nfwserver.config.loader import parse_config
 from nfwserver.fake_dde import FakeDdeSystem
 from tests.conftest import DATA
 from tests.dde.conftest import ISS_PASS
+from tests.waiting import wait_for
 
 TOKEN = "test-token-0123"
 CHROMIUM = ("/usr/bin/chromium", "chromium")
@@ -141,16 +142,6 @@ return {frames: Number(document.body.dataset.frames || 0), connection: t("connec
 
 def read_page(browser) -> dict:
     return browser.execute_script(READ_PAGE)
-
-
-def wait_for(predicate, timeout_s: float = 15.0, what: str = "condition"):
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(0.05)
-    raise AssertionError(f"timed out waiting for {what}")
 
 
 def open_page(browser, web: WebStation) -> dict:

@@ -18,7 +18,7 @@ def test_a_connecting_page_shows_each_log_line_once(browser, web_station) -> Non
     assert [int(seq) for seq, _ in rows] == [e.seq for e in events]
     web_station.advance(1.0)  # new events are added once each
     wait_for(lambda: browser.execute_script("return document.querySelectorAll('#logrows li').length")
-             == len(web_station.station.core.events.recent(200)), what="the new lines, once each")
+             == len(web_station.station.core.events.recent(200)), 20.0, "the new lines, once each")
 
 
 class _FailingRotor:

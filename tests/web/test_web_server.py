@@ -19,7 +19,8 @@ from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.web import WebServer
 from nfwserver.web.hub import FrameHub
 from tests.dde.conftest import CATALOG, ISS_PASS, OBSERVER
-from tests.web.conftest import TOKEN, config_text, start_station, wait_for
+from tests.waiting import wait_for
+from tests.web.conftest import TOKEN, config_text, start_station
 
 
 def test_a_browser_that_stops_reading_is_dropped_and_never_delays_a_tick() -> None:

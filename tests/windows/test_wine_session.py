@@ -7,11 +7,11 @@ import signal
 import subprocess
 import sys
 import time
-from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
+from tests.waiting import wait_for
 from tests.windows.wine_session import kill_session, session_members
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="Linux processes")
@@ -28,19 +28,12 @@ def _programs(sid: int) -> list[str]:
     return names
 
 
-def _wait_for(condition: Callable[[], bool], seconds: float = 10.0) -> bool:
-    deadline = time.monotonic() + seconds
-    while not condition() and time.monotonic() < deadline:
-        time.sleep(0.01)
-    return condition()
-
-
 def test_kill_session_ends_the_program_the_launcher_left_running() -> None:
     # Like nfw_wine_exec: `timeout` runs the program in a process group of its own; the launcher exits.
     launcher = subprocess.Popen(["bash", "-c", "timeout 60 sleep 60 & exit 0"], start_new_session=True)
     launcher.wait(10)
     # The program itself, not only `timeout` (which starts it a moment later), must be running to be left behind.
-    assert _wait_for(lambda: "sleep" in _programs(launcher.pid)), "the program should outlive its launcher"
+    wait_for(lambda: "sleep" in _programs(launcher.pid), what="the program to outlive its launcher")
     kill_session(launcher)
     assert session_members(launcher.pid) == []  # kill_session returns when nothing of the session is left
 
@@ -51,7 +44,7 @@ def test_kill_session_ends_what_a_member_starts_while_it_is_being_killed() -> No
     launcher = subprocess.Popen(["bash", "-c", "bash -c 'for i in $(seq 400); do sleep 60 & done; wait' & exit 0"],
                                 start_new_session=True)
     launcher.wait(10)
-    assert _wait_for(lambda: len(session_members(launcher.pid)) >= 20)
+    assert wait_for(lambda: len(session_members(launcher.pid)) >= 20)
     try:
         kill_session(launcher)
         assert session_members(launcher.pid) == []

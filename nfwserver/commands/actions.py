@@ -1,0 +1,190 @@
+"""What each command does: the action column of the command table (Hamlib's ``ACTION(...)`` in ``rotctl_parse.c``).
+
+Every entry of :data:`nfwserver.commands.table.COMMANDS` names one of the actions below.  An action takes the
+:class:`Targets` a command can act on (the station core, the rotor, the sender's session, the console's
+display), the entry's checked argument and the sender, and returns an :class:`Outcome`.  The targets are
+typed by what the actions call on them (protocols), so this package imports none of them.
+
+The station core runs the actions (:meth:`nfwserver.core.station_core.StationCore.execute`); a face only
+parses the text it received (:func:`nfwserver.commands.parsing.parse_request`) and renders the outcome.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Protocol
+
+__all__ = ["DONE", "NO_ROTOR", "TRACK_WITHOUT_ROTOR", "Action", "DisplayPort", "Outcome", "RotorControl",
+           "SessionPort", "StationPort", "Targets"]
+
+#: Why a rotor command is refused on a station with no rotor (every face says it in these words).
+NO_ROTOR = "no rotor is configured"
+
+#: The warning that comes with an accepted ``TRACK ON`` on a station that drives no rotor itself.
+TRACK_WITHOUT_ROTOR = ("TRACK ON with no rotor configured: nothing turns here ([rotor] backend); "
+                       "DDE clients that drive their own rotor still follow the feed")
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What one command did."""
+
+    refused: str | None = None  #: not done, and why (a rotor command with no rotor)
+    note: str | None = None  #: done but without effect, and why (``TRACK ON`` with no satellite)
+    warning: str | None = None  #: done, with something the sender should know
+
+
+DONE = Outcome()
+
+
+class StationPort(Protocol):
+    """What Nova's station commands need of the station core."""
+
+    #: whether the station drives a rotor itself (None: not known, then no warning)
+    rotor_configured: bool | None
+
+    def set_tune(self, on: bool, source: str = ...) -> None: ...
+
+    def set_track(self, on: bool, source: str = ...) -> str | None: ...
+
+    def select_satellite(self, catalog_number: int, source: str = ...) -> bool: ...
+
+    def report_antenna_position(self, azimuth_deg: float | None, elevation_deg: float | None,
+                                source: str = ...) -> None: ...
+
+
+class RotorControl(Protocol):
+    """What the rotor commands need of the rotor coupling (any thread may call these)."""
+
+    def set_flip_mode(self, mode: str) -> None: ...
+
+    def request_park(self) -> None: ...
+
+
+class SessionPort(Protocol):
+    """The connection that sent a session command (Nova's TCP face; the console answers ``help`` only)."""
+
+    def summary(self) -> None: ...
+
+    def status(self) -> None: ...
+
+    def watch(self) -> None: ...
+
+    def help(self) -> None: ...
+
+    def quit(self) -> None: ...
+
+
+class DisplayPort(Protocol):
+    """The console's display."""
+
+    def toggle_zone(self) -> None: ...
+
+
+@dataclass(frozen=True)
+class Targets:
+    """What a command may act on; a face that has no session or display passes None for it."""
+
+    station: StationPort
+    rotor: RotorControl | None = None
+    session: SessionPort | None = None
+    display: DisplayPort | None = None
+
+    def the_session(self) -> SessionPort:
+        if self.session is None:  # the table's faces keep session commands to faces that have one
+            raise AssertionError("a session command from a face without a session")
+        return self.session
+
+    def the_display(self) -> DisplayPort:
+        if self.display is None:
+            raise AssertionError("a display command from a face without a display")
+        return self.display
+
+
+#: An entry's action: (targets, checked argument, sender) -> outcome.
+Action = Callable[[Targets, object, str], Outcome]
+
+
+def _degrees(value: object) -> float:
+    if not isinstance(value, (int, float)) or isinstance(value, bool):
+        raise AssertionError(f"a number of degrees was expected, got {value!r}")
+    return float(value)
+
+
+def tune(targets: Targets, value: object, source: str) -> Outcome:
+    targets.station.set_tune(value is True, source)
+    return DONE
+
+
+def track(targets: Targets, value: object, source: str) -> Outcome:
+    on = value is True
+    ignored = targets.station.set_track(on, source)
+    if ignored is not None:
+        return Outcome(note=ignored)
+    if on and targets.station.rotor_configured is False:
+        return Outcome(warning=TRACK_WITHOUT_ROTOR)
+    return DONE
+
+
+def satellite(targets: Targets, value: object, source: str) -> Outcome:
+    """``SAT=``: ``value`` is the catalog number the station resolved (names are resolved before)."""
+    if not isinstance(value, int) or isinstance(value, bool):
+        raise AssertionError(f"SAT= reached its action unresolved: {value!r}")
+    targets.station.select_satellite(value, source)
+    return DONE
+
+
+def antenna_azimuth(targets: Targets, value: object, source: str) -> Outcome:
+    targets.station.report_antenna_position(_degrees(value), None, source)
+    return DONE
+
+
+def antenna_elevation(targets: Targets, value: object, source: str) -> Outcome:
+    targets.station.report_antenna_position(None, _degrees(value), source)
+    return DONE
+
+
+def flip(targets: Targets, value: object, source: str) -> Outcome:
+    if targets.rotor is None:
+        return Outcome(refused=NO_ROTOR)
+    targets.rotor.set_flip_mode(str(value))
+    return DONE
+
+
+def park(targets: Targets, value: object, source: str) -> Outcome:
+    if targets.rotor is None:
+        return Outcome(refused=NO_ROTOR)
+    targets.station.set_track(False, source)
+    targets.rotor.request_park()
+    return DONE
+
+
+def summary(targets: Targets, value: object, source: str) -> Outcome:
+    targets.the_session().summary()
+    return DONE
+
+
+def status(targets: Targets, value: object, source: str) -> Outcome:
+    targets.the_session().status()
+    return DONE
+
+
+def watch(targets: Targets, value: object, source: str) -> Outcome:
+    targets.the_session().watch()
+    return DONE
+
+
+def show_help(targets: Targets, value: object, source: str) -> Outcome:
+    targets.the_session().help()
+    return DONE
+
+
+def quit_session(targets: Targets, value: object, source: str) -> Outcome:
+    targets.the_session().quit()
+    return DONE
+
+
+def toggle_zone(targets: Targets, value: object, source: str) -> Outcome:
+    targets.the_display().toggle_zone()
+    return DONE

@@ -1,0 +1,46 @@
+"""What the console's own commands act on: its display (``Z``) and its answer to ``HELP``.
+
+The console hands every command to the station core (:meth:`nfwserver.core.station_core.StationCore.execute`),
+which runs the entry's action from the command table; the actions of the console's commands call back here.
+The TCP session's other commands (``SUMMARY``, ``STATUS``, ``WATCH``, ``QUIT``) are not the console's: the
+table does not let the console send them, so reaching them here is a bug in the table.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from nfwserver.commands.help_text import help_lines
+from nfwserver.commands.table import Face
+
+__all__ = ["ConsolePort"]
+
+
+class ConsolePort:
+    """The console's session and display, for the core's command actions."""
+
+    def __init__(self, note: Callable[[str, str], None], toggle_zone: Callable[[], None]) -> None:
+        self._note = note
+        self._toggle_zone = toggle_zone
+
+    def help(self) -> None:
+        for line in help_lines(Face.CONSOLE):
+            self._note(line, "cyan")
+
+    def toggle_zone(self) -> None:
+        self._toggle_zone()
+
+    def _not_the_consoles(self, word: str) -> None:
+        raise AssertionError(f"{word} reached the console, which the command table does not let send it")
+
+    def summary(self) -> None:
+        self._not_the_consoles("SUMMARY")
+
+    def status(self) -> None:
+        self._not_the_consoles("STATUS")
+
+    def watch(self) -> None:
+        self._not_the_consoles("WATCH")
+
+    def quit(self) -> None:
+        self._not_the_consoles("QUIT")
