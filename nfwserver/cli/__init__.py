@@ -78,6 +78,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         code = _main(argv)
     except SystemExit as exc:  # argparse: usage errors (2), --help and --version (0)
         code = exc.code if isinstance(exc.code, int) else 2
+    except Exception:  # a failure nobody would otherwise see: its traceback goes into the message box
+        import traceback
+
+        traceback.print_exc()
+        code = 1
     windowless.report(tail, code)
     return code
 

@@ -14,6 +14,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from nfwserver.cli.errors import CliError
+
 
 def editor_command(environ: dict[str, str] | None = None) -> list[str] | None:
     """The user's editor as an argument list (``$VISUAL``, then ``$EDITOR``), or None."""
@@ -35,8 +37,6 @@ def _system_open(path: Path) -> None:
         return
     opener = "open" if sys.platform == "darwin" else "xdg-open"
     if shutil.which(opener) is None:
-        from nfwserver.cli import CliError
-
         raise CliError(f"no editor: set $EDITOR (e.g. EDITOR=nano), or open {path} yourself")
     subprocess.Popen([opener, str(path)], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                      stderr=subprocess.DEVNULL, start_new_session=True)
@@ -44,7 +44,6 @@ def _system_open(path: Path) -> None:
 
 def open_in_editor(path: Path | None) -> int:
     """Create the file from the template if it is missing, print its path, open it; the exit code."""
-    from nfwserver.cli import CliError
     from nfwserver.config import default_config_path
     from nfwserver.config.render import template
     from nfwserver.file_lock import locked

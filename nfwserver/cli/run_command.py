@@ -186,8 +186,6 @@ class _Requests:
 def _claim_channel(plan: RunPlan) -> StationChannel | None:
     """This user's station channel, held for the run (:mod:`nfwserver.cli.station_channel`); None when the
     caller stops the run itself (``plan.stop``).  Refused while another station of this user runs."""
-    from nfwserver.cli import CliError
-
     if plan.stop is not None:
         return None
     channel = StationChannel()
@@ -200,6 +198,16 @@ def _claim_channel(plan: RunPlan) -> StationChannel | None:
         who = f" (process {info.pid})" if info is not None else ""
         raise CliError(f"a station is already running for this user{who}: `nfwserver stop` stops it")
     return channel
+
+
+def _browser_url(station: Station) -> str | None:
+    """The dashboard's address as a browser on this machine opens it (a wildcard host is reached on loopback)."""
+    if station.web is None or station.web.address is None:
+        return None
+    url = station.web.url
+    for wildcard, loopback in (("//0.0.0.0:", "//127.0.0.1:"), ("//[::]:", "//[::1]:")):
+        url = url.replace(wildcard, loopback)
+    return url
 
 
 def _listen(plan: RunPlan, requests: _Requests, clock: Clock,
@@ -248,8 +256,7 @@ def serve(config: Config, plan: RunPlan, watch: str | None = None) -> int:
             raise CliError(f"cannot start the station: {exc.strerror or exc}") from None
         requests.station_started(station)
         if channel is not None and control is not None:
-            channel.describe(StationInfo(os.getpid(), control.path, station.web.url if station.web is not None
-                                         and station.web.address is not None else None))
+            channel.describe(StationInfo(os.getpid(), control.path, _browser_url(station), started=True))
         try:
             file_handler = _serve_started(station, config, plan, watch, requests, file_handler)
         finally:

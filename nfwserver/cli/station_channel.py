@@ -80,6 +80,7 @@ class StationInfo:
     pid: int
     control: Path  #: the control file it watches
     web_url: str | None = None  #: its dashboard's address, once it serves one
+    started: bool = False  #: the station is up (until then ``web_url`` is not known yet)
 
 
 class StationChannel:
@@ -97,19 +98,29 @@ class StationChannel:
 
     # -- the station's side ---------------------------------------------------------------------------
     def claim(self, retry_s: float = CLAIM_RETRY_S) -> bool:
-        """Take the lock for this process (retrying ``retry_s`` seconds, for a prober's brief hold)."""
+        """Take the lock for this process (retrying ``retry_s`` seconds, for a prober's brief hold), and remove
+        a description left by a station that was killed (a ``stop`` must never read that one's)."""
         deadline = time.monotonic() + retry_s
         while not self._lock.try_acquire():
             if time.monotonic() >= deadline:
                 return False
             time.sleep(0.05)
+        with contextlib.suppress(OSError):
+            self.info_path.unlink()
         return True
 
     def describe(self, info: StationInfo) -> None:
-        """Write ``station.json`` (atomically); only while this process holds the lock."""
-        record = {"pid": info.pid, "control": str(info.control), "web": info.web_url}
-        with contextlib.suppress(OSError):
-            atomic_write_text(self.info_path, json.dumps(record) + "\n")
+        """Write ``station.json`` (atomically); only while this process holds the lock.  On Windows the
+        replace fails while a reader has the old file open: it is tried again for up to a second."""
+        record = {"pid": info.pid, "control": str(info.control), "web": info.web_url, "started": info.started}
+        for _ in range(20):
+            try:
+                atomic_write_text(self.info_path, json.dumps(record) + "\n")
+                return
+            except PermissionError:
+                time.sleep(0.05)
+            except OSError:
+                return
 
     def release(self) -> None:
         """Remove the description, then free the lock (the order a waiting ``stop`` relies on)."""
@@ -134,6 +145,7 @@ class StationChannel:
         try:
             record = json.loads(self.info_path.read_text(encoding="utf-8"))
             web = record.get("web")
-            return StationInfo(int(record["pid"]), Path(str(record["control"])), str(web) if web else None)
+            return StationInfo(int(record["pid"]), Path(str(record["control"])), str(web) if web else None,
+                               record.get("started") is True)
         except (OSError, ValueError, KeyError, TypeError, AttributeError):
             return None

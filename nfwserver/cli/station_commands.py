@@ -1,21 +1,27 @@
 """``nfwserver stop`` and ``nfwserver dashboard``: the user's running station, reached through its local channel.
 
 ``stop`` asks the station to stop cleanly (the request ``run`` takes from a signal: state saved, DDE
-conversations ended, listeners closed), through its control file, never by killing it, and waits until it
-has stopped: exit 0 once stopped, 1 with one sentence when none is running or it has not stopped in time.
-It works the same on Linux and Windows, for a station in a terminal, headless, or started at logon
-(:mod:`nfwserver.cli.station_channel`).
+conversations ended, listeners closed), through its control file, never by killing it, and waits until its
+process has ended (on Windows its program files are in use until then; an installer replacing them relies on
+it).  Exit status: 0 once stopped; 1 with one sentence when none is running (or it cannot be asked);
+:data:`STILL_RUNNING` (3) with one sentence when it has not stopped within ``--timeout``.  It works the same
+on Linux and Windows, for a station in a terminal, headless, or started at logon
+(:mod:`nfwserver.cli.station_channel`).  The waits are on the operating system (another process's lock and
+exit), in real time.
 
 ``dashboard`` opens the running station's web page in the default browser (``--print``: only print its
-address).
+address), waiting for a station that is still starting.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 import time
 
 from nfwserver.cli.arguments import number_in
+from nfwserver.cli.errors import CliError, say
 from nfwserver.cli.station_channel import StationChannel, StationInfo
 from nfwserver.storage import atomic_write_text
 
@@ -23,6 +29,10 @@ from nfwserver.storage import atomic_write_text
 STOP_TIMEOUT_S = 60.0
 #: Seconds between looks at the lock while waiting.
 POLL_S = 0.1
+#: ``stop``'s exit status when the station was asked but has not stopped in time.
+STILL_RUNNING = 3
+#: Seconds ``dashboard`` waits for a station that is starting.
+START_WAIT_S = 60.0
 
 
 def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -30,7 +40,7 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
         "stop", help="stop the running station cleanly and wait until it has stopped",
         description="Ask this user's running station (`nfwserver run`, in a terminal, headless or started at "
         "logon) to stop cleanly, as Ctrl+C does, and wait until it has stopped. Exit 0 once stopped, 1 when "
-        "none is running or it has not stopped within --timeout.")
+        f"none is running, {STILL_RUNNING} when it has not stopped within --timeout.")
     stop.add_argument("--timeout", type=number_in(0.1, 3600.0, unit="s"), default=STOP_TIMEOUT_S, metavar="SECONDS",
                       help=f"how long to wait for the station to stop (default {STOP_TIMEOUT_S:g})")
     stop.set_defaults(func=run_stop)
@@ -38,25 +48,53 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
         "dashboard", help="open the running station's web dashboard in the browser",
         description="Open the web page of this user's running station in the default browser.")
     dash.add_argument("--print", dest="print_only", action="store_true", help="only print the address")
+    dash.add_argument("--wait", type=number_in(0.0, 3600.0, unit="s"), default=START_WAIT_S, metavar="SECONDS",
+                      help=f"how long to wait for a station that is still starting (default {START_WAIT_S:g})")
     dash.set_defaults(func=run_dashboard)
 
 
-def _described(channel: StationChannel, timeout_s: float) -> StationInfo | None:
+def _described(channel: StationChannel, timeout_s: float, started: bool = False) -> StationInfo | None:
     """The running station's description, waiting up to ``timeout_s`` for a station that is starting to
-    write it (it is written once the station watches its control file); None if none runs any more."""
+    write it (first once it watches its control file, then, ``started``, once it is up); None if there is
+    none by then or no station runs any more."""
     deadline = time.monotonic() + timeout_s
     while True:
         info = channel.info()
-        if info is not None or not channel.running():
+        if info is not None and (info.started or not started):
             return info
-        if time.monotonic() >= deadline:
-            return None
+        if not channel.running() or time.monotonic() >= deadline:
+            return info if info is not None and not started else None
         time.sleep(POLL_S)
 
 
-def run_stop(args: argparse.Namespace) -> int:
-    from nfwserver.cli import CliError
+def _process_ended(pid: int) -> bool:
+    """Whether process ``pid`` has ended (a zombie left for its parent to reap counts as ended)."""
+    if sys.platform == "win32":
+        import ctypes
 
+        synchronize, wait_timeout = 0x00100000, 0x102
+        kernel32 = ctypes.WinDLL("kernel32", use_last_error=True)
+        handle = kernel32.OpenProcess(synchronize, False, pid)
+        if not handle:
+            return True  # no such process (any more)
+        try:
+            return bool(kernel32.WaitForSingleObject(handle, 0) != wait_timeout)
+        finally:
+            kernel32.CloseHandle(handle)
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    except PermissionError:
+        return False
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as stat:
+            return stat.read().rsplit(b")", 1)[1].split()[0] == b"Z"
+    except (OSError, IndexError):
+        return False
+
+
+def run_stop(args: argparse.Namespace) -> int:
     channel = StationChannel()
     if not channel.running():
         raise CliError("no station is running for this user: nothing to stop")
@@ -73,23 +111,24 @@ def run_stop(args: argparse.Namespace) -> int:
         raise CliError(f"cannot ask the station (process {info.pid}) to stop: {info.control}: "
                        f"{exc.strerror or exc}") from None
     deadline = time.monotonic() + args.timeout
-    while channel.running():
+    while channel.running() or not _process_ended(info.pid):
         if time.monotonic() >= deadline:
-            raise CliError(f"the station (process {info.pid}) was asked to stop but is still running after "
-                           f"{args.timeout:g} s; its log says what it is waiting for")
+            say(f"the station (process {info.pid}) was asked to stop but is still running after "
+                f"{args.timeout:g} s; its log says what it is waiting for")
+            return STILL_RUNNING
         time.sleep(POLL_S)
     print(f"stopped the station (process {info.pid})")
     return 0
 
 
 def run_dashboard(args: argparse.Namespace) -> int:
-    from nfwserver.cli import CliError
-
     channel = StationChannel()
     if not channel.running():
         raise CliError("no station is running for this user: start one (`nfwserver run`, or the Start menu's "
                        "\"nfwserver station\"), then open its dashboard")
-    info = _described(channel, 10.0)
+    info = _described(channel, args.wait, started=True)
+    if info is None and channel.running():
+        raise CliError(f"the station has not finished starting after {args.wait:g} s; try again in a moment")
     if info is None or not info.web_url:
         raise CliError("the running station serves no web dashboard: `nfwserver config set web.enabled true` "
                        "turns it on (the station applies it at its next start)")

@@ -9,9 +9,7 @@ import os
 import signal
 import subprocess
 import sys
-import time
 import urllib.request
-from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -21,6 +19,7 @@ from nfwserver.cli.station_channel import StationChannel
 from nfwserver.cli.windowless import TailText
 from tests.app import test_run_signals
 from tests.conftest import ROOT
+from tests.waiting import wait_for
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX processes (Windows: tests/windows)")
 #: The fixture making real ``nfwserver run --headless`` stations in ``tmp_path``.
@@ -34,14 +33,6 @@ def _cli(home: Path, *args: str, env: dict[str, str] | None = None,
             "XDG_STATE_HOME": str(home / "state")}
     return subprocess.run([sys.executable, "-m", "nfwserver", *args], cwd=ROOT, env={**base, **(env or {})},
                           capture_output=True, text=True, timeout=timeout_s, stdin=subprocess.DEVNULL)
-
-
-def wait_until(predicate: Callable[[], bool], timeout_s: float) -> None:
-    """Return once ``predicate()`` holds; fail the test when it has not within ``timeout_s``."""
-    deadline = time.monotonic() + timeout_s
-    while not predicate():
-        assert time.monotonic() < deadline, f"not within {timeout_s:g} s: {predicate}"
-        time.sleep(0.05)
 
 
 def test_stop_asks_the_station_through_its_channel_and_returns_once_it_has_stopped(station, tmp_path) -> None:
@@ -82,7 +73,7 @@ def test_a_killed_station_leaves_nothing_running_behind(station, tmp_path) -> No
                        "XDG_STATE_HOME": str(tmp_path / "state")}, stdin=subprocess.DEVNULL,
         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        wait_until(lambda: channel.info() is not None and channel.info().pid == again.pid, 30.0)
+        wait_for(lambda: channel.info() is not None and channel.info().pid == again.pid, 30.0, "the new station")
         assert _cli(tmp_path, "stop").returncode == 0 and again.wait(10) == 0
     finally:
         if again.poll() is None:
@@ -159,3 +150,72 @@ def test_a_windowless_run_keeps_its_output_bounded_and_returns_usage_errors(monk
     monkeypatch.setattr(sys, "stderr", None)
     assert main(["stop", "--bogus"]) == 2  # no SystemExit out of a program with no console to print it on
     assert isinstance(sys.stderr, TailText) and "unrecognized arguments: --bogus" in sys.stderr.getvalue()
+
+
+def test_a_windowless_run_that_fails_unexpectedly_reports_the_failure(monkeypatch) -> None:
+    from nfwserver.cli import config_command
+
+    def broken(args) -> int:
+        raise RuntimeError("something nobody expected")
+
+    monkeypatch.setattr(config_command, "run_path", broken)
+    monkeypatch.setattr(sys, "stdout", None)
+    monkeypatch.setattr(sys, "stderr", None)
+    assert main(["config", "path"]) == 1  # not a traceback into nowhere and a silent exit
+    assert "RuntimeError: something nobody expected" in sys.stderr.getvalue()
+
+
+#: A process that holds the user's station channel as a station does, but never reads its control file (a
+#: station stuck while stopping); it says "started" only when its stdin gets a line, and exits at EOF.
+STUCK = """
+import os, sys
+from pathlib import Path
+from nfwserver.cli.station_channel import StationChannel, StationInfo
+channel = StationChannel(Path(sys.argv[1]))
+assert channel.claim()
+channel.describe(StationInfo(os.getpid(), channel.default_control))
+print("claimed", flush=True)
+sys.stdin.readline()
+channel.describe(StationInfo(os.getpid(), channel.default_control, "http://127.0.0.1:8091/", started=True))
+print("started", flush=True)
+sys.stdin.readline()
+"""
+
+
+def _stuck(tmp_path: Path) -> subprocess.Popen[str]:
+    proc = subprocess.Popen([sys.executable, "-c", STUCK, str(tmp_path / "state" / "nfwserver")], cwd=ROOT,
+                            env={**os.environ, "PYTHONPATH": str(ROOT)}, stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, text=True)
+    assert proc.stdout is not None and proc.stdout.readline() == "claimed\n"
+    return proc
+
+
+def test_a_station_that_does_not_stop_in_time_gets_its_own_exit_status(tmp_path) -> None:
+    stuck = _stuck(tmp_path)
+    try:
+        result = _cli(tmp_path, "stop", "--timeout", "0.5")
+        assert result.returncode == 3 and result.stdout == ""
+        assert result.stderr == (f"nfwserver: the station (process {stuck.pid}) was asked to stop but is still "
+                                 "running after 0.5 s; its log says what it is waiting for\n")
+        assert (tmp_path / "state" / "nfwserver" / "control").read_text() == "stop\n"  # it was asked
+    finally:
+        stuck.kill()
+        stuck.wait(10)
+
+
+def test_dashboard_waits_for_a_station_that_is_still_starting_and_says_so(tmp_path) -> None:
+    stuck = _stuck(tmp_path)
+    try:
+        starting = _cli(tmp_path, "dashboard", "--print", "--wait", "0.5")
+        assert starting.returncode == 1 and starting.stdout == ""  # not "serves no web dashboard": not up yet
+        assert starting.stderr == ("nfwserver: the station has not finished starting after 0.5 s; try again in a "
+                                   "moment\n")
+        assert stuck.stdin is not None and stuck.stdout is not None
+        stuck.stdin.write("go\n")
+        stuck.stdin.flush()
+        assert stuck.stdout.readline() == "started\n"
+        up = _cli(tmp_path, "dashboard", "--print", "--wait", "0.5")
+        assert up.returncode == 0 and up.stdout == "http://127.0.0.1:8091/\n", up.stderr
+    finally:
+        stuck.kill()
+        stuck.wait(10)
