@@ -39,7 +39,6 @@ from nfwserver.tracking.element_set import (
     is_csv_header,
 )
 from nfwserver.tracking.tle import TleError, epoch_from_tle, parse_tle
-from nfwserver.tracking.tle_bulk import read_canonical
 
 __all__ = ["MAX_CSV_ROW", "ElementSet", "LoadResult", "Rejection", "load_element_file", "load_elements"]
 _MAX_NAME = MAX_NAME_LENGTH
@@ -208,9 +207,14 @@ def _build_tles(pending: list[Any], source: str, result: LoadResult) -> None:
 
 def _build_block(pending: list[Any], source: str, result: LoadResult, years: dict[int, datetime]) -> None:
     pairs = [p for p in pending if not isinstance(p, Rejection)]
-    good, values = read_canonical([p[2] for p in pairs], [p[3] for p in pairs])
-    rows = zip(*(values[c].tolist() for c in _BULK_COLUMNS)) if values else iter(())
-    good_list = good.tolist()
+    rows: Any = iter(())
+    good_list = [False] * len(pairs)
+    if len(pairs) >= _BULK_MIN:  # a few sets are read one by one: no numpy to import (a command for one satellite)
+        from nfwserver.tracking.tle_bulk import read_canonical
+
+        good, values = read_canonical([p[2] for p in pairs], [p[3] for p in pairs])
+        rows = zip(*(values[c].tolist() for c in _BULK_COLUMNS)) if values else iter(())
+        good_list = good.tolist()
     k = 0
     for item in pending:
         if isinstance(item, Rejection):
@@ -239,6 +243,8 @@ def _build_block(pending: list[Any], source: str, result: LoadResult, years: dic
 
 #: Columns of tle_bulk.read_canonical a set keeps as values (the others are read from its lines when asked).
 _BULK_COLUMNS = ("year2", "day", "catalog_number")
+#: Fewest TLE pairs of a block read in bulk (numpy); fewer are read by parse_tle, which gives the same values.
+_BULK_MIN = 64
 
 
 def _take_amsat(lines: list[str], i: int, source: str, result: LoadResult) -> int:
