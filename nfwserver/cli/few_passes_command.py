@@ -28,7 +28,13 @@ def run_few_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: list[
     if not 0 < len(sets) <= FEW or not inputs.horizon.is_flat:
         return False
     from nfwserver.cli.pass_text import write_pass_text
-    from nfwserver.cli.tracking_commands import PASS_COLUMNS, no_passes_warning, pass_names, wide_table_local_note
+    from nfwserver.cli.tracking_commands import (
+        PASS_COLUMNS,
+        always_up_note,
+        no_passes_warning,
+        pass_names,
+        wide_table_local_note,
+    )
     from nfwserver.tracking.few_passes import NeedsCatalogSearch, find_few_passes
     from nfwserver.tracking.timescale import julian_date
 
@@ -43,6 +49,7 @@ def run_few_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: list[
     numbers = sorted({row[0] for row in rows})
     names, short_names, searched = pass_names(args, inputs, sets, found.skipped, numbers)
     compact = args.format == "table" and not args.wide
+    always_up_note([(short_names if compact else names)[row[0]] for row in rows if row[1] is None and row[3] is None])
     if compact:
         from nfwserver.cli.pass_text import zone_label
 

@@ -211,7 +211,10 @@ def _run_catalog_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: 
         cols = {key: value[keep] for key, value in cols.items()}
     numbers = np.array(sorted(names), dtype=np.int64)
     which = np.searchsorted(numbers, cols["catalog_number"])
-    if args.format == "table" and not args.wide:
+    compact = args.format == "table" and not args.wide
+    up = cols["catalog_number"][np.isnan(cols["aos_s"]) & np.isnan(cols["los_s"])].tolist()
+    always_up_note([(short_names if compact else names)[n] for n in up])
+    if compact:
         if not len(cols["catalog_number"]):
             no_passes_warning(args, searched)
         write_rows(compact_columns(start, cols, [short_names[n] for n in numbers.tolist()], which, args.local),
@@ -234,6 +237,14 @@ def no_passes_warning(args: argparse.Namespace, searched: int) -> None:
     """The compact table's line on stderr when no pass is listed."""
     reach = f" reaching {args.min_el:g} deg" if args.min_el else ""
     warn(f"no passes{reach} of the {searched} satellite(s) in the {args.hours:g} h from {format_time(args.start)}")
+
+
+def always_up_note(names: Sequence[str]) -> None:
+    """Name on stderr the satellites (``names``) whose rows have neither AOS nor LOS because they stay up."""
+    if names:
+        shown = ", ".join(names[:5]) + (", ..." if len(names) > 5 else "")
+        warn(f"up for the whole window (above the horizon from before the search to after it, so no AOS or "
+             f"LOS): {shown}")
 
 
 def wide_table_local_note(args: argparse.Namespace) -> None:

@@ -22,6 +22,7 @@ import csv
 import gc
 import json
 import os
+import sys
 from collections.abc import Callable
 from datetime import datetime, timedelta
 from pathlib import Path
@@ -209,7 +210,7 @@ def _build_block(pending: list[Any], source: str, result: LoadResult, years: dic
     pairs = [p for p in pending if not isinstance(p, Rejection)]
     rows: Any = iter(())
     good_list = [False] * len(pairs)
-    if len(pairs) >= _BULK_MIN:  # a few sets are read one by one: no numpy to import (a command for one satellite)
+    if len(pairs) >= _BULK_MIN or "numpy" in sys.modules:  # else no numpy to import (a command for one satellite)
         from nfwserver.tracking.tle_bulk import read_canonical
 
         good, values = read_canonical([p[2] for p in pairs], [p[3] for p in pairs])
@@ -243,8 +244,9 @@ def _build_block(pending: list[Any], source: str, result: LoadResult, years: dic
 
 #: Columns of tle_bulk.read_canonical a set keeps as values (the others are read from its lines when asked).
 _BULK_COLUMNS = ("year2", "day", "catalog_number")
-#: Fewest TLE pairs of a block read in bulk (numpy); fewer are read by parse_tle, which gives the same values.
-_BULK_MIN = 64
+#: Fewest TLE pairs of a block read in bulk (numpy, 12 us a set) unless numpy is loaded already; fewer are read by
+#: parse_tle (67 us a set), which gives the same values: below this, importing numpy (60-90 ms) costs more.
+_BULK_MIN = 768
 
 
 def _take_amsat(lines: list[str], i: int, source: str, result: LoadResult) -> int:

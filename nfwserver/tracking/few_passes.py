@@ -18,9 +18,10 @@ passes for a handful of satellites with ``sgp4``'s scalar propagator and :mod:`m
 
 Times are seconds after the window start, angles degrees.  A satellite whose position at the start cannot be
 computed or is implausibly far is ``skipped``, as :mod:`nfwserver.tracking.screening` decides; one that stays
-above the horizon over the whole extended search is ``always_up`` (no AOS or LOS to report).  Anything this
-search does not handle as the catalog search does (SGP4 failing inside the window, an unpaired event) raises
-:class:`NeedsCatalogSearch`, and the caller runs the catalog search instead.
+above the horizon over the whole extended search has one pass with neither AOS nor LOS, whose TCA is the
+highest point inside the window (a culmination there, or an end), as :mod:`nfwserver.tracking.pass_always_up`
+gives.  Anything this search does not handle as the catalog search does (SGP4 failing inside the window, an
+unpaired event) raises :class:`NeedsCatalogSearch`, and the caller runs the catalog search instead.
 """
 
 from __future__ import annotations
@@ -57,7 +58,6 @@ class FewPasses:
 
     rows: list[Row] = field(default_factory=list)
     skipped: list[int] = field(default_factory=list)  #: position unusable at the start, ascending
-    always_up: list[int] = field(default_factory=list)  #: above the horizon throughout, ascending
 
 
 def find_few_passes(satrecs: Sequence[Any], catalog_numbers: Sequence[int], observer: Observer, jd: float,
@@ -71,14 +71,9 @@ def find_few_passes(satrecs: Sequence[Any], catalog_numbers: Sequence[int], obse
         if err or not _finite(r) or not look.look(r, v, jd, fr)[2] <= MAX_PLAUSIBLE_RANGE_KM:
             found.skipped.append(number)
             continue
-        rows = _search(satrec, number, look, jd, fr, window_s, min_elevation_deg)
-        if rows is None:
-            found.always_up.append(number)
-        else:
-            found.rows += rows
+        found.rows += _search(satrec, number, look, jd, fr, window_s, min_elevation_deg)
     found.rows.sort(key=lambda row: (row[2] if row[1] is None else row[1], row[0]))
     found.skipped.sort()
-    found.always_up.sort()
     return found
 
 
@@ -87,8 +82,8 @@ def _finite(values: Sequence[float]) -> bool:
 
 
 def _search(satrec: Any, number: int, look: ScalarLookAngles, jd: float, fr: float, window_s: float,
-            h0: float) -> list[Row] | None:
-    """The passes of one satellite overlapping ``[0, window_s]``; None when it never leaves the sky."""
+            h0: float) -> list[Row]:
+    """The passes of one satellite overlapping ``[0, window_s]``."""
     period = 2.0 * math.pi / max(satrec.no_kozai, 1e-9) * 60.0
     look_back = (0.5 if satrec.ecco < 0.05 and period <= 3.0 * 3600.0 else 1.0) * period
     extension = min(look_back, SECONDS_PER_DAY)
@@ -126,9 +121,14 @@ def _search(satrec: Any, number: int, look: ScalarLookAngles, jd: float, fr: flo
         if top is not None and top_state is not None:
             tops.append((top, top_state[0]))
     if not events:
-        if samples[0][0] - h0 > 0.0:
-            return None
-        return []
+        if samples[0][0] - h0 <= 0.0:
+            return []
+        # Up throughout: the highest point inside the window (the start first, then the end, then turns).
+        best_t, best_el = max(((0.0, state(0.0)[0]), (window_s, state(window_s)[0])), key=lambda c: c[1])
+        for t, el in sorted(tops, key=lambda c: c[1]):
+            if 0.0 <= t <= window_s and el > best_el:
+                best_t, best_el = t, el
+        return [(number, None, best_t, None, best_el, None, None)]
     return _passes(number, events, tops, t_lo, t_hi, window_s)
 
 

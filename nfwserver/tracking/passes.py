@@ -23,9 +23,10 @@ Passes already in progress at ``start`` are reported with
 their true AOS before ``start`` (``aos_before_start``), passes in progress at ``end`` with their
 LOS after it: the search looks back and ahead by up to one orbital period (at most a day; half a
 period for near-circular orbits shorter than three hours, whose passes last less than that).  A
-satellite that stays up over the whole extended search (a geostationary satellite, say) has no AOS
-or LOS and gets no pass, rather than bogus events; one whose rise or set lies beyond the
-extension gets ``None`` for that time.
+satellite that stays up over the whole extended search (a geostationary satellite in view, say) gets
+one pass with neither AOS nor LOS (``None``: both beyond the search), whose TCA is the highest point
+inside the window (:mod:`~nfwserver.tracking.pass_always_up`), rather than no pass or bogus events; one
+whose rise or set lies beyond the extension gets ``None`` for that time.
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ from nfwserver.tracking.constants import MINUTES_PER_DAY, SECONDS_PER_DAY
 from nfwserver.tracking.frames import TopocentricFrame
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer
+from nfwserver.tracking.pass_always_up import always_up_columns
 from nfwserver.tracking.pass_assemble import assemble
 from nfwserver.tracking.pass_batch import Batch, Chunk
 from nfwserver.tracking.pass_kinematics import PairEvaluator
@@ -201,8 +203,10 @@ def find_passes(
                 idx = idx[usable]
                 if not models:
                     continue
-            batch.add(_screen_chunk(models, catalog_numbers[idx], observer, start, end, horizon, ut1_utc,
-                                    fine_step_s, step, extension))
+            chunk, always_up = _screen_chunk(models, catalog_numbers[idx], observer, start, end, horizon, ut1_utc,
+                                             fine_step_s, step, extension)
+            batch.add(chunk)
+            found.add(always_up)
             if batch.size >= _BATCH_BRACKETS:
                 found.add(_refine(batch, observer, horizon, ut1_utc))
                 batch = Batch()
@@ -232,8 +236,9 @@ def _model(satellite: object) -> object:
 
 def _screen_chunk(satrecs: list[Any], catalog_numbers: np.ndarray, observer: Observer, start: datetime, end: datetime,
                   horizon: HorizonTable, ut1_utc: float, fine_step_s: float, coarse_step_s: float,
-                  extension: float) -> Chunk:
-    """One chunk of satellites screened over ``[start - extension, end + extension]``."""
+                  extension: float) -> tuple[Chunk, dict[str, np.ndarray]]:
+    """One chunk of satellites screened over ``[start - extension, end + extension]``, and the passes of those
+    above the horizon throughout (PassList columns)."""
     t0 = start - timedelta(seconds=extension)
     window_s = (end - start).total_seconds()
     span = window_s + 2.0 * extension
@@ -241,7 +246,8 @@ def _screen_chunk(satrecs: list[Any], catalog_numbers: np.ndarray, observer: Obs
     ev = PairEvaluator(satrecs, observer, jd0, fr0, ut1_utc, horizon)
     brackets = screen(satrecs, TopocentricFrame(observer), horizon, jd0, fr0, span, coarse_step_s, fine_step_s,
                       ut1_utc, ev)
-    return Chunk(satrecs, catalog_numbers, jd0, fr0, span, extension, extension + window_s, brackets)
+    always_up = always_up_columns(ev, brackets, len(satrecs), catalog_numbers, extension, window_s)
+    return Chunk(satrecs, catalog_numbers, jd0, fr0, span, extension, extension + window_s, brackets), always_up
 
 
 def _refine(batch: Batch, observer: Observer, horizon: HorizonTable, ut1_utc: float) -> dict[str, np.ndarray]:
