@@ -74,8 +74,9 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     p.add_argument("--wide", action="store_true",
                    help="a table with every column (catalog number, full name, ISO times with milliseconds, "
                    "azimuths, duration in seconds, in_progress)")
-    p.add_argument("--workers", type=number_in(1, 64, integer=True), default=1, metavar="N",
-                   help="worker processes for large catalogs (POSIX; default 1)")
+    p.add_argument("--workers", type=_workers_value, default="auto", metavar="N|auto",
+                   help="worker processes for large catalogs (POSIX; the rows are the same whatever the number); "
+                   "auto (the default): one per idle core for 1,000 satellites or more, else 1")
     p.set_defaults(func=run_passes)
 
     p = subparsers.add_parser("visible", help="satellites above the horizon table at an instant",
@@ -83,6 +84,11 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     add_tracking_options(p)
     p.add_argument("--at", type=time_value, default="now", help=TIME_HELP)
     p.set_defaults(func=run_visible)
+
+
+def _workers_value(text: str) -> int | str:
+    """``type=`` for ``--workers``: ``auto`` or a whole number from 1 to 64."""
+    return "auto" if text.strip().lower() == "auto" else int(number_in(1, 64, integer=True)(text))
 
 
 def _pick(catalog: Catalog, text: str) -> Satellite:
@@ -261,13 +267,14 @@ def _find_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: list[An
     """The passes of ``sets`` over the window the options ask for, the name and the DDE name (at most 12
     characters; only for the compact table, which alone shows them) to show for each satellite that has one
     (by catalog number), and how many satellites were searched."""
-    from nfwserver.tracking.passes import find_passes
+    from nfwserver.tracking.passes import auto_workers, find_passes
 
     start = args.start
+    workers = auto_workers(len(sets)) if args.workers == "auto" else int(args.workers)
     # The search leaves out the sets unusable at the start (it makes their models anyway); they and the
     # stale sets are reported after it, before any row (the compact table names them with its satellites).
     passes = find_passes(sets, inputs.observer, start, start + timedelta(hours=args.hours), horizon=inputs.horizon,
-                         ut1_utc=inputs.ut1_utc, workers=args.workers)
+                         ut1_utc=inputs.ut1_utc, workers=workers)
     numbers = passes.catalog_numbers()
     names, short_names, searched = pass_names(args, inputs, sets, passes.skipped, numbers)
     return passes, names, short_names, searched

@@ -152,13 +152,9 @@ obs = Observer(52.2, 0.12, 20.0)
 serial = find_passes(sats, obs, start, start + timedelta(hours=6))
 parallel = find_passes(sats, obs, start, start + timedelta(hours=6), workers=2)
 assert len(serial) > 100 and len(parallel) == len(serial), (len(serial), len(parallel))
-key = lambda p: (p.catalog_number, p.tca)
-for a, b in zip(sorted(serial, key=key), sorted(parallel, key=key)):
-    assert a.catalog_number == b.catalog_number
-    for x, y in ((a.aos, b.aos), (a.los, b.los)):
-        assert (x is None) == (y is None) and (x is None or abs((x - y).total_seconds()) < 0.01)
-    assert abs((a.tca - b.tca).total_seconds()) < 0.5
-    assert abs(a.max_elevation_deg - b.max_elevation_deg) < 1e-3
+import numpy as np
+for name, column in serial.columns.items():  # bit for bit: each worker searches whole chunks of one process
+    assert np.array_equal(column, parallel.columns[name], equal_nan=True), name
 print("same", len(serial))
 """
     done = subprocess.run([sys.executable, "-c", script, str(DATA / "active.txt")], capture_output=True, text=True,
