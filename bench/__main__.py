@@ -104,7 +104,9 @@ def main(argv: list[str]) -> int:
             old[heading] = section
         print(f"  done in {time.monotonic() - started:.1f} s", file=sys.stderr)
     stamp = time.strftime("%Y-%m-%d", time.gmtime())
-    text = HEADER + f"\nLast run {stamp}. {_machine()}\n\n" + "\n".join(old[h] for h in sorted(old))
+    ran = ", ".join(n.replace("_", "-") for n in chosen)
+    text = HEADER + f"\nLast run {stamp}: {ran} (other sections are from earlier runs). {_machine()}\n\n" + \
+        "\n".join(old[h] for h in sorted(old))
     OUT.parent.mkdir(exist_ok=True)
     OUT.write_text(text)
     print(f"wrote {OUT.relative_to(ROOT)}", file=sys.stderr)
