@@ -8,6 +8,7 @@ an event of ours next to it.
 
 from __future__ import annotations
 
+import math
 from datetime import timedelta
 
 import numpy as np
@@ -84,3 +85,29 @@ def test_the_catalog_search_finds_the_same_passes(few: FewPasses) -> None:
             assert (ours is None and np.isnan(theirs)) or abs(ours - theirs) < 1e-4  # type: ignore[operator]
         assert abs(tca - catalog["tca_s"][i]) < 1e-2
         assert abs(max_el - catalog["max_elevation_deg"][i]) < 1e-6
+
+
+class _DecaysAfter:
+    """ISS's model, failing (SGP4 error 6: decayed) from ``after_days`` past ``jd + fr`` on."""
+
+    def __init__(self, satrec: object, jd: float, fr: float, after_days: float) -> None:
+        self.satrec, self.limit = satrec, jd + fr + after_days
+        self.no_kozai, self.ecco = satrec.no_kozai, satrec.ecco  # type: ignore[attr-defined]
+
+    def sgp4(self, jd: float, fr: float) -> tuple[int, tuple[float, ...], tuple[float, ...]]:
+        if jd + fr > self.limit:
+            return 6, (math.nan,) * 3, (math.nan,) * 3
+        return self.satrec.sgp4(jd, fr)  # type: ignore[attr-defined, no-any-return]
+
+
+def test_a_model_failing_inside_the_window_is_handed_to_the_catalog_search() -> None:
+    """The small search stops (NeedsCatalogSearch) rather than guess; ``passes`` then runs the catalog search,
+    which handles SGP4 failing inside a window."""
+    from nfwserver.tracking.few_passes import NeedsCatalogSearch
+
+    jd, fr = julian_date(START)
+    failing = _DecaysAfter(BY_NUMBER[25544].satrec, jd, fr, 0.5)
+    with pytest.raises(NeedsCatalogSearch):
+        find_few_passes([failing], [25544], OBSERVER, jd, fr, WINDOW_S)
+    unusable = _DecaysAfter(BY_NUMBER[25544].satrec, jd, fr, -1.0)  # fails at the start: left out, as screening does
+    assert find_few_passes([unusable], [25544], OBSERVER, jd, fr, WINDOW_S).skipped == [25544]

@@ -95,3 +95,19 @@ def test_one_satellite_is_searched_and_written_without_numpy(tmp_path) -> None:
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.splitlines()[-1] == "False 0"
     assert out.count("2026-05-0") >= 4  # the passes were written
+
+
+def test_a_case_the_small_search_hands_back_is_searched_by_the_catalog_search(capsys, monkeypatch, elements) -> None:
+    argv = ["passes", "--elements", str(elements), "--observer", "52.2,0.12", "--start", "2026-05-08T00:00Z",
+            "--sat", "25544", "--format", "csv"]
+    monkeypatch.setattr(few_command, "FEW", 0)
+    assert main(argv) == 0
+    catalog = capsys.readouterr().out
+    monkeypatch.setattr(few_command, "FEW", 8)
+
+    def hand_back(*args: object, **kwargs: object) -> FewPasses:
+        raise few_module.NeedsCatalogSearch("test")
+
+    monkeypatch.setattr(few_module, "find_few_passes", hand_back)
+    assert main(argv) == 0
+    assert capsys.readouterr().out == catalog and catalog.count("\n") >= 5
