@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bench import web_process
 from bench.realtime_loop import ClientProcess, run_publisher, wait_until
 from nfwserver.clock import SystemClock, VirtualClock
 from nfwserver.config.schema import WebConfig
@@ -86,7 +87,8 @@ def tick_cost(clients: int, ticks: int = 600, pace_s: float = 0.1) -> tuple[floa
     every browser got."""
     clock = VirtualClock(START)
     core = StationCore(CATALOG, OBS, clock, satellite=25544, rate_hz=10)
-    web = WebServer(core, CONFIG, max_clients=clients + 10)
+    web = WebServer(core, CONFIG, max_clients=clients + 10, max_per_address=clients + 10,
+                    max_streams=clients + 10)  # every browser here comes from 127.0.0.1
     web.start()
     assert web.address is not None
     browsers = Browsers(web.address, clients) if clients else None
@@ -116,7 +118,8 @@ def tick_cost(clients: int, ticks: int = 600, pace_s: float = 0.1) -> tuple[floa
 
 def loop_lateness(clients: int, rate: float, seconds: float) -> tuple[float, float, float, int, int]:
     core = StationCore(CATALOG, OBS, SystemClock(), satellite=25544, rate_hz=rate)
-    web = WebServer(core, CONFIG, max_clients=clients + 10)
+    web = WebServer(core, CONFIG, max_clients=clients + 10, max_per_address=clients + 10,
+                    max_streams=clients + 10)  # every browser here comes from 127.0.0.1
     web.start()
     assert web.address is not None
     browsers = Browsers(web.address, clients)
@@ -161,6 +164,7 @@ def main() -> None:
     print("The tick's own cost (first table) is what the web server adds to the publish loop. The lateness tail "
           "(p99, max: one or two ticks of 151) follows the machine's load, browsers or not; compare runs on an "
           "idle machine.\n")
+    web_process.main()
 
 
 if __name__ == "__main__":

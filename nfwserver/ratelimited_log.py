@@ -36,12 +36,16 @@ class RateLimitedLog:
         self._windows: dict[str, _Window] = {}
         self._lock = threading.Lock()
 
-    def log(self, level: int, key: str, message: str, *args: object, exc_info: bool = False) -> bool:
-        """Log ``message % args`` unless ``key`` was logged less than ``interval_s`` ago; True if written."""
+    def log(self, level: int, key: str, message: str, *args: object, exc_info: bool = False,
+            force: bool = False) -> bool:
+        """Log ``message % args`` unless ``key`` was logged less than ``interval_s`` ago; True if written.
+
+        ``force`` writes it whatever the window (the first line of a new episode of a condition: only the
+        repeats within one episode are limited), with the count of those suppressed before it."""
         now = self.clock.monotonic()
         with self._lock:
             window = self._windows.get(key)
-            if window is not None and now - window.since < self.interval_s:
+            if window is not None and now - window.since < self.interval_s and not force:
                 window.suppressed += 1
                 return False
             suppressed = window.suppressed if window is not None else 0

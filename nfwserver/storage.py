@@ -31,13 +31,15 @@ def _temporary_name(target: Path) -> Path:
     return target.with_name(f".{target.name}.{os.getpid()}.{os.urandom(4).hex()}.tmp")
 
 
-def _create_like(tmp: Path, target: Path) -> int:
-    """Open ``tmp`` exclusively, with ``target``'s mode and owner if it exists."""
+def _create_like(tmp: Path, target: Path, mode: int | None = None) -> int:
+    """Open ``tmp`` exclusively, with ``target``'s mode and owner if it exists; ``mode``, when given, instead
+    of the mode (set before anything is written, so a secret never sits in a readable file)."""
     try:
         st: os.stat_result | None = os.stat(target)
     except OSError:
         st = None
-    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0),
+                 0o666 if mode is None else mode)
     if st is not None:
         if sys.platform != "win32":  # Windows has no owner ids to keep
             with contextlib.suppress(OSError):
@@ -47,15 +49,17 @@ def _create_like(tmp: Path, target: Path) -> int:
             os.fchmod(fd, stat.S_IMODE(st.st_mode))
         else:  # pragma: no cover - Windows: only the read-only bit exists
             os.chmod(tmp, stat.S_IMODE(st.st_mode))
+    if mode is not None and hasattr(os, "fchmod"):
+        os.fchmod(fd, mode)  # before a byte is written
     return fd
 
 
-def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
-    """Replace ``path`` with ``data`` atomically, keeping its permissions."""
+def atomic_write_bytes(path: str | os.PathLike[str], data: bytes, mode: int | None = None) -> None:
+    """Replace ``path`` with ``data`` atomically, keeping its permissions (or giving it ``mode``)."""
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
     tmp = _temporary_name(target)
-    fd = _create_like(tmp, target)
+    fd = _create_like(tmp, target, mode)
     try:
         with os.fdopen(fd, "wb") as handle:
             handle.write(data)
@@ -75,8 +79,8 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
                 os.close(dir_fd)
 
 
-def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
-    atomic_write_bytes(path, text.encode("utf-8"))
+def atomic_write_text(path: str | os.PathLike[str], text: str, mode: int | None = None) -> None:
+    atomic_write_bytes(path, text.encode("utf-8"), mode)
 
 
 def _pid_running(pid: int) -> bool | None:

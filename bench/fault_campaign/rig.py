@@ -116,6 +116,7 @@ class FaultRig:
         self.real_time = False
         self.rotor_distance = float("inf")  #: last seen distance (deg) of the real rotor from its target
         self.held_connections: list[socket.socket] = []  #: the slow-loris fault's open connections
+        self.edits_lost: list[str] = []  #: what the concurrent-edits fault lost (settings, element sets)
         self._last_tick = time.monotonic()
 
     def _config_text(self) -> str:

@@ -9,13 +9,17 @@ works again (:attr:`Fault.works`).
 from __future__ import annotations
 
 import math
+import os
 import socket
+import subprocess
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from bench.fault_campaign.rig import ISS, FaultRig, TickRecord
-from nfwserver.tracking.elements import load_elements
+from bench.fault_campaign.rig import ELEMENTS, ISS, ROOT, FaultRig, TickRecord
+from nfwserver.config import parse_config
+from nfwserver.tracking.elements import load_element_file, load_elements
 from nfwserver.tracking.tle import tle_checksum
 
 
@@ -76,6 +80,26 @@ def rotor_works(rig: FaultRig, record: TickRecord) -> bool:
     closing = distance < rig.rotor_distance - 0.5
     rig.rotor_distance = distance
     return distance < 15.0 or closing
+
+
+def rotor_moving(rig: FaultRig, record: TickRecord) -> bool:
+    """Stricter than :func:`rotor_works` (for a still target): the real rotor is within 15 degrees of its target
+    or is seen closing on it now, between two readings of the daemon a quarter of a real second apart (the dummy
+    turns about 1.5 degrees in that time)."""
+    rotor = rig.station.rotor
+    if rotor is None or rotor.driver.commanded_position is None or {"rotor", "rotctld"} & set(record.faults):
+        return False
+    commanded = rotor.driver.commanded_position
+
+    def distance() -> float:
+        az, el = (float(v) for v in _ask(rig.rotctld.port, b"p\n")[:2])
+        return math.hypot(az - commanded[0], el - commanded[1])
+
+    first = distance()
+    if first < 15.0:
+        return True
+    time.sleep(0.25)
+    return distance() < first - 0.5
 
 
 def radio_works(rig: FaultRig, record: TickRecord) -> bool:
@@ -203,6 +227,61 @@ def tcp_served(rig: FaultRig, record: TickRecord) -> bool:
     return data.startswith(b"Hello") and b"satellite=" in data
 
 
+def _still_target_then_kill(rig: FaultRig) -> None:
+    """PARK to a still target (az 200, el 30: a geostationary satellite, or AO-10 near apogee, asks for no new
+    target), once the rotor is on its way there, rotctld is killed; its restart (the fault's end) brings the
+    dummy back at 0/0, its target forgotten.  Recovery is the rotor seen moving toward the target again."""
+    rotor = rig.station.rotor
+    assert rotor is not None
+    rotor.driver.set_parking(0, 200, 30)
+    rig.station.core.set_track(False, source="campaign")
+    rotor.request_park()
+    for _ in range(10):  # two seconds: the target sent, the dummy turning toward it
+        rig.tick()
+    rig.rotctld.kill()
+
+
+_EDITS = {"elements.stale_days": "21", "tcp.idle_timeout_s": "299", "rotor.threshold_deg": "2.5",
+          "radio.knob_tolerance_hz": "150", "server.ut1_utc_s": "0.0"}
+
+
+def _concurrent_edits(rig: FaultRig) -> None:
+    """Five ``config set`` runs on different keys of the station's own (watched) configuration, in parallel,
+    and two ``elements update`` runs into one store, in parallel; what either lost is kept for ``works``."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    store = rig.work / "store.txt"
+    store.unlink(missing_ok=True)
+    sets = load_element_file(ELEMENTS).sets
+    halves = [rig.work / "half-a.txt", rig.work / "half-b.txt"]
+    halves[0].write_text("".join(es.tle_text() for es in sets[::2]))
+    halves[1].write_text("".join(es.tle_text() for es in sets[1::2]))
+    command = [sys.executable, "-m", "nfwserver"]
+    procs = [subprocess.Popen([*command, "config", "set", "--config", str(rig.config_path), key, value], env=env,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) for key, value in _EDITS.items()]
+    procs += [subprocess.Popen([*command, "elements", "update", str(half), "--store", str(store)], env=env,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) for half in halves]
+    for proc in procs:
+        proc.wait(120)
+    written = parse_config(rig.config_path.read_text(), str(rig.config_path), rig.config_path.parent)
+    values = {"elements.stale_days": written.elements.stale_days, "tcp.idle_timeout_s": written.tcp.idle_timeout_s,
+              "rotor.threshold_deg": written.rotor.threshold_deg,
+              "radio.knob_tolerance_hz": written.radio.knob_tolerance_hz, "server.ut1_utc_s": written.server.ut1_utc_s}
+    rig.edits_lost = [key for key, value in _EDITS.items() if float(values[key]) != float(value)]
+    stored = {es.catalog_number for es in load_element_file(store).sets} if store.exists() else set()
+    missing = len({es.catalog_number for es in sets} - stored)
+    if missing:
+        rig.edits_lost.append(f"{missing} element sets")
+
+
+def _edits_undone(rig: FaultRig) -> None:
+    rig.config_path.write_text(rig.config_text)
+
+
+def edits_kept(rig: FaultRig, record: TickRecord) -> bool:
+    """Nothing the parallel edits wrote was lost, the feed publishes and the configuration is not refused."""
+    return not rig.edits_lost and record.published and "config" not in record.faults
+
+
 def _foreign_digits(rig: FaultRig) -> None:
     """Pokes with other scripts' digits (SAT=², ANTAZ=٣) over TCP and DDE: refused, nothing else changes."""
     _tcp_send(rig, "SAT=²\r\nANTAZ=٣\r\nSAT=２５５４４\r\n".encode(), 3)
@@ -224,6 +303,8 @@ FAULTS = (
           duration_s=40.0, real_time=True),
     Fault("rotctld killed, restarted", "rotctld",
           lambda rig: rig.rotctld.kill(), lambda rig: rig.rotctld.restart(), rotor_works, real_time=True),
+    Fault("rotctld restarted under a still target (recovered = the rotor seen moving)", "rotctld",
+          _still_target_then_kill, lambda rig: rig.rotctld.restart(), rotor_moving, duration_s=8.0, real_time=True),
     Fault("rigctld killed, restarted", "rigctld",
           lambda rig: rig.rigctld.kill(), lambda rig: rig.rigctld.restart(), radio_works),
     Fault("rigctld answers one byte at a time", "rigctld",
@@ -245,6 +326,8 @@ FAULTS = (
           tcp_served, duration_s=10.0),
     Fault("pokes with other scripts' digits (SAT=², ANTAZ=٣) over TCP and DDE", None, _foreign_digits, _nothing,
           feed_works, duration_s=0.2),
+    Fault("five config set and two elements update runs in parallel", None, _concurrent_edits, _edits_undone,
+          edits_kept, duration_s=2.0),
 )
 
 
@@ -253,6 +336,9 @@ def restore_baseline(rig: FaultRig) -> None:
     satellite selected before are drained and the stale-line count starts afresh (it belongs to one fault)."""
     if rig.station.core.state.catalog_number != ISS:
         rig.station.core.select_satellite(ISS, source="campaign")
+        rig.tick()
+    if not rig.station.core.state.snapshot().tracking:  # a fault parked the rotor
+        rig.station.core.set_track(True, source="campaign")
         rig.tick()
     rig.drain_tty()
     rig.stale_easycomm = 0

@@ -1,6 +1,7 @@
 """Reading element sets from the bundled file, local files and URLs (InstantTrack UPDATE semantics).
 
-URLs are read with a timeout.  Every file and URL is held to :class:`SourceLimits` (``[elements]
+URLs are read with a deadline for the whole transfer (and each read), redirects followed only to http(s)
+(:mod:`nfwserver.app.http_fetch`).  Every file and URL is held to :class:`SourceLimits` (``[elements]
 max_source_mib`` and ``max_source_sets``): a file is measured before it is read and read with a
 bounded read, a download stops at the limit, and a source over either limit is refused whole with one
 sentence naming it and the limit.  A source that fails is reported once, as one plain sentence
@@ -13,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import socket
+import threading
 from collections.abc import Callable, Mapping
 from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
@@ -74,8 +76,14 @@ def bundled_elements() -> FetchResult:
 def _network_reason(exc: BaseException, timeout_s: float) -> str:
     import urllib.error
 
+    from nfwserver.app.http_fetch import RedirectRefused
+
     if isinstance(exc, urllib.error.HTTPError):
-        return f"the server answered HTTP {exc.code} {exc.reason}".rstrip()
+        if 300 <= exc.code < 400:  # urllib's loop message is three lines; one is enough
+            return f"too many redirects (HTTP {exc.code}; a redirect loop?)"
+        return " ".join(f"the server answered HTTP {exc.code} {exc.reason}".split())
+    if isinstance(exc, RedirectRefused):
+        return str(exc.reason)
     if isinstance(exc, urllib.error.URLError):
         exc = exc.reason if isinstance(exc.reason, BaseException) else OSError(str(exc.reason))
     if isinstance(exc, (socket.timeout, TimeoutError)):
@@ -88,36 +96,47 @@ def _network_reason(exc: BaseException, timeout_s: float) -> str:
 
 
 def fetch_url(url: str, timeout_s: float = 20.0, progress: ProgressCallback | None = None,
-              limits: SourceLimits = SourceLimits()) -> bytes:
-    """GET ``url`` (http/https only), at most ``limits.max_bytes``; raises :class:`SourceError` (one sentence)."""
+              limits: SourceLimits = SourceLimits(), cancel: threading.Event | None = None) -> bytes:
+    """GET ``url`` (http/https only, redirects too), at most ``limits.max_bytes``, the whole transfer within
+    ``timeout_s`` seconds (each read too); ``cancel`` set aborts it at once.  Raises :class:`SourceError`
+    (one sentence)."""
     scheme = url.partition("://")[0].lower()
     if scheme not in ("http", "https"):
         raise SourceError(f"{url}: unsupported scheme {scheme}:// (element sources are files or http(s) URLs)")
     import http.client  # the network modules (and ssl) load only when a URL is fetched: 3 MiB for `passes`
     import urllib.error
-    import urllib.request
 
-    request = urllib.request.Request(url, headers={"User-Agent": "nfwserver"})
+    from nfwserver.app.http_fetch import Deadline, open_url
+
     chunks: list[bytes] = []
     size = 0
+    deadline = Deadline(timeout_s, cancel).start()
     try:
-        with urllib.request.urlopen(request, timeout=timeout_s) as response:  # noqa: S310 - scheme checked above
+        with open_url(url, timeout_s, deadline) as response:
             length = response.headers.get("Content-Length")
             total = int(length) if length and length.isascii() and length.isdigit() else None
             if total is not None and total > limits.max_bytes:
                 raise limits.too_large(url)
-            while size <= limits.max_bytes:
-                chunk = response.read(_CHUNK)
+            while size <= limits.max_bytes and not deadline.expired:
+                chunk = response.read1(_CHUNK)  # what has arrived: a trickle cannot hold one read for long
                 if not chunk:
                     break
                 chunks.append(chunk)
                 size += len(chunk)
                 if progress is not None:
                     progress(size, total)
+            if deadline.expired:
+                raise TimeoutError
             if total is not None and size < total:
                 raise OSError(f"the connection closed {total - size} bytes before the announced end")
     except (OSError, ValueError, urllib.error.URLError, http.client.HTTPException) as exc:
+        if deadline.expired:
+            why = "stopped: the station is stopping" if deadline.cancelled else \
+                f"the whole transfer did not end within {timeout_s:g} s"
+            raise SourceError(f"cannot fetch {url}: {why}") from None
         raise SourceError(f"cannot fetch {url}: {_network_reason(exc, timeout_s)}") from None
+    finally:
+        deadline.finish()
     if size > limits.max_bytes:
         raise limits.too_large(url)
     return b"".join(chunks)
@@ -173,13 +192,14 @@ def parse_source(data: bytes, source: str, limits: SourceLimits = SourceLimits()
 
 def read_source(source: str, timeout_s: float = 20.0, progress: ProgressCallback | None = None,
                 limits: SourceLimits = SourceLimits(),
-                parsing: Callable[[], AbstractContextManager[object]] = contextlib.nullcontext) -> LoadResult:
+                parsing: Callable[[], AbstractContextManager[object]] = contextlib.nullcontext,
+                cancel: threading.Event | None = None) -> LoadResult:
     """Element sets from a file or an http(s) URL; raises :class:`SourceError` (one sentence).
 
     ``parsing()`` is entered around the parse (not the download): the station passes
     :func:`~nfwserver.app.long_lived.building_long_lived`."""
     if is_url(source):
-        data = fetch_url(source, timeout_s, progress, limits)
+        data = fetch_url(source, timeout_s, progress, limits, cancel)
     else:
         data = read_file(source, limits)
         if progress is not None:
@@ -191,13 +211,13 @@ def read_source(source: str, timeout_s: float = 20.0, progress: ProgressCallback
 def fetch_all(files: tuple[str, ...] = (), urls: tuple[str, ...] = (), use_bundled: bool = True,
               timeout_s: float = 20.0, limits: SourceLimits = SourceLimits(),
               parsing: Callable[[], AbstractContextManager[object]] = contextlib.nullcontext,
-              labels: Mapping[str, str] | None = None) -> FetchResult:
+              labels: Mapping[str, str] | None = None, cancel: threading.Event | None = None) -> FetchResult:
     """Element sets from every source, in order; never raises (failures are in ``failed``, each one line
     opening with the source's label from ``labels`` when it has one, e.g. a preset's name)."""
     result = bundled_elements() if use_bundled else FetchResult()
     for source in (*files, *urls):
         try:
-            loaded = read_source(source, timeout_s, limits=limits, parsing=parsing)
+            loaded = read_source(source, timeout_s, limits=limits, parsing=parsing, cancel=cancel)
         except SourceError as exc:
             label = (labels or {}).get(source)
             result.failed.append(f"{label}: {exc}" if label else str(exc))

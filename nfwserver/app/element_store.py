@@ -4,7 +4,8 @@ One text file of 3-line TLEs (canonical lines, so every format that was loaded i
 way) in the platform's user data directory.  Updates follow InstantTrack's UPDATE rule (a set
 replaces the stored one only when its epoch is newer) and are written atomically: a crash during
 an update leaves the previous file whole, and the temporary it leaves is removed the next time a
-store is opened on that file (:func:`nfwserver.storage.remove_stale_temporaries`).  The stored file
+store is opened on that file (:func:`nfwserver.storage.remove_stale_temporaries`).  Every read-modify-write
+holds the store's lock (:mod:`nfwserver.file_lock`), so parallel updates lose nothing.  The stored file
 keeps its permissions across updates.
 """
 
@@ -17,6 +18,7 @@ from pathlib import Path
 
 from sgp4.api import jday
 
+from nfwserver.file_lock import locked
 from nfwserver.storage import atomic_write_text, remove_stale_temporaries
 from nfwserver.tracking.catalog import Catalog, UpdateSummary
 from nfwserver.tracking.elements import ElementSet, load_element_file
@@ -76,12 +78,14 @@ class ElementStore:
         return load_element_file(self.path).sets
 
     def update(self, sets: list[ElementSet]) -> tuple[Catalog, UpdateSummary]:
-        """Merge ``sets`` into the stored catalog with UPDATE semantics and write it atomically."""
-        catalog = Catalog(self.load())
-        summary = catalog.update(sets)
-        if summary.added or summary.updated or not self.path.exists():
-            text = "".join(es.tle_text() for es in catalog.element_sets())
-            atomic_write_text(self.path, text)
+        """Merge ``sets`` into the stored catalog with UPDATE semantics and write it atomically, reading and
+        writing under the store's lock (another ``elements update``, a running station's refresher)."""
+        with locked(self.path):
+            catalog = Catalog(self.load())
+            summary = catalog.update(sets)
+            if summary.added or summary.updated or not self.path.exists():
+                text = "".join(es.tle_text() for es in catalog.element_sets())
+                atomic_write_text(self.path, text)
         return catalog, summary
 
     def plan_prune(self, now: datetime, max_age_days: float, keep: frozenset[int] = frozenset()) -> PruneSummary:
@@ -104,10 +108,11 @@ class ElementStore:
         """Remove exactly the sets ``planned`` names (same catalog number and epoch; a set updated since
         the plan stays) and rewrite the file atomically if anything went; returns how many sets remain."""
         gone = {(es.catalog_number, es.epoch) for es in planned.removed}
-        sets = self.load()
-        kept = [es for es in sets if (es.catalog_number, es.epoch) not in gone]
-        if len(kept) != len(sets):
-            atomic_write_text(self.path, "".join(es.tle_text() for es in kept))
+        with locked(self.path):
+            sets = self.load()
+            kept = [es for es in sets if (es.catalog_number, es.epoch) not in gone]
+            if len(kept) != len(sets):
+                atomic_write_text(self.path, "".join(es.tle_text() for es in kept))
         return len(kept)
 
     def prune(self, now: datetime, max_age_days: float, keep: frozenset[int] = frozenset()) -> PruneSummary:

@@ -41,6 +41,11 @@ def _set_radio_tuning(core: StationCore, new: Config) -> None:
     core.set_radio_tuning(new.radio.enabled, source="configuration")
 
 
+def _web_server_follows(core: StationCore, new: Config) -> None:
+    """Nothing in the core: :meth:`~nfwserver.app.station.Station.apply_config` hands the new ``[web]``
+    control, token and host names to its web server, which reads them at the next request."""
+
+
 #: Every part a reload may change: live ones with how they are applied, restart-only ones without.
 CONFIG_PARTS: tuple[ConfigPart[StationCore], ...] = (
     ConfigPart("[observer], [horizon], [server] ut1_utc_s and rate_hz, [satellites] channels",
@@ -55,5 +60,7 @@ CONFIG_PARTS: tuple[ConfigPart[StationCore], ...] = (
     ConfigPart("[dialects]", ("dialects",)),
     ConfigPart("[tcp]", ("tcp",)),
     ConfigPart("[easycomm]", ("easycomm",)),
-    ConfigPart("[web]", ("web",)),
+    ConfigPart("[web] control, token and hostnames", ("web.control", "web.token", "web.hostnames"),
+               _web_server_follows),
+    ConfigPart("[web] enabled, host, port and allow", ("web.enabled", "web.host", "web.port", "web.allow")),
 )

@@ -1,10 +1,10 @@
 """The session state kept across restarts: the AutoTracking satellite.
 
 Saved as a small JSON file, atomically (:mod:`nfwserver.storage`, keeping the file's permissions),
-whenever it changes; a missing, unreadable or malformed file just means "no saved state".  Temporaries
-left by a process killed mid-save are removed when the state file is opened.  The file also records
-which ``[server] satellite`` was configured when the choice was made, so an edit of the configuration
-wins over a choice saved before it (the station says so in its log).
+whenever it changes, and at stop from the live state; a missing, unreadable or malformed file just means
+"no saved state".  Temporaries left by a process killed mid-save are removed when the state file is
+opened.  The file also records which ``[server] satellite`` was configured when the choice was made, so an
+edit of the configuration wins over a choice saved before it (the station says so in its log).
 
 :class:`SessionSaver` follows the ticks on its own worker thread: saving (an fsync) never runs on
 the publisher.  A file that cannot be written (read-only, full disk, a removed directory) is the
@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import json
 import logging
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -77,16 +78,19 @@ class StateFile:
 class SessionSaver(TickWorker):
     """Saves the AutoTracking satellite when it changes, on the worker thread ``nfw-session``.
 
-    ``health`` is the ``state-file`` link: failures back off on its schedule; the last unsaved state is
-    tried once more when the saver stops, whatever the back-off says."""
+    ``health`` is the ``state-file`` link: failures back off on its schedule.  When the saver stops, the
+    state is saved once more, whatever the back-off says: the live selection read from ``current`` (a
+    ``SAT=`` answered ``OK`` after the last tick is not lost), else the last tick's."""
 
     thread_name = "nfw-session"
 
-    def __init__(self, state_file: StateFile, configured: int | None, health: LinkHealth) -> None:
+    def __init__(self, state_file: StateFile, configured: int | None, health: LinkHealth,
+                 current: Callable[[], int | None] | None = None) -> None:
         super().__init__(health.clock)
         self.state_file = state_file
         self.configured = configured
         self.health = health
+        self.current = current
         self._wanted: SessionState | None = None
 
     def process(self, sample: TickSample) -> None:
@@ -95,6 +99,8 @@ class SessionSaver(TickWorker):
 
     def stop(self) -> None:
         super().stop()
+        if self.current is not None:
+            self._wanted = SessionState(self.current(), self.configured)
         if self._wanted is not None:
             self._write(self._wanted, forced=True)
 

@@ -30,6 +30,7 @@ from nfwserver.app.platform_transport import default_transport
 from nfwserver.app.session_state import SessionSaver, SessionState, StateFile
 from nfwserver.app.station_catalog import configured_store, configured_urls, fetch_configured, load_station_catalog
 from nfwserver.app.status_fields import combined, device_status, elements_status
+from nfwserver.app.store_watcher import StoreWatcher
 from nfwserver.clock import Clock
 from nfwserver.config.live_reload import keep_running, restart_needed
 from nfwserver.config.schema import Config
@@ -86,7 +87,8 @@ class Station:
         self.core.rotor_configured = self.rotor is not None
         self.radio: RadioCoupling | None = make_radio(config.radio, self.core, clock)
         self.saver = (SessionSaver(self.state_file, config.server.satellite,
-                                   self.core.health.link("state-file", Backoff(0.2, 0.4)))
+                                   self.core.health.link("state-file", Backoff(0.2, 0.4)),
+                                   current=lambda: self.core.state.catalog_number)
                       if self.state_file else None)
         self.easycomm: EasyCommOutput | None = (
             EasyCommOutput(config.easycomm, self.core.state, clock,
@@ -103,10 +105,13 @@ class Station:
                                                           favourites=lambda: self.config.favourites))
             if config.web.enabled else None)
         self.watcher: ConfigWatcher | None = None
+        #: follows the stored catalog, which ``nfwserver elements update`` writes while the station runs
+        self.store_watcher = StoreWatcher(self.store.path, clock, self.reload_store) if self.store else None
         self._watcher_lock = threading.Lock()
         self.selection_note = ""  #: which satellite the station started with, and why (set by start())
         self._unsubscribe: list[Callable[[], None]] = []
         self._started = False
+        self._stopping = threading.Event()  #: set by stop(): a download in progress is aborted at once
 
     # -- convenience views -------------------------------------------------------------------------
     @property
@@ -124,11 +129,16 @@ class Station:
         One table drives it (:data:`~nfwserver.app.live_config.CONFIG_PARTS`): every live part that changed
         (observer, horizon, UT1-UTC, rate, channels, DDE names, radio tuning) changes the live state at once;
         the restart-only parts are compared with what is *running* and listed when they differ."""
+        favourites = self.config.favourites
         for part in CONFIG_PARTS:
             if part.apply is not None and part.differs(self.config, new):
                 part.apply(self.core, new)
         restart = restart_needed(CONFIG_PARTS, self.config, new)
         self.config = keep_running(CONFIG_PARTS, self.config, new)  # what needs a restart keeps running as it was
+        if self.web is not None:  # control and token at once: an old token stops working with the change
+            self.web.configure(self.config.web)
+            if self.config.favourites != favourites:
+                self.web.board.request()  # the page's pass list follows now, not at the next refresh
         return restart
 
     def _config_changed(self, new: Config) -> None:
@@ -155,22 +165,25 @@ class Station:
         as a change the watcher sees.  False when the station runs on built-in defaults or is not running."""
         if not self._started:
             return False
-        if not self.config.path:
-            log.warning("reload requested, but the station runs on built-in defaults: there is no file to read")
-            return False
+        if self.store_watcher is not None:
+            self.store_watcher.request()  # the stored catalog too (written by `elements update`)
         with self._watcher_lock:  # any thread: two requests at once make one watcher
+            path = self.watcher.path if self.watcher is not None else self.config.path
+            if not path:
+                log.warning("reload requested, but the station runs on built-in defaults: there is no file to read")
+                return False
             if self.watcher is None:  # not watching: a watcher that reads only on request
-                self.watcher = ConfigWatcher(self.config.path, self.clock, self._config_changed,
-                                             self._config_refused, None)
+                self.watcher = ConfigWatcher(path, self.clock, self._config_changed, self._config_refused, None)
                 self.watcher.start()
-        log.info("reloading the configuration from %s", self.config.path)
-        self.watcher.request()
+            watcher = self.watcher
+        log.info("reloading the configuration from %s", path)
+        watcher.request()
         return True
 
     # -- elements ----------------------------------------------------------------------------------
     @staticmethod
-    def _report(fetched: FetchResult) -> None:
-        for problem in fetched.failed:
+    def _report(fetched: FetchResult, failures: bool = True) -> None:
+        for problem in fetched.failed if failures else ():
             log.warning("element source unavailable: %s", problem)
         for rejection in fetched.rejected:
             log.info("element set skipped: %s", rejection)
@@ -193,8 +206,14 @@ class Station:
         catalog (:meth:`Catalog.update`), and saving the store.  The publish thread only ever sees the
         swap of the catalog's contents, a reference change, and no garbage collection over the new
         sets (:func:`~nfwserver.app.long_lived.building_long_lived`), so a refresh never delays a tick."""
-        fetched = fetch_configured(self.config.elements, fetch_urls=True, parsing=building_long_lived)
-        self._report(fetched)
+        fetched = fetch_configured(self.config.elements, fetch_urls=True, parsing=building_long_lived,
+                                   cancel=self._stopping)
+        self._report(fetched, failures=False)  # the failures are the `elements` link's (one line an episode)
+        sources = self.core.health.link("elements", paced=False)  # STATUS faults=elements while sources fail
+        if fetched.failed:
+            sources.failed("; ".join(fetched.failed))
+        else:
+            sources.succeeded()
         with building_long_lived():
             summary = self.core.state.catalog.update(fetched.sets)
             if summary.added or summary.updated:
@@ -208,12 +227,28 @@ class Station:
         log.info("elements refreshed: %d added, %d updated", len(summary.added), len(summary.updated))
         return summary
 
+    def reload_store(self) -> UpdateSummary | None:
+        """Merge the stored catalog into the live one (the store watcher's thread): sets added by ``nfwserver
+        elements update`` become selectable, newer epochs replace older ones.  None without a store."""
+        if self.store is None:
+            return None
+        with building_long_lived():
+            stored = self.store.load()
+            summary = self.core.state.catalog.update(stored)
+            if summary.added or summary.updated:
+                self.core.state.catalog_changed()
+            release(stored)
+        if summary.added or summary.updated:
+            log.info("stored elements read again: %d added, %d updated", len(summary.added), len(summary.updated))
+        return summary
+
     # -- session -------------------------------------------------------------------------------------
     def _restore_session(self) -> None:
         srv = self.config.server
         saved = self.state_file.load() if self.state_file is not None else SessionState()
         choice, source = srv.satellite, "config"
-        if saved.satellite is not None and saved.satellite in self.catalog and saved.configured == srv.satellite:
+        if (saved.satellite is not None and saved.satellite != srv.satellite and saved.satellite in self.catalog
+                and saved.configured == srv.satellite):
             choice, source = saved.satellite, "saved-state"  # chosen at run time; the configuration unchanged
         self.selection_note = _selection_note(choice, source, srv.satellite, saved, self.state_file)
         if choice is not None and not self.core.select_satellite(choice, source=source):
@@ -234,6 +269,7 @@ class Station:
         """Load, bind and start everything; raises OSError when a listener cannot bind (nothing keeps running)."""
         if self._started:
             return
+        self._stopping.clear()
         for warning in self.config.warnings:
             log.warning("%s", warning)
         self._load_catalog()
@@ -263,13 +299,18 @@ class Station:
         cfg = self.config.elements
         if configured_urls(cfg) or (cfg.refresh_hours > 0 and cfg.files) or self.predict is not None:
             self.refresher.start()
+        if self.store_watcher is not None:
+            self.store_watcher.start()
 
     def stop(self) -> None:
         if not self._started:
             return
         self._started = False
+        self._stopping.set()
         if self.watcher is not None:
             self.watcher.stop()
+        if self.store_watcher is not None:
+            self.store_watcher.stop()
         self.refresher.stop()
         self.publisher.stop()
         for unsubscribe in self._unsubscribe:
@@ -281,7 +322,7 @@ class Station:
                 listener.stop()
         for dialect_server in self.dialect_servers:
             dialect_server.detach()
-        for worker in (self.radio, self.rotor, self.saver, self.easycomm):
+        for worker in (self.radio, self.rotor, self.easycomm):
             if worker is not None:
                 worker.stop()
         self.nova.detach()
@@ -290,6 +331,8 @@ class Station:
                 self.transport.close()
             except Exception:
                 log.exception("closing the transport failed")
+        if self.saver is not None:  # last: no face can change the selection any more
+            self.saver.stop()
 
 
 def _selection_note(choice: int | None, source: str, configured: int | None, saved: SessionState,

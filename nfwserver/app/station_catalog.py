@@ -9,6 +9,7 @@ follow ``[satellites] names``.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable
 from contextlib import AbstractContextManager, nullcontext
 
@@ -39,11 +40,13 @@ def configured_urls(elements: ElementsConfig) -> dict[str, str]:
 
 
 def fetch_configured(elements: ElementsConfig, *, fetch_urls: bool, timeout_s: float = 20.0,
-                     parsing: Callable[[], AbstractContextManager[object]] = nullcontext) -> FetchResult:
-    """The sets of every configured source (URLs and named sources only when ``fetch_urls``)."""
+                     parsing: Callable[[], AbstractContextManager[object]] = nullcontext,
+                     cancel: threading.Event | None = None) -> FetchResult:
+    """The sets of every configured source (URLs and named sources only when ``fetch_urls``; ``cancel`` set
+    aborts a download in progress)."""
     urls = configured_urls(elements) if fetch_urls else {}
     return fetch_all(elements.files, tuple(urls), elements.use_bundled, timeout_s, source_limits(elements),
-                     parsing, labels=urls)
+                     parsing, labels=urls, cancel=cancel)
 
 
 def load_station_catalog(config: Config, *, fetch_urls: bool = False,

@@ -33,7 +33,7 @@ def device_status(rotor: RotorCoupling | None, radio: RadioCoupling | None,
                 out["rotor_target"] = f"{target_az:.1f}/{target_el:.1f}"
         if radio is not None:
             out["radio"] = radio.link_state()
-            result = radio.last_result
+            result = radio.current_result()
             if result is not None:
                 out["radio_rx"] = result.rx_hz
                 if result.tx_hz:

@@ -78,6 +78,20 @@ def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the process exit code."""
+    if sys.stdout is not None and sys.stderr is not None:
+        return _main(argv)
+    from nfwserver.cli import windowless  # nfwserverw.exe: no console, so no standard streams
+
+    tail = windowless.capture()
+    try:
+        code = _main(argv)
+    except SystemExit as exc:  # argparse: usage errors (2), --help and --version (0)
+        code = exc.code if isinstance(exc.code, int) else 2
+    windowless.report(tail, code)
+    return code
+
+
+def _main(argv: Sequence[str] | None = None) -> int:
     single_threaded_blas()  # before a command loads numpy
     args_list = join_negative_values(list(sys.argv[1:] if argv is None else argv))
     parser = build_parser(args_list)

@@ -25,10 +25,12 @@ COMMANDS: tuple[tuple[str, str, str], ...] = (
     ("passes", "tracking_commands", "AOS/TCA/LOS of satellites over a window"),
     ("visible", "tracking_commands", "satellites above the horizon table at an instant"),
     ("elements", "elements_command", "update or list the stored element catalog"),
-    ("config", "config_command", "configuration file: path, init, show"),
+    ("config", "config_command", "configuration file: path, init, show, set, edit"),
     ("poke", "control_command", "send a Nova command to the running station (TCP)"),
     ("status", "control_command", "one line of the running station's state (TCP)"),
     ("watch", "watch_command", "live view of the running station (TCP)"),
+    ("stop", "station_commands", "stop the running station cleanly and wait until it has stopped"),
+    ("dashboard", "station_commands", "open the running station's web dashboard in the browser"),
 )
 
 #: Top-level options that take no value (so the word after them is not their argument).

@@ -7,8 +7,10 @@ saved, DDE clients never told), and Windows has no ``SIGHUP``.  So when the envi
 ``stop`` stops the station as ``SIGTERM`` does, ``reload`` re-reads the configuration as ``SIGHUP`` does.
 Anything else gets one warning and is removed.  ``tools/wine/nfwserver`` sets the variable and writes
 ``stop`` when it receives ``SIGTERM``, ``SIGINT`` or ``SIGHUP`` (``reload`` on ``SIGUSR1``); on Windows
-a service wrapper can do the same.  Writers should write another name and rename it into place, so
-that the station never reads half a word (an empty file is left alone until it has a word).
+a service wrapper can do the same.  Without the variable, ``run`` watches ``control`` in the user's state
+directory and says so in its description (:mod:`nfwserver.cli.station_channel`), which is how
+``nfwserver stop`` reaches it.  Writers should write another name and rename it into place, so that the
+station never reads half a word (an empty file is left alone until it has a word).
 
 Owned by its own thread, ``nfw-control``; it waits on the injected clock.
 """

@@ -33,7 +33,7 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
                     help="named sources (`nfwserver elements sources`), element files or http(s) URLs (default: "
                     f"[elements] files, urls and sources of the configuration, else the {DEFAULT_PRESET} source)")
     up.add_argument("--timeout", type=number_in(0, 3600, low_open=True, unit="s"), default=20.0,
-                    metavar="SECONDS", help="per-URL timeout")
+                    metavar="SECONDS", help="seconds for each URL's whole download (default 20)")
     up.set_defaults(func=run_update)
     ls = sub.add_parser("list", help="list the catalog the station uses (stored + files + bundled)")
     ls.set_defaults(func=run_list)

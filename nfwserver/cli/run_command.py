@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import logging
 import logging.handlers
+import os
 import sys
 import threading
 from collections.abc import Callable
@@ -21,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 from nfwserver.cli import say
 from nfwserver.cli.control_file import ControlFile, control_path
 from nfwserver.cli.signals import StationSignals, signal_actions
+from nfwserver.cli.station_channel import StationChannel, StationInfo
 from nfwserver.cli.station_runner import run_console, serve_headless, start_report
 from nfwserver.clock import Clock, SystemClock
 
@@ -38,7 +40,8 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     p = subparsers.add_parser(
         "run", help="run the server (console on a terminal, or --headless)",
         description="Run the Nova-compatible DDE server with the configuration file (see `nfwserver config path`), "
-        "or with built-in defaults when there is none.",
+        "or with built-in defaults when there is none.  The station follows that file while it runs "
+        "(`nfwserver config set` changes it; settings that need a restart are named).",
     )
     p.add_argument("--config", metavar="FILE", help="configuration file (default: the platform's config directory)")
     p.add_argument("--headless", action="store_true", help="no console: run as a service, log to a rotating file")
@@ -87,7 +90,7 @@ class RunPlan:
 
 def run(args: argparse.Namespace) -> int:
     from nfwserver.cli import CliError
-    from nfwserver.config import ConfigError, load_config
+    from nfwserver.config import ConfigError, default_config_path, load_config
 
     try:
         config = load_config(args.config)
@@ -99,7 +102,9 @@ def run(args: argparse.Namespace) -> int:
         config = with_web(config)
     plan = RunPlan(console=sys.stdout.isatty() and not args.headless,
                    log_file=Path(args.log_file) if args.log_file else default_log_file(), duration_s=args.duration)
-    return serve(config, plan, watch=args.config)
+    # The station follows the file it loaded, with or without --config; with none yet, the file `config init`
+    # or `config set` would create, so a station started on built-in defaults takes it when it appears.
+    return serve(config, plan, watch=config.path or str(default_config_path()))
 
 
 def with_web(config: Config) -> Config:
@@ -182,16 +187,39 @@ class _Requests:
             station.reload_config()
 
 
-def _listen(plan: RunPlan, requests: _Requests, clock: Clock) -> tuple[StationSignals | None, ControlFile | None]:
-    """Signal handlers and the control file's watcher, unless the caller stops the run itself (``plan.stop``)."""
+def _claim_channel(plan: RunPlan) -> StationChannel | None:
+    """This user's station channel, held for the run (:mod:`nfwserver.cli.station_channel`); None when the
+    caller stops the run itself (``plan.stop``).  Refused while another station of this user runs."""
+    from nfwserver.cli import CliError
+
+    if plan.stop is not None:
+        return None
+    channel = StationChannel()
+    try:
+        claimed = channel.claim()
+    except OSError as exc:
+        raise CliError(f"cannot use {channel.lock_path}: {exc.strerror or exc}") from None
+    if not claimed:
+        info = channel.info()
+        who = f" (process {info.pid})" if info is not None else ""
+        raise CliError(f"a station is already running for this user{who}: `nfwserver stop` stops it")
+    return channel
+
+
+def _listen(plan: RunPlan, requests: _Requests, clock: Clock,
+            channel: StationChannel | None) -> tuple[StationSignals | None, ControlFile | None]:
+    """Signal handlers and the control file's watcher, unless the caller stops the run itself (``plan.stop``).
+    The control file is NFW_CONTROL_FILE's or the channel's; the channel then says where it is."""
     if plan.stop is not None:
         return None, None
     signals = StationSignals(signal_actions(headless=not plan.console), requests.on_stop, requests.on_reload)
     signals.install()
-    path = control_path()
+    path = control_path() or (channel.default_control if channel is not None else None)
     control = ControlFile(path, clock, signals.request) if path is not None else None
     if control is not None:
         control.start()
+    if channel is not None and control is not None:
+        channel.describe(StationInfo(os.getpid(), control.path))
     return signals, control
 
 
@@ -207,9 +235,11 @@ def serve(config: Config, plan: RunPlan, watch: str | None = None) -> int:
     clock = plan.clock or SystemClock()
     stop = plan.stop or threading.Event()
     requests = _Requests(stop)
-    signals, control = _listen(plan, requests, clock)
+    channel = _claim_channel(plan)
+    signals, control = None, None
     file_handler = None
     try:
+        signals, control = _listen(plan, requests, clock, channel)
         if not plan.console:
             file_handler = _log_to_file(plan.log_file, clock)
             say(f"logging to {plan.log_file}")
@@ -222,6 +252,9 @@ def serve(config: Config, plan: RunPlan, watch: str | None = None) -> int:
             station.stop()
             raise CliError(f"cannot start the station: {exc.strerror or exc}") from None
         requests.station_started(station)
+        if channel is not None and control is not None:
+            channel.describe(StationInfo(os.getpid(), control.path, station.web.url if station.web is not None
+                                         and station.web.address is not None else None))
         try:
             file_handler = _serve_started(station, config, plan, watch, requests, file_handler)
         finally:
@@ -237,6 +270,8 @@ def serve(config: Config, plan: RunPlan, watch: str | None = None) -> int:
         if file_handler is not None:
             logging.getLogger().removeHandler(file_handler)
             file_handler.close()
+        if channel is not None:
+            channel.release()
     return 0
 
 

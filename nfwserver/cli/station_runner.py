@@ -46,7 +46,8 @@ def enabled_outputs(station: Station) -> list[str]:
     if web is not None and web.address is not None:
         outputs.append(f"web dashboard {web.url} (control {'on' if web.control.enabled else 'off'})")
     if station.rotor is not None:
-        outputs.append(f"rotor ({cfg.rotor.backend})")
+        where = f" {cfg.rotor.host}:{cfg.rotor.port}" if cfg.rotor.backend == "rotctld" else ""
+        outputs.append(f"rotor ({cfg.rotor.backend}{where})")
     if station.radio is not None:
         outputs.append(f"radio ({cfg.radio.backend} {cfg.radio.host}:{cfg.radio.port})")
     return outputs

@@ -131,8 +131,12 @@ def _report_stale(stale: list[Any], names: Mapping[int, str], at: datetime, stal
     """Warn of the sets older than ``stale_days`` before ``at``, naming up to five by DDE name (``names``)."""
     if stale:
         shown = ", ".join(names[s.catalog_number] for s in stale[:5]) + (", ..." if len(stale) > 5 else "")
-        warn(f"{len(stale)} element set(s) are more than {stale_days:g} days older than {format_time(at)}, "
-             f"so their positions drift ({shown}); `nfwserver elements update` fetches newer ones")
+        ages = [(at - getattr(s, "elements", s).epoch).total_seconds() / 86400.0 for s in stale]
+        span = f"{min(ages):.0f} to {max(ages):.0f}" if round(min(ages)) != round(max(ages)) else f"{max(ages):.0f}"
+        sets, drift = ("1 element set is", "its position drifts") if len(stale) == 1 else \
+            (f"{len(stale)} element sets are", "their positions drift")
+        warn(f"{sets} {span} days old at {format_time(at)} (more than [elements] stale_days, {stale_days:g}), "
+             f"so {drift} ({shown}); `nfwserver elements update` fetches newer ones")
 
 
 def _stale_days(inputs: TrackingInputs) -> float:

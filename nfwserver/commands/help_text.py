@@ -13,7 +13,7 @@ from nfwserver.commands.table import Face, Target, commands_for
 
 __all__ = ["help_lines", "markdown", "poke_epilog"]
 
-_FACE_NAMES = ((Face.DDE, "DDE"), (Face.TCP, "TCP"), (Face.CONSOLE, "console"))
+_FACE_NAMES = ((Face.DDE, "DDE"), (Face.TCP, "TCP"), (Face.CONSOLE, "console"), (Face.WEB, "web"))
 _TARGET_NAMES = {Target.STATION: "station", Target.SESSION: "connection", Target.ROTOR: "rotor",
                  Target.DISPLAY: "display"}
 
@@ -58,5 +58,5 @@ def markdown() -> str:
         out.append("| " + " | ".join(cell.replace("|", "\\|") for cell in cells) + " |")
     out += ["", "Faces: **DDE** = a poke or execute on service `NFW32`/`NFW_SERVER`, topic `NFW_DATA`; "
             "**TCP** = a line on Nova's TCP port (`nfwserver poke` sends one); **console** = the console's "
-            "input line.", ""]
+            "input line; **web** = a command posted by the web dashboard (`[web] control`, docs/WEB.md).", ""]
     return "\n".join(out)

@@ -31,7 +31,8 @@ class Face(enum.Flag):
     DDE = enum.auto()  #: a poke or execute on Nova's DDE topic (several commands, one per line)
     TCP = enum.auto()  #: a line on Nova's TCP port (``nfwserver poke`` sends one)
     CONSOLE = enum.auto()  #: the console's input line
-    ALL = DDE | TCP | CONSOLE
+    WEB = enum.auto()  #: a command posted by the web dashboard (``POST /api/command``)
+    ALL = DDE | TCP | CONSOLE | WEB
 
 
 class Target(enum.Enum):
@@ -188,11 +189,11 @@ COMMANDS: tuple[Command, ...] = (
             Face.TCP, Target.SESSION),
     Command("FLIP", r"FLIP(?:\s+(\S+))?", "FLIP AUTO|ON|OFF", "FLIP AUTO|ON|OFF", "AUTO, ON or OFF",
             "FlipAnts' inverted (flip) tracking: forced on, off, or chosen per pass (auto)",
-            "OK, or ERROR no rotor is configured", Face.TCP | Face.CONSOLE, Target.ROTOR, _flip_mode),
+            "OK, or ERROR no rotor is configured", Face.TCP | Face.CONSOLE | Face.WEB, Target.ROTOR, _flip_mode),
     Command("PARK", r"PARK", "PARK", "PARK", "nothing after it",
             "stop tracking (as TRACK OFF) and send the rotor to its park position ([rotor] park_azimuth_deg and "
             "park_elevation_deg); TRACK ON resumes", "OK, or ERROR no rotor is configured",
-            Face.TCP | Face.CONSOLE, Target.ROTOR),
+            Face.TCP | Face.CONSOLE | Face.WEB, Target.ROTOR),
     Command("Z", r"Z", "Z", "Z", "nothing after it", "show times in UTC or in the local zone",
             "a note in the console", Face.CONSOLE, Target.DISPLAY),
 )

@@ -14,11 +14,17 @@ from pathlib import Path
 from typing import Any
 
 import tomlkit
+from tomlkit.exceptions import TOMLKitError
+from tomlkit.items import AoT, InlineTable, Table
 
-from nfwserver.config.loader import TomlError, parse_config, toml_document
+from nfwserver.config.loader import ConfigError, TomlError, parse_config, toml_document
 from nfwserver.config.table import SECTIONS, keys_of
 
-__all__ = ["parse_value", "set_key", "split_key"]
+__all__ = ["TEXT_KINDS", "parse_value", "set_key", "split_key"]
+
+#: Kinds of setting whose value is text: a value that TOML would read as a number or a boolean (a token of
+#: digits, a device named 1) is taken as the text typed.
+TEXT_KINDS = frozenset({"text", "host", "url", "file", "store", "location", "device"})
 
 
 def split_key(name: str) -> tuple[str, str]:
@@ -32,28 +38,44 @@ def split_key(name: str) -> tuple[str, str]:
     return section, key
 
 
-def parse_value(text: str) -> Any:
+def parse_value(text: str, kind: str | None = None) -> Any:
     """The value ``text`` stands for: a TOML value when it is one (``true``, ``12.5``, ``[25544, 7530]``,
-    ``"quoted"``), else the text itself as a string (``JO01ab``, ``/dev/ttyUSB0``)."""
+    ``"quoted"``), else the text itself as a string (``JO01ab``, ``/dev/ttyUSB0``).  For a setting of a text
+    ``kind`` (:data:`TEXT_KINDS`), a number or boolean is the text as typed (``12345678`` as a token)."""
     try:
-        return toml_document(f"v = {text}")["v"]
+        value = toml_document(f"v = {text}")["v"]
     except TomlError:
         return text
+    if kind in TEXT_KINDS and not isinstance(value, (str, list, dict)):
+        return text
+    return value
 
 
 def set_key(text: str, section: str, key: str, value: Any, source: str, base_dir: Path) -> str:
     """``text`` (a configuration file's content) with ``[section] key = value``; raises
     :class:`ConfigError` when the result is not a valid configuration (the problem named)."""
-    doc = tomlkit.parse(text.removeprefix("\ufeff"))  # a BOM, as toml_document skips it
+    try:
+        toml_document(text)  # the reader the station uses: its one sentence for a file that is not TOML
+        doc = tomlkit.parse(text.removeprefix("\ufeff"))  # a BOM, as toml_document skips it
+    except (TomlError, TOMLKitError) as exc:
+        raise ConfigError(source, [f"the file is not valid TOML, so it was not changed ({_sentence(exc)})"]) from None
     table = doc.get(section)
     if table is None:
         table = tomlkit.table()
         doc.add(section, table)
+    elif not isinstance(table, (Table, InlineTable)):
+        what = f"an array of tables ([[{section}]])" if isinstance(table, AoT) else f"a plain value ({section} = ...)"
+        raise ConfigError(source, [f"[{section}] is {what} in the file, not a table; fix or remove it first"])
     table[key] = value
     new = tomlkit.dumps(doc)
     new = _drop_commented_example(new, section, key)
     parse_config(new, source, base_dir)  # raises ConfigError with every problem
     return new
+
+
+def _sentence(exc: Exception) -> str:
+    """An exception's message as one line (TOML readers' messages hold the line and column)."""
+    return " ".join(str(exc).split()) or type(exc).__name__
 
 
 def _drop_commented_example(text: str, section: str, key: str) -> str:

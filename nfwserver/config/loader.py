@@ -32,6 +32,7 @@ from nfwserver.config.schema import (
     WebConfig,
 )
 from nfwserver.config.table import SECTION_NAMES, SETTINGS, keys_of, setting
+from nfwserver.config.tokens import new_token, weak_token_reason
 from nfwserver.tracking.horizon import HorizonTable, parse_horizon
 from nfwserver.tracking.observer import Observer
 
@@ -179,9 +180,11 @@ class _Reading:
             self.problems.append("[easycomm] device: required when enabled (e.g. \"/dev/ttyUSB0\")")
         token = self.get("web", "token")
         if "web" not in self.dirty and self.get("web", "control") and not token:
-            self.problems.append("[web] token: required when control is on (at least 8 characters)")
-        elif "web" not in self.dirty and token is not None and len(token) < 8:
-            self.problems.append("[web] token: at least 8 characters")
+            self.problems.append("[web] token: required when control is on (at least 8 characters; for a "
+                                 f"fresh one: nfwserver config set web.token {new_token()})")
+        elif "web" not in self.dirty and token is not None and (why := weak_token_reason(token)):
+            self.problems.append(f"[web] token: {why} (for a fresh one: nfwserver config set web.token "
+                                 f"{new_token()})")
 
     def warnings(self, config: Config) -> tuple[str, ...]:
         found = []

@@ -128,6 +128,7 @@ class WebConfig:
     host: str = default("web", "host")  #: address listened on
     port: int = default("web", "port")  #: 0: any free port
     allow: tuple[str, ...] = default("web", "allow")  #: networks allowed to connect (normalised as [tcp] allow)
+    hostnames: tuple[str, ...] = default("web", "hostnames")  #: host names the page may be reached by, besides host
     control: bool = default("web", "control")  #: the page may send TUNE/TRACK/SAT
     token: str | None = default("web", "token")  #: required with every control request; always set with control
 

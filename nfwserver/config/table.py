@@ -178,10 +178,14 @@ SETTINGS: tuple[Setting, ...] = (
     _S("web", "port", "int", 8091, "HTTP port (0 = any free port)", "web.port", 0, 65535),
     _S("web", "allow", "networks", ["127.0.0.1", "::1"], "addresses or networks allowed to connect, as [tcp] allow",
        "web.allow"),
+    _S("web", "hostnames", "texts", [], "further host names the page is reached by (e.g. \"station.lan\"); "
+       "besides these, only the host above, localhost and the address connected to are answered (DNS rebinding)",
+       "web.hostnames", hi=253),
     _S("web", "control", "bool", False, "let the page send TUNE, TRACK and SAT (each request needs the token)",
        "web.control"),
     _S("web", "token", "text", None, "the secret every control request must carry (required when control is on; "
-       "at least 8 characters)", "web.token", 8, 256, example="change-me-0123"),
+       "at least 8 characters, no spaces, not guessable; `config init` writes a fresh one)", "web.token", 8, 256,
+       example="change-me-0123"),
 )
 del _S
 

@@ -143,9 +143,11 @@ def radio_line(radio: RadioCoupling | None, tuning_on: bool) -> Text:
     state = "ON" if tuning_on else "OFF"
     if radio is None:
         return Text(f"Radio: none configured (tuning {state}; Ctrl+D explains)", style="dim")
-    r = radio.last_result
+    r = radio.current_result()
     if not radio.tuner.available:
         return Text(f"Radio: Doppler tuning {state}, radio unreachable ({radio.tuner.last_error})", style="red")
+    if radio.without_channel():
+        return Text(f"Radio: Doppler tuning {state}, idle: no radio channel for this satellite", style="yellow")
     if r is not None:
         tx = f" TX {r.tx_hz / 1e6:.6f} MHz" if r.tx_hz else ""
         return Text(f"Radio: Doppler tuning {state}, RX {r.rx_hz / 1e6:.6f} MHz{tx}")

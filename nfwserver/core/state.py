@@ -112,6 +112,10 @@ class StationState:
     def radio_tuning(self) -> bool:
         return self._radio_tuning
 
+    @property
+    def dde_output(self) -> bool:
+        return self._dde_output
+
     def selected(self) -> Satellite | None:
         """The AutoTracking satellite's catalog record (None when none is selected or it is unknown)."""
         with self._lock:

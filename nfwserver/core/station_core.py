@@ -133,6 +133,7 @@ class StationCore:
         else:
             self.tracker.dde_output_off()
         if self.state.set_dde_output(on):
+            self.tracker.refresh_text()  # a request right after TUNE ON gets the string, not ""
             self._note(f"TUNE {'ON' if on else 'OFF'}", source)
 
     def set_track(self, on: bool, source: str = "console") -> str | None:

@@ -89,8 +89,9 @@ class Tracker:
         return self._last
 
     def current_text(self) -> str:
-        """What a request answers now: this tick's Nova string; "" before TUNE ON, after TUNE OFF,
-        after a change of satellite until the next tick, and while the computation fails."""
+        """What a request answers now: the latest Nova string (this tick's, or the one computed when the
+        satellite was changed or the output switched on since); "" before TUNE ON, after TUNE OFF, with
+        no satellite, and while the computation fails."""
         return self._text  # replaced whole under the lock; reading one attribute needs none
 
     def status_word(self) -> int:
@@ -105,9 +106,33 @@ class Tracker:
         nothing to reset: the next tick computes as every tick does."""
 
     def selection_changed(self) -> None:
-        """A new AutoTracking satellite: never serve the old one's string."""
+        """A new AutoTracking satellite: never serve the old one's string; the new one's is there at once."""
+        self.refresh_text()
+
+    def refresh_text(self) -> None:
+        """Compute the Nova string for the live state now (a command's thread, right after ``SAT=`` or
+        ``TUNE ON``), so a request that follows the command gets the new satellite's string rather than ""
+        or the old one's.  No tick: subscribers are not called, the status word and the sample stay the
+        tick's; a satellite that cannot be computed gives "" (its tick reports why)."""
+        snap = self.state.snapshot()
+        text = ""
+        calc = self._calculator_for(snap)
+        if snap.dde_output and snap.satellite is not None and calc is not None:
+            try:
+                angles = calc.compute(snap.satellite.satrec, self.clock.now())
+            except (PropagationError, ArithmeticError, ValueError):
+                angles = None
+            if angles is not None:
+                above = snap.horizon.is_above(angles.azimuth_deg, angles.elevation_deg)
+                text = format_nova(snap.satellite.dde_name, angles.azimuth_deg, angles.elevation_deg,
+                                   angles.range_rate_km_s, above)
         with self._lock:
-            self._text = ""
+            if self._still_current(snap):  # else a newer command refreshes after us
+                self._text = text
+
+    def _still_current(self, snap: StateSnapshot) -> bool:
+        """The string computed from ``snap`` is still the one to serve: the same satellite, the output the same."""
+        return self.state.catalog_number == snap.catalog_number and self.state.dde_output == snap.dde_output
 
     def why_not_computable(self, satellite: Satellite, when: datetime | None = None) -> str | None:
         """Why ``satellite`` cannot be computed at ``when`` (default now) for this station, or None if it can.
@@ -201,7 +226,8 @@ class Tracker:
         with self._lock:
             if self.state.generation == snap.generation:
                 self._computed_generation = snap.generation
-            self._text = text
+            if self._still_current(snap):  # else a command changed the satellite or the output meanwhile
+                self._text = text
             sample = TickSample(when, snap.catalog_number, sat.dde_name if sat else None, angles, above,
                                 snap.dde_output, snap.tracking, text, 0, snap.radio_tuning, self._error)
             sample = replace(sample, status=self._status(snap, sample))

@@ -16,6 +16,11 @@ may :meth:`LinkHealth.retry_now` (an operator action: a new satellite, ``TRACK O
 skip the wait once.  A link that is tried on its own schedule anyway (the tracker computes every tick)
 is made with ``paced=False``: it is never held back and its lines name no retry time.
 
+Log lines are limited per episode, not per link: the first failure of each episode (a fault after the link
+was well) and its recovery are written; only the repeats within an episode are rate-limited.  A fault that
+comes back less than :data:`FLAP_GAP_S` after the last one cleared belongs to the same episode in the log
+(a link flapping every tick writes a line a minute, not two a tick).
+
 Thread-safe: the state is read by ``STATUS`` and the console from other threads.
 """
 
@@ -29,9 +34,12 @@ from dataclasses import dataclass
 from nfwserver.clock import Clock
 from nfwserver.ratelimited_log import RateLimitedLog
 
-__all__ = ["Backoff", "Fault", "LinkHealth"]
+__all__ = ["FLAP_GAP_S", "Backoff", "Fault", "LinkHealth"]
 
 log = logging.getLogger(__name__)
+
+#: A link well for less than this (clock seconds) between two faults is flapping: one episode in the log.
+FLAP_GAP_S = 2.0
 
 
 @dataclass(frozen=True)
@@ -87,6 +95,7 @@ class LinkHealth:
         self._fault: Fault | None = None
         self.recoveries = 0  #: faults healed so far (for benchmarks and tests)
         self._announced = False  # the current fault's first failure was written to the log
+        self._recovered_at: float | None = None  # clock monotonic seconds the last fault cleared
 
     # -- reading ---------------------------------------------------------------------------
     @property
@@ -132,12 +141,14 @@ class LinkHealth:
                 retry_at = old.retry_at
             fault = Fault(reason, now if old is None else old.since, failures, retry_at)
             self._fault = fault
+        # A new episode (the link was well for a while) is written whatever the rate limit; repeats are not.
+        new_episode = old is None and (self._recovered_at is None or now - self._recovered_at >= FLAP_GAP_S)
         if self.paced:
             wait = fault.retry_at - now  # "0.2 s" for a short back-off, never "0 s"
             written = self._lines.log(level, self.name, "%s: %s; retrying in %s s", self.name, reason,
-                                      f"{round(wait, 1) if wait < 10 else round(wait):g}")
+                                      f"{round(wait, 1) if wait < 10 else round(wait):g}", force=new_episode)
         else:
-            written = self._lines.log(level, self.name, "%s: %s", self.name, reason)
+            written = self._lines.log(level, self.name, "%s: %s", self.name, reason, force=new_episode)
         if old is None:
             self._announced = written  # a link that flaps every tick writes a line a minute, not two a tick
         if old is None:
@@ -151,6 +162,7 @@ class LinkHealth:
             old, self._fault = self._fault, None
         if old is None:
             return
+        self._recovered_at = self.clock.monotonic()
         self.recoveries += 1
         if self._announced:
             count = f" ({old.failures} failure{'s' if old.failures != 1 else ''})" if old.failures else ""

@@ -42,6 +42,8 @@ class RadioCoupling(TickWorker):
             return None
         channel = self.state.channels.get(sample.catalog_number)
         if channel is None:
+            self.last_result = None  # another satellite's frequencies are not this one's
+            self._catalog_number = self._channel = None
             return None
         if sample.catalog_number != self._catalog_number or channel is not self._channel:
             # another satellite, or its channel was reconfigured (the knob offset starts again)
@@ -52,13 +54,25 @@ class RadioCoupling(TickWorker):
 
     def link_state(self) -> str:
         """The radio's state in one word, as STATUS, the console and the web page show it: ``unreachable``,
-        ``refusing`` (the radio refused the last command), ``failing`` (its daemon answers slowly or with
-        nonsense), else ``ok``."""
+        ``no-channel`` (Doppler tuning is on, but the selected satellite has no radio channel: nothing is
+        tuned), ``refusing`` (the radio refused the last command), ``failing`` (its daemon answers slowly
+        or with nonsense), else ``ok``.  Read from the live state, so it changes with ``SAT=`` at once."""
         if not self.tuner.available:
             return "unreachable"
+        if self.without_channel():
+            return "no-channel"
         if self.tuner.last_error is not None:
             return "refusing"
         return "ok" if daemon_link_ok(self.tuner.backend) else "failing"
+
+    def without_channel(self) -> bool:
+        """Doppler tuning is on and the selected satellite has no radio channel (so nothing is tuned)."""
+        number = self.state.catalog_number
+        return self.state.radio_tuning and number is not None and number not in self.state.channels
+
+    def current_result(self) -> TuneResult | None:
+        """The last tuning, unless the selected satellite has no channel (then its frequencies are stale)."""
+        return None if self.without_channel() else self.last_result
 
     def stop(self) -> None:
         super().stop()

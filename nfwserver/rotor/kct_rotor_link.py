@@ -11,6 +11,10 @@ for at most one stall timeout a minute).  The stall is that link's fault from th
 until the re-armed rotor accepts a command and moves toward its target (or is found already there).  A single refused
 move is the link's fault at once (not yet a stall: three in a row are), cleared the same way.
 
+When the backend cannot be reached (its daemon stopped or restarts), the target is sent again at the first
+reading after its return, whether or not it changed meanwhile: a restarted daemon has forgotten it.  A rotor
+that is neither where it was sent nor seen moving there is ``off-target`` in :meth:`KctRotorLink.link_state`.
+
 Angles are degrees; rotor-frame positions are what the backend takes and reports.
 """
 
@@ -57,6 +61,9 @@ class KctRotorLink:
         self._card_absent = False
         self._position: tuple[float, float] | None = None  # rotor frame, last read back
         self._alarmed = False  # the current stall was announced
+        #: the backend could not be reached since the target was last sent: its daemon may have restarted
+        #: and forgotten the target (a restarted dummy rotctld sits at 0/0), so it is sent again at once
+        self._resend = False
 
     @property
     def _axes(self) -> int:
@@ -69,8 +76,7 @@ class KctRotorLink:
             self._position = self.backend.get_position()
             self._card_absent = False
         except RotorUnavailable:
-            self._card_absent = True
-            self.stall.lost_sight()  # an outage is not a stall: the no-movement timers restart on return
+            self._lost()
             return None
         except RotorError as exc:
             self._diagnostics.warning("read", "rotor position read failed: %s", exc)
@@ -83,9 +89,16 @@ class KctRotorLink:
         if not self.health.ok and not any(self.stall.stalled) and self.stall.errors == 0 and self.stall.progressed:
             self.health.succeeded()  # re-armed, accepted, and moving (or already there): the stall is over
             self._alarmed = False
-        if self._sent is None and self._target is not None:
-            self._push(force=True)  # the rotor came back: send the target again
+        if (self._sent is None or self._resend) and self._target is not None:
+            self._resend = False
+            self._push(force=True)  # the rotor came back: send the target again, at once
         return self._position
+
+    def _lost(self) -> None:
+        """The backend cannot be reached: whatever it held may be gone when it returns."""
+        self._card_absent = True
+        self._resend = True
+        self.stall.lost_sight()  # an outage is not a stall: the no-movement timers restart on return
 
     def rotor_position(self) -> tuple[float, float] | None:
         """Last read-back position, rotor frame."""
@@ -134,18 +147,30 @@ class KctRotorLink:
     def link_state(self) -> str:
         """The rotor's state in one word, as STATUS, the console and the web page show it: ``unreachable`` (no
         position read back, or the backend cannot be reached), ``stalled``, ``retrying`` (moves refused),
-        ``failing`` (its daemon answers slowly or with nonsense), else ``ok``."""
+        ``failing`` (its daemon answers slowly or with nonsense), ``off-target`` (neither where it was sent
+        nor seen moving there for :attr:`StallWatch.idle_grace_s`, not yet a stall), else ``ok``."""
         if self.rotor_position() is None or not self.backend_reachable:
             return "unreachable"
         if self.stalled:
             return "stalled"
         if not self.health.ok:
             return "retrying"
-        return "ok" if daemon_link_ok(self.backend) else "failing"
+        if not daemon_link_ok(self.backend):
+            return "failing"
+        return "off-target" if self.off_target() else "ok"
+
+    def off_target(self) -> bool:
+        """An enabled rotor is neither where it was last sent nor moving there (see :meth:`link_state`)."""
+        if not self._enabled:
+            return False
+        return bool(self.stall.idle_axes(self.clock.monotonic(), self._sent, self._position, self._axes))
 
     def _stop_rotor(self) -> None:
         try:
             self.backend.stop()
+        except RotorUnavailable as exc:
+            log.warning("rotor stop failed: %s", exc)
+            self._lost()
         except RotorError as exc:
             log.warning("rotor stop failed: %s", exc)
 
@@ -180,7 +205,7 @@ class KctRotorLink:
         except RotorUnavailable as exc:
             if not self._card_absent:
                 log.warning("rotor unavailable: %s", exc)
-            self._card_absent = True
+            self._lost()
             self._sent = None
             return
         except RotorError as exc:

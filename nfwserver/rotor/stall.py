@@ -9,6 +9,11 @@ An axis is declared stalled when
 - the backend refused ``error_limit`` calls in a row (``RPRT -n`` from rotctld): then both axes,
   as the daemon does not say which one failed.
 
+Before a stall is declared, an axis off its target that has not made progress for ``idle_grace_s``
+(:meth:`StallWatch.idle_axes`) is neither where it was told nor moving there: the driver shows that as
+its own state (``off-target``), never as ``ok``.  Progress is watched even without a no-movement
+timeout (``timeout_s`` None), which then only declares no stalls.
+
 A stalled axis stays stalled until :meth:`StallWatch.reset` (the driver's Enable call) or
 :meth:`StallWatch.probe` (the driver trying again after its back-off, or at an operator's action).  A
 probe is on probation: one refusal declares the stall again at once (not three), and the watch notes
@@ -46,6 +51,8 @@ class StallWatch:
     tolerance_deg: float = 1.0  #: movement towards the target that counts as progress
     deadband_deg: float = 3.0  #: closer than this to the target, an axis needs no moving
     error_limit: int = 3
+    #: a rotor off its target without progress for this long is shown as such (before any stall)
+    idle_grace_s: float = 3.0
     stalled: list[bool] = field(default_factory=lambda: [False, False])  #: [azimuth, elevation]
     errors: int = 0  #: backend refusals in a row
     progressed: bool = False  #: since the last reset or probe, every axis moved toward its target or arrived
@@ -95,7 +102,7 @@ class StallWatch:
         Progress is movement of at least ``tolerance_deg`` towards the target since the last progress,
         so a rotor that lags behind a fast satellite but keeps turning is not declared stalled.
         """
-        if sent is None or self.timeout_s is None:
+        if sent is None:
             return []
         newly = []
         for i in range(axes):
@@ -111,10 +118,25 @@ class StallWatch:
             if abs(moved) >= self.tolerance_deg and (moved > 0) == (sent[i] > p.reference):
                 self._progress[i] = _Progress(position[i], now)
                 self._moved[i] = True
-            elif now - p.since >= self.timeout_s:
+            elif self.timeout_s is not None and now - p.since >= self.timeout_s:
                 newly.append(i)
         self.progressed = all(self._moved[:axes])
         return self._declare(newly)
+
+    def idle_axes(self, now: float, sent: tuple[float, float] | None, position: tuple[float, float] | None,
+                  axes: int) -> list[int]:
+        """The axes that are neither where they were sent (beyond ``deadband_deg``) nor seen moving there for
+        ``idle_grace_s`` seconds (``now`` as for :meth:`observe`, after it); none while nothing was sent or
+        nothing read back.  A stalled axis is one of these that the watch has also given up on."""
+        if sent is None or position is None:
+            return []
+        grace = self.idle_grace_s if self.timeout_s is None else min(self.idle_grace_s, self.timeout_s)
+        idle = []
+        for i in range(axes):
+            since = self._progress[i].since
+            if abs(sent[i] - position[i]) > self.deadband_deg and since is not None and now - since >= grace:
+                idle.append(i)
+        return idle
 
     def _declare(self, axes: Iterable[int]) -> list[int]:
         newly = [i for i in axes if not self.stalled[i]]

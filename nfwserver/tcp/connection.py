@@ -7,6 +7,7 @@ import os
 import selectors
 import socket
 from collections import deque
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -14,7 +15,11 @@ from nfwserver.config.schema import TcpConfig
 from nfwserver.health.link_health import LinkHealth
 from nfwserver.tcp.line_splitter import MAX_LINE_BYTES, LineSplitter
 
-__all__ = ["Connection", "ListenerRest", "TcpStats", "admission_refusal", "bind_listener", "peer_label"]
+__all__ = ["Connection", "ListenerRest", "TcpStats", "admission", "admission_refusal", "bind_listener",
+           "idle_victim", "peer_label"]
+
+#: A connection idle (no complete line) for at least this long (clock seconds) may be closed to make room.
+EVICT_AFTER_S = 1.0
 
 
 @dataclass
@@ -22,6 +27,7 @@ class TcpStats:
     accepted: int = 0
     refused: int = 0  #: peers not allowed, or over a connection cap
     idle_closed: int = 0  #: connections closed for completing no line within the idle timeout
+    evicted: int = 0  #: idle connections closed to make room for a new one under a cap
     dropped: int = 0  #: watching clients dropped for not reading
     lost: int = 0  #: published strings lost because the loop fell PUBLISHED_BACKLOG behind
     delivered: int = 0  #: published strings handed to the watchers
@@ -44,6 +50,30 @@ class Connection:
         self.closing = False  # QUIT: close once the output is sent
         self.eof = False  # the client shut its side: answer what it sent, then close (unless watching)
         self.closed = False
+
+
+def admission(config: TcpConfig, per_address: Mapping[str, int], clients: Iterable[Connection], max_clients: int,
+              address: str, now: float) -> tuple[tuple[str, str | None] | None, Connection | None]:
+    """(why a new connection from ``address`` is refused, or None; a connection to close first so it fits, or
+    None): over a cap, :func:`idle_victim` makes room when it finds one (see :func:`admission_refusal`)."""
+    key = TcpConfig.peer_key(address)
+    clients = list(clients)
+    refusal = admission_refusal(config, per_address.get(key, 0), len(clients), max_clients, address)
+    if refusal is None or refusal[1] is None:  # served, or not allowed at all
+        return refusal, None
+    victim = idle_victim(clients, key, per_address.get(key, 0) >= config.max_per_address, now)
+    return (refusal, None) if victim is None else (None, victim)
+
+
+def idle_victim(clients: Iterable[Connection], key: str, same_address: bool, now: float) -> Connection | None:
+    """The connection to close so that a new one from ``key`` fits under a cap, or None: the one idle longest,
+    for at least :data:`EVICT_AFTER_S`, never a ``WATCH`` subscriber; among ``key``'s own connections when the
+    cap reached is the per-address one (``same_address``).  So idle connections never lock out a client that
+    talks -- on the loopback default every local tool shares one address, the operator's ``status`` and
+    ``poke`` included -- while a client that keeps talking keeps its connection."""
+    idle = [c for c in clients if not c.watching and not c.closed and now - c.last_line >= EVICT_AFTER_S
+            and (not same_address or c.address == key)]
+    return min(idle, key=lambda c: c.last_line, default=None)
 
 
 def peer_label(address: tuple[Any, ...]) -> str:

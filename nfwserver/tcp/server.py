@@ -9,9 +9,9 @@ so many clients cost no thread each.  The loop waits in ``select`` until the nex
 - A peer whose address is not in ``[tcp] allow`` is closed at once, before the greeting, and
   logged (once a minute per address at most) and recorded in the event stream.  IPv4-mapped IPv6
   peers count as their IPv4 address everywhere (allow list, caps, rate limits).
-- Caps, so that one address never locks the others out: ``[tcp] max_per_address`` per address and
-  ``max_clients`` in all (the connection over a cap gets one ``ERROR`` line, then is closed); a
-  connection that completes no line for ``idle_timeout_s`` is closed (a ``WATCH`` subscriber never is).
+- Caps: ``[tcp] max_per_address`` per address, ``max_clients`` in all; a new connection over one closes the
+  one idle longest (1 s or more, never a ``WATCH``), else gets one ``ERROR`` line and is closed.  A connection
+  that completes no line for ``idle_timeout_s`` is closed (a ``WATCH`` subscriber never is).
 - Out of file descriptors (EMFILE and kin), the listener rests for a back-off (0.1 s doubling to 5 s)
   instead of spinning: the ``tcp-accept`` link shows it in STATUS until a spare descriptor is found.
 - Refused commands are logged once a minute per peer *address* (reconnecting does not reset it).
@@ -50,7 +50,7 @@ from nfwserver.tcp.connection import (
     Connection,
     ListenerRest,
     TcpStats,
-    admission_refusal,
+    admission,
     bind_listener,
     peer_label,
 )
@@ -241,8 +241,11 @@ class NovaTcpServer:
             self._rest.health.succeeded()
             peer = peer_label(address)
             key = TcpConfig.peer_key(address[0])
-            refusal = admission_refusal(self.config, self._per_address[key], len(self._clients),
-                                        self.max_clients, address[0])
+            refusal, victim = admission(self.config, self._per_address, self._clients, self.max_clients, address[0],
+                                        self.core.clock.monotonic())
+            if victim is not None:  # over a cap: the connection idle longest makes room (connection.admission)
+                self.stats.evicted += 1
+                self._close(victim, "idle, closed to make room for a new connection under the connection caps")
             if refusal is not None:
                 reason, line = refusal
                 if line is not None:

@@ -9,9 +9,8 @@ never again afterwards:
   ``C*``) and the line/paragraph separators (``Zl``, ``Zp``) becomes a blank: ESC sequences lose
   their ESC, a newline cannot split a line or a PREDICT reply;
 - runs of white space become one blank; leading and trailing blanks go;
-- the result is cut to :data:`MAX_NAME_LENGTH` characters, so the stored catalog's name line is
-  read back as a name (:func:`nfwserver.tracking.elements.load_elements` takes name lines up to
-  that length).
+- the result is cut to :data:`MAX_NAME_LENGTH` characters (:func:`nfwserver.tracking.elements.load_elements`
+  reads name lines up to twice that length, so a long name line still names its set, cut).
 """
 
 from __future__ import annotations

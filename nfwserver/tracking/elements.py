@@ -42,7 +42,8 @@ from nfwserver.tracking.element_set import (
 from nfwserver.tracking.tle import TleError, epoch_from_tle, parse_tle
 
 __all__ = ["MAX_CSV_ROW", "ElementSet", "LoadResult", "Rejection", "load_element_file", "load_elements"]
-_MAX_NAME = MAX_NAME_LENGTH
+#: Longest line read as a name line (characters); the name is then cut to MAX_NAME_LENGTH.
+_MAX_NAME = 2 * MAX_NAME_LENGTH
 
 
 def _clean_name(line: str) -> str:

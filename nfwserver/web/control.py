@@ -2,34 +2,32 @@
 
 A control request is a JSON object ``{"command": "TRACK ON", "token": "..."}`` posted to
 ``/api/command``.  It is refused (HTTP 403, one log line per address a minute, and an event in the
-station's stream) when ``[web] control`` is off, when the token is missing or wrong (compared in
-constant time), or when it is not one of the station's or the rotor's commands (``TUNE``, ``TRACK``,
-``SAT``, ``ANTAZ``/``ANTEL``, ``FLIP``, ``PARK``: the entries of :data:`nfwserver.commands.table.COMMANDS`
-that act on the station or the rotor).  An accepted station command goes to
-:meth:`~nfwserver.core.station_core.StationCore.command` as a TCP line would, a rotor command to
+station's stream) when ``[web] control`` is off or its token is weak (checked before the body is read),
+when the token is missing or wrong (:func:`~nfwserver.config.tokens.token_matches`, constant time), or
+when the line is not one of the commands the table lets the web face send (:attr:`Face.WEB`: ``TUNE``,
+``TRACK``, ``SAT``, ``ANTAZ``/``ANTEL``, ``FLIP``, ``PARK``).  The line is parsed by the command table
+(:func:`~nfwserver.commands.parsing.parse_line`, which also bounds its length); a station command goes
+to :meth:`~nfwserver.core.station_core.StationCore.command` as the web face's, a rotor command to
 :func:`~nfwserver.commands.rotor_commands.run_rotor_command` as TCP and the console run it, with the
-browser's address as the source; the reply is their answer.
+browser's address as the source; the reply is their answer.  The control switch and the token are read
+from :attr:`Control.config` at every request, so a changed ``[web]`` section applies at once.
 """
 
 from __future__ import annotations
 
-import hmac
 import logging
-import re
 from dataclasses import dataclass
 
-from nfwserver.commands.parsing import parse_line
+from nfwserver.commands.parsing import Parsed, parse_line
 from nfwserver.commands.rotor_commands import RotorControl, run_rotor_command
 from nfwserver.commands.table import Command, CommandError, Face, Target, commands_for, escape_for_log
 from nfwserver.config.schema import WebConfig
+from nfwserver.config.tokens import token_matches, weak_token_reason
 from nfwserver.core.events import Direction
 from nfwserver.core.station_core import StationCore
 from nfwserver.ratelimited_log import RateLimitedLog
 
 log = logging.getLogger(__name__)
-
-#: Longest command text taken from the page (the table refuses longer ones anyway).
-MAX_COMMAND_CHARS = 256
 
 
 @dataclass(frozen=True)
@@ -50,15 +48,13 @@ def help_entries() -> list[dict[str, str]]:
 
 
 def _page_commands() -> list[Command]:
-    """The commands the page may send: the station's and the rotor's (not the TCP session's)."""
-    return [c for c in commands_for(Face.TCP) if c.target in (Target.STATION, Target.ROTOR)]
+    """The commands the page may send: the station's and the rotor's, as the table gives them to the web."""
+    return list(commands_for(Face.WEB))
 
 
-def _entry(text: str) -> Command | None:
-    """The table entry ``text``'s keyword names, if any."""
-    match = re.match(r"\s*([A-Za-z]+)", text)
-    word = match.group(1).upper() if match else ""
-    return next((c for c in commands_for(Face.TCP) if c.word == word), None)
+def _open(config: WebConfig) -> bool:
+    """Whether ``config`` lets the page send commands: control on, with a token that is not weak."""
+    return bool(config.control and config.token and weak_token_reason(config.token) is None)
 
 
 class Control:
@@ -66,49 +62,59 @@ class Control:
 
     def __init__(self, core: StationCore, config: WebConfig, rotor: RotorControl | None = None) -> None:
         self.core = core
-        self.config = config
+        self.config = config  #: replaced whole when the configuration changes (read once per request)
         self.rotor = rotor  #: the rotor's command port (FLIP, PARK); None without a rotor
         self._refusals = RateLimitedLog(log, core.clock, 60.0)
 
     @property
     def enabled(self) -> bool:
-        return bool(self.config.control and self.config.token)
+        return _open(self.config)
 
-    def _refuse(self, peer: str, status: int, reason: str, text: str = "") -> ControlReply:
-        self._refusals.warning(f"{peer}:{reason}", "web control from %s refused: %s", peer, reason)
-        self.core.events.add(self.core.clock.now(), Direction.IN, "poke", escape_for_log(text), client=peer,
-                             accepted=False, detail=f"web control refused: {reason}")
+    def refuse(self, peer: str, status: int, reason: str, text: str = "") -> ControlReply:
+        """Refuse a request from ``peer``: one log line and one event per burst of the same reason."""
+        if self._refusals.warning(f"{peer}:{reason}", "web control from %s refused: %s", peer, reason):
+            self.core.events.add(self.core.clock.now(), Direction.IN, "poke", escape_for_log(text), client=peer,
+                                 accepted=False, detail=f"web control refused: {reason}")
         return ControlReply(status, False, reason)
+
+    def closed(self, peer: str) -> ControlReply | None:
+        """The refusal when control is off (checked before a request's body is read), else None."""
+        return None if self.enabled else self.refuse(peer, 403, "control is off ([web] control)")
 
     def run(self, request: object, peer: str) -> ControlReply:
         """Check and run one decoded JSON request from ``peer`` (``"web 192.0.2.1"``)."""
-        if not self.enabled:
-            return self._refuse(peer, 403, "control is off ([web] control)")
+        config = self.config  # one reading for the whole request
+        if not _open(config) or config.token is None:
+            return self.refuse(peer, 403, "control is off ([web] control)")
         if not isinstance(request, dict):
-            return self._refuse(peer, 400, "the request must be a JSON object with command and token")
+            return self.refuse(peer, 400, "the request must be a JSON object with command and token")
         token, text = request.get("token"), request.get("command")
-        if not isinstance(token, str) or not hmac.compare_digest(token.encode("utf-8", "replace"),
-                                                                 str(self.config.token).encode("utf-8")):
-            return self._refuse(peer, 403, "missing or wrong token", text if isinstance(text, str) else "")
-        if not isinstance(text, str) or not text.strip() or len(text) > MAX_COMMAND_CHARS \
-                or "\n" in text or "\r" in text:
-            return self._refuse(peer, 400, "command must be one line of at most 256 characters",
-                                text if isinstance(text, str) else "")
-        entry = _entry(text)
-        if entry is None or entry.target not in (Target.STATION, Target.ROTOR):
-            usages = ", ".join(c.short for c in _page_commands())
-            return self._refuse(peer, 400, f"not a station command ({usages})", text)
-        if entry.target is Target.ROTOR:
-            return self._rotor(text, peer)
-        result = self.core.command(text, source=peer, face=Face.TCP)
+        shown = text if isinstance(text, str) else ""
+        if not isinstance(token, str) or not token_matches(token, config.token):
+            return self.refuse(peer, 403, "missing or wrong token", shown)
+        if not isinstance(text, str) or "\n" in text or "\r" in text:
+            return self.refuse(peer, 400, "command must be one line", shown)
+        try:
+            parsed = parse_line(text, Face.WEB)
+        except CommandError as exc:
+            if exc.command is None and not exc.bad_argument:
+                usages = ", ".join(c.short for c in _page_commands())
+                return self.refuse(peer, 400, f"not a station command ({usages}): {exc}", text)
+            if exc.command is not None and exc.command.target is Target.ROTOR:
+                return self.refuse(peer, 409, str(exc), text)
+            return self._refused_by_station(text, peer, str(exc))
+        if parsed.command.target is Target.ROTOR:
+            return self._rotor(parsed, text, peer)
+        result = self.core.command(text, source=peer, face=Face.WEB)
         return ControlReply(200 if result.accepted else 409, result.accepted, result.note or "OK")
 
-    def _rotor(self, text: str, peer: str) -> ControlReply:
-        """``FLIP``/``PARK``: parsed by the table and run as every face runs them."""
-        try:
-            parsed = parse_line(text, Face.TCP)
-        except CommandError as exc:
-            return self._refuse(peer, 409, str(exc), text)
+    def _refused_by_station(self, text: str, peer: str, why: str) -> ControlReply:
+        """A command the table knows but refuses as written (``SAT=abc``): the station's answer, 409."""
+        result = self.core.command(text, source=peer, face=Face.WEB)  # logs and records it like any face
+        return ControlReply(409, False, result.note or why)
+
+    def _rotor(self, parsed: Parsed, text: str, peer: str) -> ControlReply:
+        """``FLIP``/``PARK``: run as every face runs them."""
         why = run_rotor_command(parsed, self.rotor, self.core, peer)
         self.core.events.add(self.core.clock.now(), Direction.IN, "poke", escape_for_log(text), client=peer,
                              accepted=why is None, detail=why or "")

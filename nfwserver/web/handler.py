@@ -12,20 +12,28 @@
 
 Every response carries a Content-Security-Policy allowing only the station's own scripts and styles,
 so nothing from a satellite or client name can run as script even if it reached the HTML (the page
-only ever sets ``textContent``).  Request bodies are limited to :data:`MAX_BODY_BYTES`.
+only ever sets ``textContent``).  The request head is read whole within a deadline and a size cap
+(:mod:`~nfwserver.web.request_head`), a request for another host name is refused (421) and a command
+must come as JSON from the station's own page (:mod:`~nfwserver.web.guard`); request bodies are
+limited to :data:`MAX_BODY_BYTES` and read only once control is known to be on.  Nothing a peer does
+makes a traceback: a failed connection is one log line (rate-limited) by :meth:`WebServer.connection_failed`.
 """
 
 from __future__ import annotations
 
+import io
 import json
 import logging
 import re
 import socket
+import time
 from http.server import BaseHTTPRequestHandler
 from importlib import resources
 from typing import Any
 
 from nfwserver.web.control import help_entries
+from nfwserver.web.guard import cross_site_reason, host_refusal
+from nfwserver.web.request_head import HeadReader, error_response, linger_close, read_head
 
 log = logging.getLogger(__name__)
 
@@ -39,7 +47,7 @@ SECURITY_HEADERS = (
     ("Content-Security-Policy", "default-src 'self'; img-src 'self' data:; style-src 'self'; script-src 'self'; "
                                 "connect-src 'self'; frame-ancestors 'none'; base-uri 'none'; form-action 'none'"),
     ("X-Content-Type-Options", "nosniff"),
-    ("Referrer-Policy", "no-referrer"),
+    ("Referrer-Policy", "same-origin"),  # the page's own requests carry their Origin; others learn nothing
 )
 
 
@@ -63,6 +71,43 @@ class WebHandler(BaseHTTPRequestHandler):
         super().setup()
         if web.send_buffer_bytes:
             self.connection.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, web.send_buffer_bytes)
+
+    def handle(self) -> None:
+        """One request (HTTP/1.0); whatever the peer does to the connection ends it with one log line at most."""
+        try:
+            self.handle_one_request()
+        except Exception as exc:  # noqa: BLE001 - a peer's reset, a write timeout: never a traceback
+            self.web.connection_failed(self.client_address[0], exc)
+
+    def handle_one_request(self) -> None:
+        web = self.web
+        deadline = time.monotonic() + web.head_deadline_s
+        head = read_head(self.connection, deadline, io_timeout_s=web.io_timeout_s)
+        if head.silent:
+            self.close_connection = True
+            return
+        if head.status:
+            self.close_connection = True
+            self.requestline, self.command = head.data.split(b"\n", 1)[0].decode("latin-1").strip()[:200], ""
+            web.request_refused(self.client_address[0], head.status, head.message)
+            self.connection.settimeout(web.io_timeout_s)
+            self.connection.sendall(error_response(head.status, head.message, headers=SECURITY_HEADERS))
+            linger_close(self.connection)
+            return
+        self.rfile = io.BufferedReader(HeadReader(head.data, self.connection, deadline, web.io_timeout_s))
+        self.connection.settimeout(web.io_timeout_s)
+        super().handle_one_request()
+
+    def parse_request(self) -> bool:
+        if not super().parse_request():
+            return False
+        why = host_refusal(self.headers.get("Host"), self.web.config, str(self.connection.getsockname()[0]))
+        if why is not None:
+            self.web.request_refused(self.client_address[0], 421, why)
+            self.close_connection = True
+            self._json(421, {"ok": False, "error": why})
+            return False
+        return True
 
     @property
     def web(self) -> Any:
@@ -120,11 +165,21 @@ class WebHandler(BaseHTTPRequestHandler):
             self._json(404, {"error": "not found"})
 
     def do_HEAD(self) -> None:  # noqa: N802
+        if self.path.split("?", 1)[0] == "/api/stream":
+            self._stream_headers()  # the headers a stream would start with, and no body
+            return
         self.do_GET()
 
     def do_POST(self) -> None:  # noqa: N802
         if self.path.split("?", 1)[0] != "/api/command":
             self._json(404, {"error": "not found"})
+            return
+        control = self.web.control
+        why = cross_site_reason(self.headers, self.headers.get("Host", ""))
+        early = control.refuse(self.peer, 403, why) if why is not None else control.closed(self.peer)
+        if early is not None:  # refused before a byte of the body is read or parsed
+            self.close_connection = True
+            self._json(early.status, early.as_json())
             return
         try:
             length = int(self.headers.get("Content-Length", "-1"))
@@ -135,23 +190,33 @@ class WebHandler(BaseHTTPRequestHandler):
             return
         try:
             request = json.loads(self.rfile.read(length).decode("utf-8"))
-        except (UnicodeDecodeError, json.JSONDecodeError):
+        except (UnicodeDecodeError, ValueError):
             request = None
-        reply = self.web.control.run(request, self.peer)
+        except RecursionError:  # "[[[[..." deeper than the interpreter's stack
+            reply = control.refuse(self.peer, 400, "the body is nested too deeply to be a command")
+            self._json(reply.status, reply.as_json())
+            return
+        reply = control.run(request, self.peer)
         self._json(reply.status, reply.as_json())
 
     # -- the event stream ----------------------------------------------------------------------------
-    def _stream(self) -> None:
+    def _stream_headers(self) -> None:
         self.send_response(200)
         self.send_header("Content-Type", "text/event-stream; charset=utf-8")
         self.send_header("Cache-Control", "no-store")
         for name, value in SECURITY_HEADERS:
             self.send_header(name, value)
         self.end_headers()
+
+    def _stream(self) -> None:
         web = self.web
-        web.stream_opened(self.peer)
+        refusal = web.stream_opened(self.peer)
+        if refusal is not None:
+            self._json(503, {"ok": False, "error": refusal})
+            return
         reason, dropped = "closed by the browser", False
         try:
+            self._stream_headers()
             history = json.dumps(web.history(), default=str).encode()
             self.wfile.write(b"event: history\ndata: " + history + b"\n\n")
             seen, frame = web.hub.newest()

@@ -6,21 +6,30 @@ What it computes, for the instant of the computation (``docs/WEB.md`` gives the 
   are not over: AOS/TCA/LOS (UTC), maximum elevation (degrees), duration (s) and, when the rotor can
   flip, whether the rotor's planner would fly the pass flipped;
 - the selected satellite's current or next pass as a sky track (azimuth/elevation in degrees, every
-  :data:`TRACK_STEP_S` s) with its AOS/TCA/LOS points, for the polar plot;
+  :data:`TRACK_STEP_S` s, or coarser so that a pass of any length, AO-10's 11 hours say, is drawn whole in
+  at most :data:`MAX_TRACK_POINTS` points ending at LOS) with its AOS/TCA/LOS points, for the polar plot;
+  a satellite that is up now and never sets (geostationary) gets ``always_up`` and its one point;
 - the selected satellite's ground track (geodetic latitude, east longitude in degrees) from
   :data:`GROUND_BEFORE_S` before to :data:`GROUND_AFTER_S` after the instant, for the map;
 - the horizon table as azimuth/elevation points every 5 degrees (the polar plot's mask).
 
 It recomputes when the live state changes (its generation), when the first listed pass is over, and
 at least every :data:`REFRESH_S` seconds of the station's clock.  Readers get the newest result whole
-(:meth:`PassBoard.result`); the frame carries its ``version`` so a page fetches ``/api/passes`` again
-only when it changed.
+(:meth:`PassBoard.result`): its version, the result and its encoding are published as one reference, so
+a frame never carries a version whose result is not yet served.  The frame carries ``version`` so a page
+fetches ``/api/passes`` again only when it changed.
+
+A computation that fails is retried after :data:`RETRY_FIRST_S`, doubling up to :data:`REFRESH_S`
+(station clock), whatever else would make it due; the failure is logged once per episode (the
+traceback at DEBUG), shown on the page (``error`` in the result) until a computation succeeds, and the
+first success after it is logged.
 """
 
 from __future__ import annotations
 
 import json
 import logging
+import math
 import threading
 from collections.abc import Callable, Sequence
 from datetime import datetime, timedelta
@@ -45,22 +54,25 @@ log = logging.getLogger(__name__)
 LIST_HOURS = 12.0
 NEXT_PASS_HOURS = 24.0
 TRACK_STEP_S = 10.0
+MAX_TRACK_POINTS = 721  #: a longer pass is sampled more coarsely, never cut
 GROUND_BEFORE_S = 45 * 60.0
 GROUND_AFTER_S = 95 * 60.0
 GROUND_STEP_S = 60.0
 REFRESH_S = 120.0
+RETRY_FIRST_S = 5.0  #: first retry after a failed computation (station clock seconds), then doubling
 MAX_PASSES = 12
 
 
 def _track(calc: LookAngleCalculator, satrec: Satrec, p: Pass, now: datetime) -> list[tuple[float, float]]:
-    start = p.aos or now
-    end = p.los or (start + timedelta(minutes=20))
+    """The pass from AOS to LOS (both included) in at most :data:`MAX_TRACK_POINTS` points."""
+    start = p.aos or min(now, p.tca)
+    end = p.los or (max(now, p.tca) + timedelta(hours=NEXT_PASS_HOURS))  # a set beyond the search: a day on
+    span = max(0.0, (end - start).total_seconds())
+    steps = max(1, min(MAX_TRACK_POINTS - 1, math.ceil(span / TRACK_STEP_S)))
     out: list[tuple[float, float]] = []
-    t = start
-    while t <= end and len(out) < 2000:
-        la = calc.compute(satrec, t)
+    for i in range(steps + 1):
+        la = calc.compute(satrec, start + timedelta(seconds=span * i / steps))
         out.append((round(la.azimuth_deg, 2), round(la.elevation_deg, 2)))
-        t += timedelta(seconds=TRACK_STEP_S)
     return out
 
 
@@ -80,10 +92,13 @@ class PassBoard:
         self.clock = clock
         self.favourites = favourites
         self.rotor = rotor
-        self.version = 0
-        self._result: dict[str, object] = {"version": 0, "computed_at": None, "passes": [], "left_out": [],
-                                           "track": None, "ground_track": [], "horizon": []}
-        self._encoded = json.dumps(self._result).encode()
+        empty: dict[str, object] = {"version": 0, "computed_at": None, "passes": [], "left_out": [],
+                                    "track": None, "ground_track": [], "horizon": [], "error": None}
+        #: (version, result, its JSON): replaced whole, so readers on other threads see one of them
+        self._published: tuple[int, dict[str, object], bytes] = (0, empty, json.dumps(empty).encode())
+        self._error: str | None = None  #: the failing computation's error while an episode lasts
+        self._retry_s = 0.0  #: the current back-off after a failure (0: none)
+        self._retry_at = -1e18  #: monotonic clock seconds before which a failed computation is not retried
         self._wake = threading.Event()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -91,15 +106,19 @@ class PassBoard:
         self._done_at = -1e18
         self._first_los: datetime | None = None
 
+    @property
+    def version(self) -> int:
+        return self._published[0]
+
     def result(self) -> dict[str, object]:
-        return self._result
+        return self._published[1]
 
     def encoded(self) -> bytes:
-        return self._encoded
+        return self._published[2]
 
     def next_event(self, now: datetime) -> dict[str, object] | None:
         """AOS or LOS of the selected satellite's pass, with the seconds until it (negative: past)."""
-        track = self._result.get("track")
+        track = self.result().get("track")
         if not isinstance(track, dict):
             return None
         for kind in ("aos", "los"):
@@ -131,21 +150,41 @@ class PassBoard:
 
     def _due(self) -> bool:
         now = self.clock.now()
+        if self._error is not None and self.clock.monotonic() < self._retry_at:
+            return False  # backing off after a failure, whatever else changed
         return (self.state.generation != self._done_generation
                 or self.clock.monotonic() - self._done_at >= REFRESH_S
-                or (self._first_los is not None and now >= self._first_los))
+                or (self._first_los is not None and now >= self._first_los)
+                or self._error is not None)
 
     def _run(self) -> None:
         while not self._stop.is_set():
-            if self._due():
-                try:
-                    self.compute()
-                except Exception:  # keep the board alive; the page shows the last result
-                    log.exception("web: pass computation failed")
-                    self._done_at = self.clock.monotonic()
-                    self._done_generation = self.state.generation
+            self.step()
             self.clock.wait(self._wake, 1.0)
             self._wake.clear()
+
+    def step(self) -> bool:
+        """Compute if it is due (the board thread's one round); True when a computation was tried."""
+        if not self._due():
+            return False
+        try:
+            self.compute()
+        except Exception as exc:  # keep the board alive; the page shows the failure and the last result
+            self._failed(exc)
+        return True
+
+    def _failed(self, exc: Exception) -> None:
+        """One failed computation: back off, show it, and log it once for the episode."""
+        error = f"the pass search failed: {type(exc).__name__}: {exc}"[:300]
+        if self._error is None:
+            log.warning("web: %s (retrying with back-off; the page shows it)", error)
+            log.debug("web: pass search failure", exc_info=exc)
+        self._error = error
+        self._retry_s = min(REFRESH_S, self._retry_s * 2 if self._retry_s else RETRY_FIRST_S)
+        self._retry_at = self.clock.monotonic() + self._retry_s
+        version, result, _ = self._published
+        shown = {**result, "version": version + 1, "error": error}
+        self._published = (version + 1, shown, json.dumps(shown).encode())
 
     # -- the work ------------------------------------------------------------------------------------
     def compute(self) -> dict[str, object]:
@@ -177,11 +216,13 @@ class PassBoard:
             if selected is not None:
                 result["track"] = self._selected_track(selected, found, observer, snap, calc, now)
                 result["ground_track"] = self._ground_track(selected.satrec, now, snap.ut1_utc_s)
-        self.version += 1
-        result["version"] = self.version
-        self._result = result
-        self._encoded = json.dumps(result).encode()
+        version = self.version + 1
+        result["version"], result["error"] = version, None
+        self._published = (version, result, json.dumps(result).encode())  # one step: version and result
         self._done_generation, self._done_at = generation, self.clock.monotonic()
+        if self._error is not None:
+            log.info("web: the pass search works again")
+            self._error, self._retry_s = None, 0.0
         return result
 
     def _flipped(self, track: list[tuple[float, float]]) -> bool | None:
@@ -213,7 +254,7 @@ class PassBoard:
                                           horizon=snap.horizon, ut1_utc=snap.ut1_utc_s)
                    if p.los is None or p.los > now]
         if not own:
-            return None
+            return self._always_up(sat, snap, calc, now)
         p = own[0]
         try:
             points = _track(calc, sat.satrec, p, now)
@@ -223,6 +264,21 @@ class PassBoard:
                     "flipped": self._flipped(points)}
         except PropagationError:
             return None
+
+    @staticmethod
+    def _always_up(sat: Satellite, snap: StateSnapshot, calc: LookAngleCalculator,
+                   now: datetime) -> dict[str, object] | None:
+        """No pass in the next day: a satellite above the horizon now is up all that time (a point); else None."""
+        try:
+            la = calc.compute(sat.satrec, now)
+        except PropagationError:
+            return None
+        if la.elevation_deg < snap.horizon.min_elevation(la.azimuth_deg):
+            return None
+        point = (round(la.azimuth_deg, 2), round(la.elevation_deg, 2))
+        return {"catalog_number": sat.catalog_number, "points": [point], "always_up": True,
+                "aos": None, "tca": {"time": iso(now), "az": point[0], "el": point[1]}, "los": None,
+                "max_el": point[1], "flipped": None}
 
     @staticmethod
     def _ground_track(satrec: Satrec, now: datetime, ut1_utc: float) -> list[list[float]]:

@@ -4,9 +4,13 @@ Threads and what they do:
 
 - the publisher thread only runs :meth:`WebServer.on_tick`: it keeps a reference to the newest sample
   and sets an event, at a cost that does not depend on the number of browsers;
-- ``nfw-web`` (the frame thread) wakes on that event, builds one frame (JSON) from the live state
+- ``nfw-web`` (the frame thread) wakes on that event and, while at least one page is connected (an
+  event stream is open), builds one frame (JSON) from the live state
   (:mod:`~nfwserver.web.state_view`, :mod:`~nfwserver.web.station_parts`) at most
-  :data:`MAX_FRAME_HZ` times a second, and puts it in the :class:`~nfwserver.web.hub.FrameHub`;
+  :data:`MAX_FRAME_HZ` times a second, and puts it in the :class:`~nfwserver.web.hub.FrameHub`; with no
+  page connected it builds none (``/api/state`` then builds its own).  A frame that fails to build is
+  logged once a minute and replaced in the hub by ``{"frame_error": ...}``, so no page shows itself live
+  on a frame that no longer changes;
 - ``nfw-web-http`` accepts connections (Python's :class:`http.server.ThreadingHTTPServer`); each
   connection has a thread of its own, at most ``max_clients`` at once (others are closed at once);
   an event-stream connection sends the hub's newest frame whenever there is one (Server-Sent Events);
@@ -14,9 +18,14 @@ Threads and what they do:
 
 Bounds: every socket has a timeout (``io_timeout_s``): a browser that stops reading blocks only its
 own thread, for at most that long, and is then dropped (``stats.dropped``); there is no queue, so it
-never costs memory beyond its socket buffer, and no tick ever waits for it.  Peers outside
-``[web] allow`` are closed before a byte is read, logged once a minute per address and recorded in the
-event stream.
+never costs memory beyond its socket buffer, and no tick ever waits for it.  A request head must arrive
+whole within ``head_deadline_s`` and :data:`~nfwserver.web.request_head.MAX_HEAD_BYTES`
+(:mod:`~nfwserver.web.request_head`).  At most ``max_clients`` connections at once, at most
+``max_per_address`` from one address, and at most ``max_streams`` event streams: a connection over a
+cap is answered 503 naming the cap (without reading it) and closed.  Peers outside ``[web] allow`` are
+closed before a byte is read.  Each kind of refusal is logged, and recorded in the event stream, once
+per burst (a line a minute per address and kind, with the count of the others), so a flood never
+pushes the operator's history off the page.
 """
 
 from __future__ import annotations
@@ -24,6 +33,7 @@ from __future__ import annotations
 import json
 import logging
 import socket
+import sys
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -45,6 +55,7 @@ from nfwserver.web.control import Control
 from nfwserver.web.handler import WebHandler
 from nfwserver.web.hub import FrameHub
 from nfwserver.web.pass_board import PassBoard
+from nfwserver.web.request_head import HEAD_DEADLINE_S, error_response
 from nfwserver.web.state_view import now_tracking
 from nfwserver.web.station_parts import (
     EventFollower,
@@ -58,7 +69,9 @@ from nfwserver.web.station_parts import (
 log = logging.getLogger(__name__)
 
 MAX_FRAME_HZ = 10.0  #: frames built per second at most, whatever the feed's rate
-MAX_CLIENTS = 64  #: connections served at once (each event stream holds one)
+MAX_CLIENTS = 128  #: connections served at once (each event stream holds one)
+MAX_PER_ADDRESS = 16  #: connections served at once from one address
+MAX_STREAMS = 64  #: event streams at once (the other connections stay free for requests)
 IO_TIMEOUT_S = 10.0  #: a read or write that waits longer drops the connection
 HISTORY_EVENTS = 200  #: log lines a new page receives first
 
@@ -95,13 +108,17 @@ class _HttpServer(ThreadingHTTPServer):
         super().__init__(address, WebHandler)
 
     def verify_request(self, request: Any, client_address: Any) -> bool:
-        return self.web._admit(client_address)
+        return self.web._admit(request, client_address)
 
     def process_request_thread(self, request: Any, client_address: Any) -> None:
         try:
             super().process_request_thread(request, client_address)
         finally:
-            self.web._release()
+            self.web._release(client_address)
+
+    def handle_error(self, request: Any, client_address: Any) -> None:
+        """Whatever escaped a connection's handler: one rate-limited line, never a traceback on stderr."""
+        self.web.connection_failed(str(client_address[0]), sys.exc_info()[1])
 
 
 class WebServer:
@@ -109,11 +126,15 @@ class WebServer:
 
     def __init__(self, core: StationCore, config: WebConfig, parts: StationParts | None = None, *,
                  max_clients: int = MAX_CLIENTS, io_timeout_s: float = IO_TIMEOUT_S,
-                 send_buffer_bytes: int | None = None) -> None:
+                 send_buffer_bytes: int | None = None, max_per_address: int = MAX_PER_ADDRESS,
+                 max_streams: int = MAX_STREAMS, head_deadline_s: float = HEAD_DEADLINE_S) -> None:
         self.core = core
         self.config = config
         self.parts = parts or StationParts()
         self.max_clients = max_clients
+        self.max_per_address = max_per_address
+        self.max_streams = max_streams
+        self.head_deadline_s = head_deadline_s  #: real seconds a request head may take to arrive
         self.io_timeout_s = io_timeout_s
         self.send_buffer_bytes = send_buffer_bytes
         self.stats = WebStats()
@@ -128,10 +149,13 @@ class WebServer:
         self._stop = threading.Event()
         self._lock = threading.Lock()
         self._active = 0
+        self._per_address: dict[str, int] = {}
         self._httpd: _HttpServer | None = None
         self._threads: list[threading.Thread] = []
         self._unsubscribe: Callable[[], None] | None = None
         self._refusals = RateLimitedLog(log, core.clock, 60.0)
+        self._frame_log = RateLimitedLog(log, core.clock, 60.0)
+        self._build_lock = threading.Lock()
 
     @property
     def url(self) -> str:
@@ -155,7 +179,6 @@ class WebServer:
         self.hub.reopen()
         self._unsubscribe = self.core.subscribe(self.on_tick)
         self.board.start()
-        self._build_frame()
         self._threads = [threading.Thread(target=self._frames, name="nfw-web", daemon=True),
                          threading.Thread(target=self._httpd.serve_forever, kwargs={"poll_interval": 0.25},
                                           name="nfw-web-http", daemon=True)]
@@ -203,13 +226,28 @@ class WebServer:
                 if early > 1e-6:
                     clock.wait(self._stop, early)
             self._ticked.clear()
-            try:
-                framed = self._build_frame()
-            except Exception:  # the page shows the last frame; the station carries on
-                log.exception("web: building a frame failed")
+            if self.stats.streams == 0:
+                continue  # nobody to send it to: build nothing (a page that connects gets one at once)
+            framed = self._safe_frame() or framed
+
+    def _safe_frame(self) -> datetime | None:
+        """:meth:`_build_frame`; a failure is logged (rate-limited) and put in the hub as a frame error."""
+        try:
+            framed = self._build_frame()
+        except Exception as exc:  # the station carries on; the pages say they are not updated
+            error = f"{type(exc).__name__}: {exc}"[:300]
+            self._frame_log.log(logging.ERROR, "frame", "web: building a frame failed: %s", error, exc_info=True)
+            self.hub.publish(json.dumps({"frame_error": f"the station's page is not updating: {error}"}).encode())
+            return None
+        self._frame_log.clear("frame")
+        return framed
 
     def _build_frame(self) -> datetime | None:
         """Build and publish a frame of the newest sample; returns that sample's instant (None without one)."""
+        with self._build_lock:
+            return self._build_frame_locked()
+
+    def _build_frame_locked(self) -> datetime | None:
         now = self.core.clock.now()
         sample = self._sample or self.core.tracker.last_sample
         events, skipped = self._follower.new_events()
@@ -242,6 +280,8 @@ class WebServer:
     # -- what the handler reads ------------------------------------------------------------------
     def state_json(self) -> bytes:
         """``/api/state``: the newest frame, with the last :data:`HISTORY_EVENTS` log lines."""
+        if self.stats.streams == 0:  # no frame thread at work: this request's own, from the live state
+            self._safe_frame()
         frame = dict(self._latest)
         frame["log"] = self.history()
         return json.dumps(frame, allow_nan=False, default=str).encode()
@@ -250,32 +290,85 @@ class WebServer:
         return [event_json(e) for e in self.core.events.recent(HISTORY_EVENTS)]
 
     # -- connections (nfw-web-http and connection threads) ---------------------------------------
-    def _admit(self, client_address: Any) -> bool:
+    def configure(self, config: WebConfig) -> None:
+        """Take a changed ``[web]`` section while running: control, token and host names apply to the
+        next request (an old token stops working at once); host, port and allow need a restart."""
+        self.config = config
+        self.control.config = config
+
+    def _admit(self, request: Any, client_address: Any) -> bool:
         host = str(client_address[0])
         reason = None
         if not self.config.allows(host):
             reason = "not in [web] allow"
         with self._lock:
             if reason is None and self._active >= self.max_clients:
-                reason = f"already {self.max_clients} connections"
+                reason = f"already {self.max_clients} connections (the web server's cap)"
+            if reason is None and self._per_address.get(host, 0) >= self.max_per_address:
+                reason = f"already {self.max_per_address} connections from {host} (the cap per address)"
             if reason is None:
                 self._active += 1
+                self._per_address[host] = self._per_address.get(host, 0) + 1
                 self.stats.accepted += 1
                 return True
             self.stats.refused += 1
-        self._refusals.warning(host, "web connection from %s refused: %s", host, reason)
-        self.core.events.add(self.core.clock.now(), Direction.INFO, "note", f"connection refused: {reason}",
-                             client=f"web {host}", accepted=False)
+        if reason != "not in [web] allow":  # a peer that is let in hears why it is turned away
+            try:
+                request.setblocking(False)
+                request.send(error_response(503, f"connection refused: {reason}"))
+            except OSError:
+                pass
+        self._note_refusal(host, "connection", f"web connection from {host} refused: {reason}",
+                           f"connection refused: {reason}")
         return False
 
-    def _release(self) -> None:
+    def _release(self, client_address: Any) -> None:
+        host = str(client_address[0])
         with self._lock:
             self._active -= 1
+            left = self._per_address.get(host, 1) - 1
+            if left > 0:
+                self._per_address[host] = left
+            else:
+                self._per_address.pop(host, None)
 
-    def stream_opened(self, peer: str) -> None:
+    def _note_refusal(self, host: str, kind: str, line: str, event: str) -> None:
+        """One log line and one event per burst of refusals of ``kind`` from ``host``."""
+        if self._refusals.warning(f"{host}:{kind}", "%s", line):
+            self.core.events.add(self.core.clock.now(), Direction.INFO, "note", event, client=f"web {host}",
+                                 accepted=False)
+
+    def request_refused(self, host: str, status: int, why: str) -> None:
+        """A request answered ``status`` before its route (head too slow or too large, wrong Host, ...)."""
         with self._lock:
-            self.stats.streams += 1
+            self.stats.refused += 1
+        self._note_refusal(host, f"http {status}", f"web request from {host} refused ({status}): {why}",
+                           f"request refused ({status}): {why}")
+
+    def connection_failed(self, host: str, exc: BaseException | None) -> None:
+        """A connection that ended in an error of the peer's making (reset, timeout): one line per burst."""
+        what = f"{type(exc).__name__}: {exc}" if exc is not None else "unknown error"
+        self._refusals.log(logging.INFO, f"{host}:failed", "web connection from %s ended: %s", host, what[:200])
+
+    def stream_opened(self, peer: str) -> str | None:
+        """Count an event stream in; or why not (over :attr:`max_streams`)."""
+        first = False
+        with self._lock:
+            if self.stats.streams >= self.max_streams:
+                self.stats.refused += 1
+                reason = f"already {self.max_streams} event streams (the web server's cap)"
+            else:
+                self.stats.streams += 1
+                first, reason = self.stats.streams == 1, None
+        if reason is None and first:
+            self._safe_frame()  # frames were not built while no page was connected: a fresh one now
+        if reason is not None:
+            host = peer.removeprefix("web ")
+            self._note_refusal(host, "stream", f"web event stream for {host} refused: {reason}",
+                               f"event stream refused: {reason}")
+            return reason
         log.info("web page %s connected", peer)
+        return None
 
     def stream_closed(self, peer: str, reason: str, dropped: bool) -> None:
         with self._lock:

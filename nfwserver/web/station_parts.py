@@ -5,7 +5,8 @@ console and ``STATUS`` do); no device is ever asked from here.  Rotor angles are
 rotor's own frame (``*_rotor``: KCT, elevation above 90 when flipped) and in the sky (``az``/``el``, for
 the polar plot).  Clients and the log come from the station's event stream
 (:class:`~nfwserver.core.events.EventLog`): :class:`EventFollower` reads the events added since the last
-frame and keeps the last state of each client (bounded), so a page sees every string once.
+frame and keeps the last state of each connected client (bounded; a client that disconnects leaves the
+list, its lines stay in the log), so a page sees every string once.
 """
 
 from __future__ import annotations
@@ -59,7 +60,7 @@ def rotor_part(rotor: RotorCoupling | None) -> dict[str, object] | None:
 def radio_part(radio: RadioCoupling | None, tuning_on: bool) -> dict[str, object] | None:
     if radio is None:
         return None
-    result = radio.last_result
+    result = radio.current_result()  # none while the satellite has no channel: no other satellite's frequency
     state = radio.link_state()
     return {"state": state, "tuning": tuning_on, "error": None if state == "ok" else str(radio.tuner.last_error or ""),
             "rx_hz": result.rx_hz if result is not None else None,
@@ -116,11 +117,11 @@ class EventFollower:
         if not event.client or event.kind == "note" and event.client in ("config", "health", "startup"):
             return
         record = self.clients.pop(event.client, None)
+        if event.kind == "disconnect":
+            return  # a finished connection (every `nfwserver poke` is one) leaves the list; the log keeps it
         if record is None:
             record = ClientRecord(event.client, True, "", "", None, None)
-        if event.kind == "disconnect":
-            record.connected = False
-        elif event.kind == "connect":
+        if event.kind == "connect":
             record.connected = True
         if event.kind != "connect" and event.kind != "disconnect" or not record.last_kind:
             record.last_kind, record.last_text = event.kind, event.text

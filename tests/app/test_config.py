@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import replace
 
 import pytest
@@ -11,6 +12,7 @@ from nfwserver.cli import main
 from nfwserver.config import Config, ConfigError, load_config, parse_config
 from nfwserver.config.render import template
 from nfwserver.config.schema import DEFAULT_OBSERVER
+from nfwserver.config.tokens import TEMPLATE_TOKEN
 from nfwserver.storage import atomic_write_text
 
 
@@ -100,7 +102,10 @@ def test_missing_explicit_file_is_refused(tmp_path) -> None:
 def test_config_init_and_show(tmp_path, capsys) -> None:
     path = tmp_path / "sub" / "config.toml"
     assert main(["config", "init", "--config", str(path)]) == 0
-    assert path.read_text() == template()
+    written = path.read_text()
+    offered = re.search(r'^# token = "([^"]+)"$', written, re.MULTILINE)
+    assert offered is not None and offered[1] != TEMPLATE_TOKEN  # a fresh token, not the example
+    assert written == template().replace(f'# token = "{TEMPLATE_TOKEN}"', f'# token = "{offered[1]}"')
     assert main(["config", "init", "--config", str(path)]) == 1
     assert "already exists" in capsys.readouterr().err
     assert main(["config", "show", "--config", str(path)]) == 0

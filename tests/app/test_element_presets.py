@@ -170,8 +170,9 @@ def test_the_running_station_refreshes_its_named_sources(tmp_path, provider, cap
     finally:
         station.stop()
     offline = [r.getMessage() for r in caplog.records if "amateur-json" in r.getMessage()]
+    # One line, from the `elements` link (STATUS faults=elements while it lasts; #34 item 11).
     assert len(offline) == 1 and offline[0].startswith(
-        "element source unavailable: amateur-json (CelesTrak, OMM JSON): cannot fetch http://127.0.0.1:9/gp.php")
+        "elements: amateur-json (CelesTrak, OMM JSON): cannot fetch http://127.0.0.1:9/gp.php")
 
 
 def test_preset_urls_are_labelled_for_messages() -> None:

@@ -56,7 +56,7 @@ def test_failed_write_keeps_the_previous_store(tmp_path, monkeypatch, capsys) ->
     assert "cannot write" in capsys.readouterr().err
     monkeypatch.undo()
     assert store.read_bytes() == before
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["elements.txt", "newer.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".elements.txt.lock", "elements.txt", "newer.txt"]
 
 
 @pytest.mark.parametrize(("content", "says"), [

@@ -41,7 +41,8 @@ def test_prune_removes_decayed_and_old_sets(store, capsys) -> None:
     assert out == f"removed 1 decayed and 1 older than 30 days; 2 sets remain in {store}\n"
     assert "90004 FALLEN: decayed" in err
     assert sorted(s.catalog_number for s in ElementStore(store).load()) == [90001, 90003]
-    assert sorted(p.name for p in store.parent.iterdir()) == ["stored.txt"]  # no temporary file left
+    # no temporary file left (the lock's sidecar stays: removing it would race another writer)
+    assert sorted(p.name for p in store.parent.iterdir()) == [".stored.txt.lock", "stored.txt"]
 
 
 def test_prune_age_is_configurable_and_the_configured_store_is_used(store, tmp_path, capsys) -> None:

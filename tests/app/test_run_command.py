@@ -119,3 +119,17 @@ def test_a_console_failure_is_reported_in_one_sentence_and_the_station_keeps_ser
     assert len(received) >= 5 and all(text.startswith("ISS AZ:") for text in received)
     log_text = log_file.read_text()
     assert "the console stopped: RuntimeError: the console broke" in log_text and "Traceback" in log_text
+
+
+def test_the_start_up_line_names_where_the_rotor_daemon_is(tmp_path) -> None:
+    """#34 item 10: the radio was named with its rigctld address, the rotor only as ``rotor (rotctld)``."""
+    from nfwserver.app.station import Station
+    from nfwserver.cli.station_runner import enabled_outputs
+    from nfwserver.clock import VirtualClock
+    from nfwserver.config import parse_config
+
+    config = parse_config('[rotor]\nbackend = "rotctld"\nhost = "127.0.0.1"\nport = 14533\n'
+                          '[radio]\nbackend = "rigctld"\nport = 14532\n[server]\nstate_file = "none"\n')
+    station = Station(config, VirtualClock(ISS_PASS.aos), transport=FakeDdeSystem().server_transport())
+    outputs = enabled_outputs(station)  # construction only: nothing is connected
+    assert "rotor (rotctld 127.0.0.1:14533)" in outputs and "radio (rigctld 127.0.0.1:14532)" in outputs

@@ -2,12 +2,13 @@
 EasyComm ``SA SE`` sent, exit 0), also during start-up and when repeated; SIGHUP reloads the configuration.
 
 The station runs with its configuration and state in the XDG directories of a temporary home (no
-``--config``: the configuration file is not watched, so only SIGHUP can make the station read it
-again), the TCP server on a free port and EasyComm on a real pseudo-terminal.
+``--config``, as the README starts it: the station still follows the file it loaded, and SIGHUP reads it at
+once), the TCP server on a free port and EasyComm on a real pseudo-terminal.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import socket
@@ -30,8 +31,9 @@ STOP_WITHIN_S = 5.0
 class Station:
     """``nfwserver run --headless`` in a process of its own, configured through ``$XDG_CONFIG_HOME``."""
 
-    def __init__(self, home: Path, elements: Path = DATA / "visual.txt", extra: str = "") -> None:
+    def __init__(self, home: Path, elements: Path = DATA / "visual.txt", extra: str = "", server: str = "") -> None:
         self.home = home
+        self.server = server
         self.elements = elements
         self.port = free_port()
         self.pty = Pty(home / "ttyUSB0")
@@ -52,7 +54,7 @@ class Station:
         self.config.write_text(
             '[observer]\nlocation = "52.2053,0.1218,20"\n'
             f'[elements]\nfiles = ["{self.elements}"]\nuse_bundled = false\nstore = "none"\n'
-            '[server]\nsatellite = 25544\ntune = true\ntrack = true\n'
+            f'[server]\nsatellite = 25544\ntune = true\ntrack = true\n{self.server}'
             f'[tcp]\nenabled = true\nport = {self.port}\n'
             f'[easycomm]\nenabled = true\ndevice = "{self.pty.path}"\nrate_hz = 2\n{extra}')
 
@@ -138,6 +140,36 @@ def test_sigterm_and_sigint_stop_the_station_cleanly_within_5_s(station, sig) ->
     assert f"{sig.name}: stopping" in log and log.rstrip().endswith("stopped")
 
 
+def test_config_set_reaches_a_station_started_without_config(station) -> None:
+    """#34 item 2: the file was watched only with ``run --config``; ``config set`` on a station started as the
+    README starts it did nothing, although ``config set --help`` says a running station applies it."""
+    st = station()
+    st.wait_serving()
+    assert st.status()["name"] == "ISS"
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "XDG_CONFIG_HOME": str(st.home / "config")}
+    done = subprocess.run([sys.executable, "-m", "nfwserver", "config", "set", "satellites.names",
+                           '{ 25544 = "ZARYA" }'], cwd=ROOT, env=env, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0 and done.stdout.startswith(str(st.config)), done
+    assert "applies it within seconds" in done.stdout
+    assert _until(lambda: st.status()["name"] == "ZARYA", 15.0), st.status()
+    st.proc.send_signal(signal.SIGTERM)
+    assert "Traceback" not in st.finish()
+
+
+def test_a_choice_answered_ok_just_before_sigterm_is_restored(station) -> None:
+    """#34 item 4: the saver wrote the last tick's sample at stop, so a ``SAT=`` answered ``OK`` and followed by
+    SIGTERM before the next tick (1 Hz here) was lost; the next start came back with the old satellite."""
+    st = station(server="rate_hz = 1\n")
+    st.wait_serving()
+    assert _until(lambda: '"satellite": 25544' in (st.state.read_text() if st.state.exists() else ""), 5.0)
+    assert st.ask("SAT=694") == "OK"
+    st.proc.send_signal(signal.SIGTERM)
+    err = st.finish()
+    assert st.proc.returncode == 0 and "Traceback" not in err, err
+    # What the next start restores (tests/app/test_satellite_origin.py): the choice, made under this configuration.
+    assert json.loads(st.state.read_text()) == {"satellite": 694, "configured": 25544}
+
+
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
 @pytest.mark.parametrize("second_after_s", [0.0, 0.05])
 def test_signals_during_start_up_stop_the_station_once_started_without_a_traceback(station, sig,
@@ -180,3 +212,30 @@ def test_sighup_reloads_the_configuration_and_the_station_keeps_serving(station)
     assert st.proc.returncode == 0 and "Traceback" not in err, err
     log = st.log.read_text()
     assert log.count("SIGHUP: reloading the configuration") == 3 and "configuration reloaded" in log
+
+
+def test_a_station_on_built_in_defaults_takes_the_file_config_set_creates(tmp_path) -> None:
+    """#34 item 2: with no configuration file at all, the station follows the path where ``config set`` creates
+    one (the default location), and applies it when it appears."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "XDG_CONFIG_HOME": str(tmp_path / "config"),
+           "XDG_STATE_HOME": str(tmp_path / "state"), "XDG_DATA_HOME": str(tmp_path / "data")}
+    env.pop("NFW_CONTROL_FILE", None)
+    log = tmp_path / "nfw.log"
+    proc = subprocess.Popen([sys.executable, "-m", "nfwserver", "run", "--headless", "--log-file", str(log)], cwd=ROOT,
+                            env=env, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    try:
+        assert _until(lambda: "outputs:" in (log.read_text() if log.exists() else ""), 60.0)
+        assert "configuration: <built-in defaults>" in log.read_text()
+        done = subprocess.run([sys.executable, "-m", "nfwserver", "config", "set", "observer.location", "JO02ae"],
+                              cwd=ROOT, env=env, capture_output=True, text=True, timeout=60)
+        assert done.returncode == 0, done.stderr
+        assert _until(lambda: "configuration reloaded" in log.read_text(), 15.0), log.read_text()[-2000:]
+        proc.send_signal(signal.SIGTERM)
+        proc.wait(STOP_WITHIN_S)
+        assert proc.returncode == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(10)
+        assert proc.stderr is not None
+        proc.stderr.close()

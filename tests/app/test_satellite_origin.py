@@ -57,3 +57,44 @@ def test_a_changed_configuration_beats_the_saved_choice_and_says_so(tmp_path, ca
 def test_without_saved_state_the_configuration_is_named(tmp_path, capsys) -> None:
     err, status = _start(tmp_path, 25544, None, capsys)
     assert status["satellite_from"] == "config" and "satellite 25544: from [server] satellite" in status["hint"]
+
+
+def test_a_choice_made_after_the_last_tick_is_saved_at_stop_and_restored(tmp_path) -> None:
+    """#34 item 4: ``SAT=`` over TCP answered ``OK``, then the station stops before its next tick (the virtual
+    clock is not advanced): the saver wrote the last tick's sample, so the choice was lost."""
+    from tests.tcp.conftest import LineClient
+
+    state = tmp_path / "state.json"
+    path = tmp_path / "station.toml"
+    path.write_text(f'[observer]\nlocation = "JO02ae"\n[server]\nsatellite = 25544\nstate_file = "{state}"\n'
+                    '[tcp]\nenabled = true\nport = 0\n')
+    config = load_config(str(path))
+    station = Station(config, VirtualClock(ISS_PASS.aos), transport=FakeDdeSystem().server_transport())
+    station.start()
+    try:
+        assert station.tcp is not None
+        client = LineClient(station.tcp.address)
+        try:
+            client.read_line()
+            assert client.ask("SAT=7530") == "OK"
+        finally:
+            client.close()
+    finally:
+        station.stop()
+    assert json.loads(state.read_text()) == {"satellite": 7530, "configured": 25544}
+    again = Station(config, VirtualClock(ISS_PASS.aos), transport=FakeDdeSystem().server_transport())
+    again.start()
+    try:
+        assert again.core.state.catalog_number == 7530
+        assert again.core.selected_by == "saved-state"
+    finally:
+        again.stop()
+
+
+def test_a_saved_state_that_only_repeats_the_configuration_is_not_called_a_choice(tmp_path, capsys) -> None:
+    """#34 item 10: the saver records the configured satellite too, so the next start said "restored ...
+    (chosen while running)" of a satellite nobody chose."""
+    err, status = _start(tmp_path, 25544, {"satellite": 25544, "configured": 25544}, capsys)
+    assert status["satellite"] == "25544" and status["satellite_from"] == "config"
+    assert status["hint"] == "satellite 25544: from [server] satellite"
+    assert "chosen while running" not in err

@@ -51,7 +51,8 @@ def test_each_live_part_reaches_the_running_core_and_only_when_it_changed() -> N
     catalog = Catalog(s.elements for s in CATALOG)
     core = StationCore(catalog, RUNNING.observer, VirtualClock(ISS_PASS.tca), satellite=ISS, rate_hz=5)
     new = parse_config('[observer]\nlocation = "JO62qm"\n[server]\nrate_hz = 2\nut1_utc_s = 0.25\n'
-                       '[satellites]\nnames = { 25544 = "ARISS" }\n[radio]\nenabled = true\n')
+                       '[satellites]\nnames = { 25544 = "ARISS" }\n[radio]\nenabled = true\n'
+                       '[web]\nhostnames = ["station.lan"]\n')  # the web server's part: the station hands it on
     live = [(part, part.apply) for part in CONFIG_PARTS if part.apply is not None]
     assert live and all(part.differs(RUNNING, new) for part, _ in live)
     for _, apply in live:

@@ -54,7 +54,8 @@ def test_wisp_with_interval_0_and_delphi_request_on_each_warm_notification(capsy
     expected_ticks = [(t, kind, text) for t in (0.0, 1.0, 2.0)
                       for kind, text in (("notify", "NFW_SERVER"), ("reply", "DATA"))]
     rows = _run(capsys, "--client", "delphi", "--rate", "1", "--duration", "2")
-    assert _shape(rows) == [(0.0, "poke", "TUNE ON"), (0.0, "reply", "(empty)"), *expected_ticks]
+    # The request right after TUNE ON, before the first tick, gets the string (#34 item 5), not "".
+    assert _shape(rows) == [(0.0, "poke", "TUNE ON"), (0.0, "reply", "DATA"), *expected_ticks]
     rows = _run(capsys, "--client", "wisp", "--poll", "0", "--rate", "1", "--duration", "2")
     assert _shape(rows) == [(0.0, "poke", "TUNE ON"), *expected_ticks]
 

@@ -105,3 +105,23 @@ def test_a_symptom_shows_the_fault_without_growing_the_back_off(clock: VirtualCl
     assert h.describe() == "the rotor refused a move (for 0 s)"
     fault = h.failed("stalled")  # the first real attempt that failed: the first back-off step
     assert fault.failures == 1 and fault.retry_at == clock.monotonic() + 5.0
+
+
+def test_every_outage_episode_gets_its_lost_and_recovered_lines(clock: VirtualClock,
+                                                                caplog: pytest.LogCaptureFixture) -> None:
+    """#34 item 9: the lines were limited per link (one a minute), so four separate 8 s outages of rotctld within
+    one minute wrote no line for the last three (and so no recovery line either).  Each episode gets its two
+    lines; only the repeats within an episode are limited."""
+    h = LinkHealth("rotctld", clock, Backoff(0.25, 1.5), logger=logging.getLogger("test.episodes"))
+    with caplog.at_level(logging.INFO, logger="test.episodes"):
+        for _ in range(4):  # 8 s out, polled at 5 Hz, then 7 s well
+            for _ in range(40):
+                h.failed("rotctld at 127.0.0.1:4533 lost (connection refused)")
+                clock.advance(0.2)
+            h.succeeded()
+            clock.advance(7.0)
+    lines = [r.getMessage() for r in caplog.records]
+    lost = [line for line in lines if "lost (connection refused)" in line]
+    recovered = [line for line in lines if "recovered after 8.0 s" in line]
+    assert len(lost) == 4 and len(recovered) == 4, lines
+    assert len(lines) == 8  # and nothing else: the repeats within each episode stay limited

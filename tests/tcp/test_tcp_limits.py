@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import select
 
 import pytest
 
@@ -117,4 +118,49 @@ def test_an_ipv4_mapped_peer_matches_ipv4_allow_entries() -> None:
         assert c.ask("STATUS").startswith("satellite=")
         c.close()
     finally:
+        server.stop()
+
+
+def test_idle_connections_never_lock_out_the_operators_tools() -> None:
+    """#34 item 14: on the loopback default every local client shares one address, so 32 idle connections from
+    127.0.0.1 made ``nfwserver status`` and ``poke`` fail for up to the 300 s idle timeout.  Over a cap, the
+    connection idle longest (1 s or more, never a WATCH) now makes room; one that talks keeps its place."""
+    station = make_station()
+    server = NovaTcpServer(station.core, LOOPBACK_ONLY)  # the defaults: 32 per address
+    server.start()
+    flood: list[LineClient] = []
+    try:
+        watcher = LineClient(server.address)
+        assert watcher.read_line() == GREETING and watcher.ask("WATCH") == "OK"
+        for _ in range(LOOPBACK_ONLY.max_per_address - 1):
+            flood.append(LineClient(server.address))
+            assert flood[-1].read_line() == GREETING
+        station.run(2.0)  # the flood has been idle for 2 s of the station's clock
+        server.wake()
+        tools = []
+        for _ in range(3):  # the operator's tools, one connection each, as `status` and `poke` make them
+            tools.append(LineClient(server.address))
+            assert tools[-1].read_line() == GREETING
+            assert tools[-1].ask("STATUS").startswith("satellite=")  # (still connected when the next comes)
+        assert server.stats.evicted == 3 and server.watcher_count() == 1
+        for tool in tools:
+            tool.close()
+        assert wait_for(lambda: server.client_count() == LOOPBACK_ONLY.max_per_address - 3)
+        closed, _, _ = select.select([c.sock for c in flood], [], [], 1.0)  # idle ones closed for the tools
+        assert len(closed) == 3 and all(sock.recv(1) == b"" for sock in closed)
+        alive = [c for c in flood if c.sock not in closed]
+        # Connections that keep talking are never closed for a newcomer: then the cap refuses, as before.
+        busy = [LineClient(server.address) for _ in range(3)]
+        assert all(c.read_line() == GREETING for c in busy)
+        for c in (*alive, *busy):
+            assert c.ask("STATUS").startswith("satellite=")
+        late = LineClient(server.address)
+        assert late.text() == f"ERROR too many connections from 127.0.0.1 (at most {LOOPBACK_ONLY.max_per_address})"
+        late.close()
+        for c in busy:
+            c.close()
+        watcher.close()
+    finally:
+        for c in flood:
+            c.close()
         server.stop()

@@ -287,3 +287,16 @@ def test_values_of_a_generated_set_are_those_of_its_lines() -> None:
     assert first.eccentricity == sat.ecco == 0.6027104
     assert first.bstar == sat.bstar
     assert math.radians(first.mean_anomaly_deg) == pytest.approx(sat.mo, rel=1e-15)
+
+
+@pytest.mark.parametrize("bulk", [True, False])
+def test_a_name_line_over_40_characters_names_its_set_cut_to_40(bulk: bool) -> None:
+    """#34 item 13: a name line of 41..80 characters was not taken as a name, so its set had none."""
+    iss = next(s for s in load_element_file(DATA / "visual.txt").sets if s.catalog_number == 25544)
+    long_name = "ISS (ZARYA) WITH A NAME LINE OF SIXTY CHARACTERS, ALL TOLD!"
+    assert len(long_name) == 59
+    text = f"{long_name}\n{iss.line1}\n{iss.line2}\n"
+    if not bulk:  # a comment first: not the bulk 3-line form, so the line-by-line reader names it
+        text = "# a header\n" + text
+    sets = load_elements(text).sets
+    assert [s.name for s in sets] == [long_name[:40].rstrip()]

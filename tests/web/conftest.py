@@ -99,7 +99,7 @@ def _which(candidates: tuple[str, ...]) -> str | None:
     return None
 
 
-def make_browser(width: int = 1280, height: int = 900):
+def make_browser(width: int = 1280, height: int = 900, extra_args: tuple[str, ...] = ()):
     from selenium import webdriver
     from selenium.webdriver.chrome.service import Service
 
@@ -110,7 +110,7 @@ def make_browser(width: int = 1280, height: int = 900):
     options = webdriver.ChromeOptions()
     options.binary_location = binary
     for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                "--no-first-run", "--disable-extensions", f"--window-size={width},{height}"):
+                "--no-first-run", "--disable-extensions", f"--window-size={width},{height}", *extra_args):
         options.add_argument(arg)
     options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
     browser = webdriver.Chrome(options=options, service=Service(driver))

@@ -149,10 +149,10 @@ def test_hub_gives_the_newest_frame_and_wakes_waiters_on_close() -> None:
 
 def test_web_configuration() -> None:
     assert WebConfig() == WebConfig(enabled=False, host="127.0.0.1", port=8091, allow=("127.0.0.1/32", "::1/128"),
-                                    control=False, token=None)
+                                    hostnames=(), control=False, token=None)
     with pytest.raises(ConfigError, match=r"\[web\] token: required when control is on"):
         parse_config("[web]\ncontrol = true\n")
-    with pytest.raises(ConfigError, match=r"\[web\] token: at least 8 characters"):
+    with pytest.raises(ConfigError, match=r"\[web\] token: must be at least 8 characters"):
         parse_config('[web]\ncontrol = true\ntoken = "short"\n')
     exposed = parse_config('[web]\nenabled = true\nhost = "0.0.0.0"\nallow = ["192.168.1.0/24"]\n')
     assert any(w.startswith('[web] host = "0.0.0.0"') for w in exposed.warnings)
@@ -199,7 +199,11 @@ def test_a_newer_sample_is_framed_even_if_the_clock_then_stands_still() -> None:
     core.set_tune(True)
     web = WebServer(core, WebConfig(enabled=True, port=0))
     web.start()
+    assert web.address is not None
+    page = socket.create_connection(web.address, timeout=10)  # frames are built while a page is connected
     try:
+        page.sendall(b"GET /api/stream HTTP/1.0\r\n\r\n")
+        wait_for(lambda: web.stats.streams == 1, what="the page's stream")
         first = core.tick(clock.now())  # the publisher's work, listeners included
         wait_for(lambda: web.stats.frames >= 2, what="the first tick's frame")
         seen = web.hub.seq
@@ -211,4 +215,5 @@ def test_a_newer_sample_is_framed_even_if_the_clock_then_stands_still() -> None:
         wait_for(lambda: web.hub.seq > seen and b"NEWEST" in (web.hub.newest()[1] or b""), timeout_s=10.0,
                  what="the newest sample's frame, the clock standing still")
     finally:
+        page.close()
         web.stop()

@@ -9,7 +9,15 @@ let frame = null, passesVersion = -1, passes = null, control = false;
 function text(id, value) { const el = T(id); if (el) el.textContent = value; return el; }
 function fixed(v, n) { return v === null || v === undefined ? "-" : Number(v).toFixed(n); }
 function hhmmss(iso) { return iso ? iso.slice(11, 19) : "-"; }
-function local(iso) { return iso ? new Date(iso).toLocaleTimeString([], { hour: "2-digit", minute: "2-digit", second: "2-digit" }) : ""; }
+// The browser's local time, or "" where its zone is UTC there (the UTC time is shown already).
+function local(iso) {
+  if (!iso) return "";
+  const when = new Date(iso);
+  return when.getTimezoneOffset() === 0 ? "" : when.toLocaleTimeString([], { hour: "2-digit", minute: "2-digit", second: "2-digit" });
+}
+function latLon(lat, lon) {
+  return `${Math.abs(lat).toFixed(2)}\u00b0${lat < 0 ? "S" : "N"} ${Math.abs(lon).toFixed(2)}\u00b0${lon < 0 ? "W" : "E"}`;
+}
 function duration(s) {
   if (s === null || s === undefined) return "-";
   s = Math.max(0, Math.round(s));
@@ -47,11 +55,11 @@ function renderNow(f) {
   text("range", pos ? fixed(pos.range_km, 1) : "-");
   text("rr", pos ? fixed(pos.range_rate_km_s, 4) : "-");
   const sp = n.subpoint;
-  text("subpoint", sp ? `${fixed(sp.lat, 2)}, ${fixed(sp.lon, 2)} ${sp.locator}` : "-");
+  text("subpoint", sp ? `${latLon(sp.lat, sp.lon)} ${sp.locator}` : "-");
   text("nova-string", n.nova || "(nothing published: TUNE OFF or no position)");
-  const ev = f.next_event;
-  text("countdown-label", ev ? ev.kind + " in" : "AOS in");
-  text("countdown", ev ? duration(ev.seconds) : "-");
+  const ev = f.next_event, up = passes && passes.track && passes.track.always_up;
+  text("countdown-label", up ? "Up" : ev ? ev.kind + " in" : "AOS in");
+  text("countdown", up ? "all day" : ev ? duration(ev.seconds) : "-");
   const d = n.doppler;
   text("doppler", d ? `${d.channel}: RX ${(d.rx_hz / 1e6).toFixed(6)} MHz` + (d.tx_hz ? `  TX ${(d.tx_hz / 1e6).toFixed(6)} MHz` : "")
     : "no radio channel for this satellite");
@@ -98,16 +106,24 @@ function logLine(e) {
     (e.detail ? "  -- " + e.detail : "") + (e.accepted === false ? "  REFUSED" : "");
   li.className = e.dir + (e.accepted === false ? " refused" : "");
   li.dataset.dir = e.dir;
+  li.dataset.kind = e.kind;
+  li.dataset.seq = e.seq;
   return li;
 }
 function applyFilter(li) {
   const q = $("logfilter").value.toLowerCase(), dir = $("logdir").value;
-  li.hidden = (dir && li.dataset.dir !== dir) || (q && !li.textContent.toLowerCase().includes(q));
+  li.hidden = (dir && li.dataset.dir !== dir) || (q && !li.textContent.toLowerCase().includes(q))
+    || (li.dataset.kind === "publish" && !$("logpublish").checked);  // one a tick: shown on request
 }
+let lastSeq = 0;  // the newest event shown: a frame's log repeats what the history already gave
 function addLog(events) {
   const list = $("logrows");
   const atBottom = list.scrollTop + list.clientHeight >= list.scrollHeight - 4;
-  for (const e of events) { const li = logLine(e); applyFilter(li); list.appendChild(li); }
+  for (const e of events) {
+    if (e.seq <= lastSeq) continue;
+    lastSeq = e.seq;
+    const li = logLine(e); applyFilter(li); list.appendChild(li);
+  }
   while (list.childElementCount > MAX_LOG_ROWS) list.firstElementChild.remove();
   if (atBottom) list.scrollTop = list.scrollHeight;
 }
@@ -123,6 +139,9 @@ function renderPasses() {
   leftOut.textContent = names.length ? "Left out, position cannot be computed now: " + names.slice(0, 5).join(", ")
     + (names.length > 5 ? ", ..." : "") : "";
   leftOut.classList.toggle("hidden", !names.length);
+  const failed = T("passes-error");
+  failed.textContent = passes.error || "";
+  failed.classList.toggle("hidden", !passes.error);
   const selected = frame && frame.now.satellite ? frame.now.satellite.catalog_number : null;
   if (!passes.passes.length) { row(["none in the next 12 h", "", "", "", "", "", ""], body); return; }
   for (const p of passes.passes) {
@@ -138,7 +157,8 @@ function renderPasses() {
   }
 }
 function loadPasses() {
-  fetch("/api/passes").then(r => r.json()).then(p => { passes = p; renderPasses(); }).catch(() => {});
+  fetch("/api/passes").then(r => r.json()).then(p => { passes = p; renderPasses(); if (frame) renderNow(frame); })
+    .catch(() => {});
 }
 
 function setControl(on) {
@@ -182,8 +202,16 @@ function onFrame(f) {
 function connect() {
   const link = T("connection");
   const source = new EventSource("/api/stream");
-  source.addEventListener("history", e => { $("logrows").textContent = ""; addLog(JSON.parse(e.data)); });
-  source.addEventListener("state", e => { link.textContent = "live"; link.className = "badge ok"; onFrame(JSON.parse(e.data)); });
+  source.addEventListener("history", e => { $("logrows").textContent = ""; lastSeq = 0; addLog(JSON.parse(e.data)); });
+  source.addEventListener("state", e => {
+    const f = JSON.parse(e.data);
+    if (f.frame_error) {  // the station could not build a frame: say so, never "live" on an old one
+      link.textContent = "not updating"; link.className = "badge bad"; link.title = f.frame_error;
+      return;
+    }
+    link.textContent = "live"; link.className = "badge ok"; link.title = "";
+    onFrame(f);
+  });
   source.onerror = () => { link.textContent = "reconnecting"; link.className = "badge bad"; };
 }
 
@@ -196,6 +224,8 @@ document.addEventListener("DOMContentLoaded", () => {
   $("satform").addEventListener("submit", e => { e.preventDefault(); const v = $("satinput").value.trim(); if (v) send("SAT=" + v); });
   $("logfilter").addEventListener("input", () => { for (const li of $("logrows").children) applyFilter(li); });
   $("logdir").addEventListener("change", () => { for (const li of $("logrows").children) applyFilter(li); });
+  $("logpublish").addEventListener("change", () => { for (const li of $("logrows").children) applyFilter(li); });
+  if (new Date().getTimezoneOffset() === 0) text("passes-zone", "UTC");
   fetch("/api/help").then(r => r.json()).then(h => {
     for (const c of h.commands) { const li = document.createElement("li"); li.textContent = c.usage + " - " + c.summary; T("help").appendChild(li); }
   }).catch(() => {});

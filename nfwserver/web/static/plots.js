@@ -21,20 +21,28 @@ const Polar = {
     this.svg = svg;
     svg.textContent = "";
     this.mask = svgEl("path", { class: "mask" }, svg);
-    for (const el of [0, 30, 60]) svgEl("circle", { class: "grid", r: 90 - el, cx: 0, cy: 0 }, svg);
+    for (const el of [0, 30, 60]) {
+      svgEl("circle", { class: "grid", r: 90 - el, cx: 0, cy: 0 }, svg);
+      const [x, y] = polarXY(135, el);  // on the south-east diagonal, clear of the N/E/S/W letters
+      svgEl("text", { class: "gridtext ring", x: x + 1.5, y: y - 1.5, "data-testid": "ring-" + el }, svg).textContent = el + "\u00b0";
+    }
     for (let az = 0; az < 360; az += 30) {
       const [x, y] = polarXY(az, 0);
       svgEl("line", { class: "grid", x1: 0, y1: 0, x2: x, y2: y }, svg);
     }
+    this.letters = [];  // where N, E, S and W are written: labels keep clear of them too
     for (const [t, az] of [["N", 0], ["E", 90], ["S", 180], ["W", 270]]) {
       const [x, y] = polarXY(az, -11);
       svgEl("text", { class: "gridtext", x: x, y: y + 2.5, "text-anchor": "middle" }, svg).textContent = t;
+      this.letters.push([x, y, 4.5]);
     }
     this.track = svgEl("polyline", { class: "track" }, svg);
     this.marks = svgEl("g", {}, svg);
     this.target = svgEl("rect", { class: "target hidden", width: 9, height: 9, "data-testid": "rotor-target" }, svg);
     this.actual = svgEl("path", { class: "actual hidden", d: "M0,-5 L5,0 L0,5 L-5,0 Z", "data-testid": "rotor-actual" }, svg);
     this.sat = svgEl("circle", { class: "sat hidden", r: 4.5, "data-testid": "sat-marker" }, svg);
+    this.labels = svgEl("g", {}, svg);  // above every marker, each placed clear of the marks (placeLabels)
+    this.points = [];
   },
   horizon(points) {
     if (!points || !points.length) { this.mask.setAttribute("d", ""); return; }
@@ -45,15 +53,44 @@ const Polar = {
   },
   pass(track) {
     this.marks.textContent = "";
+    this.labels.textContent = "";
+    this.points = [];
     if (!track || !track.points) { this.track.setAttribute("points", ""); return; }
-    this.track.setAttribute("points", track.points.filter(p => p[1] > -2)
+    this.track.setAttribute("points", track.always_up ? "" : track.points.filter(p => p[1] > -2)
       .map(([az, el]) => polarXY(az, el).map(v => v.toFixed(2)).join(",")).join(" "));
-    for (const key of ["aos", "tca", "los"]) {
+    const keys = track.always_up ? [["tca", "up all day"]] : [["aos", "AOS"], ["tca", "TCA"], ["los", "LOS"]];
+    for (const [key, label] of keys) {
       const p = track[key];
       if (!p) continue;
       const [x, y] = polarXY(p.az, p.el);
-      svgEl("circle", { class: "passmark", cx: x, cy: y, r: 2.2, "data-testid": "pass-" + key }, this.marks);
-      svgEl("text", { class: "passlabel", x: x + 3, y: y - 3 }, this.marks).textContent = key.toUpperCase();
+      svgEl("circle", { class: "passmark", cx: x, cy: y, r: track.always_up ? 3.5 : 2.2, "data-testid": "pass-" + key }, this.marks);
+      const text = svgEl("text", { class: "passlabel", "data-testid": "label-" + key }, this.labels);
+      text.textContent = label;
+      this.points.push({ x, y, text, width: label.length * 4.3 });
+    }
+    this.placeLabels();
+  },
+  // Each label goes where it covers no marker (pass marks, satellite, rotor marks) and no other label.
+  placeLabels() {
+    const circles = this.points.map(p => [p.x, p.y, 3]).concat(this.letters);
+    for (const node of [this.sat, this.target, this.actual]) {
+      if (node.classList.contains("hidden") || !node.hasAttribute("data-az")) continue;
+      const [x, y] = polarXY(Number(node.getAttribute("data-az")), Number(node.getAttribute("data-el")));
+      circles.push([x, y, 6]);
+    }
+    const placed = [];
+    const clear = (x0, y0, w, h) => x0 >= -110 && x0 + w <= 110 && y0 >= -110 && y0 + h <= 110 &&
+      circles.every(([cx, cy, r]) => cx + r < x0 || cx - r > x0 + w || cy + r < y0 || cy - r > y0 + h) &&
+      placed.every(([a, b, c, d]) => a + c < x0 || a > x0 + w || b + d < y0 || b > y0 + h);
+    for (const p of this.points) {
+      const h = 7, w = p.width;
+      const spots = [[4, -9], [4, 2], [-4 - w, -9], [-4 - w, 2], [-w / 2, -13], [-w / 2, 6], [8, -3.5], [-8 - w, -3.5],
+        [12, -14], [-12 - w, 7], [12, 7], [-12 - w, -14]];
+      let [dx, dy] = spots[0];
+      for (const spot of spots) if (clear(p.x + spot[0], p.y + spot[1], w, h)) { [dx, dy] = spot; break; }
+      placed.push([p.x + dx, p.y + dy, w, h]);
+      p.text.setAttribute("x", (p.x + dx).toFixed(2));
+      p.text.setAttribute("y", (p.y + dy + h - 1).toFixed(2));  // text y is its baseline
     }
   },
   place(node, pos, fn) {
@@ -71,6 +108,7 @@ const Polar = {
     const rotor = frame.rotor || {};
     this.place(this.target, rotor.target, (x, y) => { this.target.setAttribute("x", (x - 4.5).toFixed(2)); this.target.setAttribute("y", (y - 4.5).toFixed(2)); });
     this.place(this.actual, rotor.actual, (x, y) => this.actual.setAttribute("transform", `translate(${x.toFixed(2)},${y.toFixed(2)})`));
+    if (this.points.length) this.placeLabels();
   },
 };
 

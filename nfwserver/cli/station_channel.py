@@ -1,0 +1,139 @@
+"""The running station's local channel: one station per user, found and stopped by ``nfwserver stop``.
+
+A station started by ``nfwserver run`` holds an exclusive lock on ``station.lock`` in the user's state
+directory (``nfwserver config path`` names the configuration's; this is the state directory beside the
+saved state) for as long as it runs, and describes itself in ``station.json`` beside it: its process id,
+the control file it watches (:mod:`nfwserver.cli.control_file`; ``control`` in the same directory unless
+``NFW_CONTROL_FILE`` names another) and, once serving, its web dashboard's address.  The operating system
+releases the lock when the process ends, however it ends, so a station killed outright never leaves a
+"running" station behind: the lock, not the description, says whether one runs.
+
+``nfwserver stop`` writes ``stop`` to the control file and waits until the lock is free;
+``nfwserver dashboard`` opens the address.  A second ``nfwserver run`` of the same user while one runs is
+refused, naming the running one: two stations would offer the same DDE service names and ports.
+
+The lock is :mod:`nfwserver.file_lock`'s (``fcntl.flock`` on Linux, ``msvcrt.locking`` of one byte on
+Windows), held here for the whole run; the system releases it at process exit.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from nfwserver.storage import atomic_write_text
+
+LOCK_NAME = "station.lock"
+INFO_NAME = "station.json"
+CONTROL_NAME = "control"
+#: How long a station starting up retries the lock (a ``stop`` or ``status`` probing it holds it briefly).
+CLAIM_RETRY_S = 1.0
+
+
+def user_run_dir() -> Path:
+    """The user's state directory, where the lock, the description and the default control file live."""
+    from platformdirs import user_state_dir
+
+    return Path(user_state_dir("nfwserver", appauthor=False))
+
+
+class _Lock:
+    """An exclusive, non-blocking lock on one file, held through an open descriptor."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self._fd: int | None = None
+
+    def try_acquire(self) -> bool:
+        """Take the lock if it is free; True when this object now holds it."""
+        from nfwserver.file_lock import try_lock
+
+        if self._fd is not None:
+            return True
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        fd = os.open(self.path, os.O_RDWR | os.O_CREAT | getattr(os, "O_BINARY", 0), 0o600)
+        if not try_lock(fd):
+            os.close(fd)
+            return False
+        self._fd = fd
+        return True
+
+    def release(self) -> None:
+        from nfwserver.file_lock import unlock
+
+        fd, self._fd = self._fd, None
+        if fd is None:
+            return
+        with contextlib.suppress(OSError):
+            unlock(fd)
+        os.close(fd)
+
+
+@dataclass(frozen=True)
+class StationInfo:
+    """What a running station says of itself in ``station.json``."""
+
+    pid: int
+    control: Path  #: the control file it watches
+    web_url: str | None = None  #: its dashboard's address, once it serves one
+
+
+class StationChannel:
+    """The lock, description and control file of the user's station, in ``directory``."""
+
+    def __init__(self, directory: Path | None = None) -> None:
+        self.directory = directory if directory is not None else user_run_dir()
+        self.lock_path = self.directory / LOCK_NAME
+        self.info_path = self.directory / INFO_NAME
+        self._lock = _Lock(self.lock_path)
+
+    @property
+    def default_control(self) -> Path:
+        return self.directory / CONTROL_NAME
+
+    # -- the station's side ---------------------------------------------------------------------------
+    def claim(self, retry_s: float = CLAIM_RETRY_S) -> bool:
+        """Take the lock for this process (retrying ``retry_s`` seconds, for a prober's brief hold)."""
+        deadline = time.monotonic() + retry_s
+        while not self._lock.try_acquire():
+            if time.monotonic() >= deadline:
+                return False
+            time.sleep(0.05)
+        return True
+
+    def describe(self, info: StationInfo) -> None:
+        """Write ``station.json`` (atomically); only while this process holds the lock."""
+        record = {"pid": info.pid, "control": str(info.control), "web": info.web_url}
+        with contextlib.suppress(OSError):
+            atomic_write_text(self.info_path, json.dumps(record) + "\n")
+
+    def release(self) -> None:
+        """Remove the description, then free the lock (the order a waiting ``stop`` relies on)."""
+        with contextlib.suppress(OSError):
+            self.info_path.unlink()
+        self._lock.release()
+
+    # -- everyone else's side -------------------------------------------------------------------------
+    def running(self) -> bool:
+        """Whether a station holds the lock now (probed by taking it for an instant)."""
+        probe = _Lock(self.lock_path)
+        try:
+            if probe.try_acquire():
+                probe.release()
+                return False
+        except OSError:  # the directory cannot be written: no station of this user could run either
+            return False
+        return True
+
+    def info(self) -> StationInfo | None:
+        """The running station's description, or None (none running, or not written yet)."""
+        try:
+            record = json.loads(self.info_path.read_text(encoding="utf-8"))
+            web = record.get("web")
+            return StationInfo(int(record["pid"]), Path(str(record["control"])), str(web) if web else None)
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            return None

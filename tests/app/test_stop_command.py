@@ -1,0 +1,161 @@
+"""``nfwserver stop`` and ``nfwserver dashboard`` against a real ``nfwserver run --headless`` process, through the
+station's own channel (lock, description, control file); one station per user; ``config edit``/``init --web``;
+the windowless program's output."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+import urllib.request
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from nfwserver.cli import main
+from nfwserver.cli.station_channel import StationChannel
+from nfwserver.cli.windowless import TailText
+from tests.app import test_run_signals
+from tests.conftest import ROOT
+
+pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX processes (Windows: tests/windows)")
+#: The fixture making real ``nfwserver run --headless`` stations in ``tmp_path``.
+station = test_run_signals.station
+
+
+def _cli(home: Path, *args: str, env: dict[str, str] | None = None,
+         timeout_s: float = 60.0) -> subprocess.CompletedProcess[str]:
+    """``nfwserver ARGS`` as the user runs it, with ``home``'s XDG directories (those the Station uses)."""
+    base = {**os.environ, "PYTHONPATH": str(ROOT), "XDG_CONFIG_HOME": str(home / "config"),
+            "XDG_STATE_HOME": str(home / "state")}
+    return subprocess.run([sys.executable, "-m", "nfwserver", *args], cwd=ROOT, env={**base, **(env or {})},
+                          capture_output=True, text=True, timeout=timeout_s, stdin=subprocess.DEVNULL)
+
+
+def wait_until(predicate: Callable[[], bool], timeout_s: float) -> None:
+    """Return once ``predicate()`` holds; fail the test when it has not within ``timeout_s``."""
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        assert time.monotonic() < deadline, f"not within {timeout_s:g} s: {predicate}"
+        time.sleep(0.05)
+
+
+def test_stop_asks_the_station_through_its_channel_and_returns_once_it_has_stopped(station, tmp_path) -> None:
+    st = station()
+    st.wait_serving()
+    assert st.ask("SAT=694") == "OK"  # live state that a clean stop saves
+    result = _cli(tmp_path, "stop")
+    assert result.returncode == 0, result.stderr
+    assert result.stdout == f"stopped the station (process {st.proc.pid})\n" and result.stderr == ""
+    assert st.proc.wait(10) == 0  # a clean exit, not a kill
+    log = st.log.read_text()
+    assert f"control file {tmp_path / 'state' / 'nfwserver' / 'control'}: stopping" in log
+    assert log.rstrip().endswith("stopped")
+    assert json.loads(st.state.read_text())["satellite"] == 694
+    channel = StationChannel(tmp_path / "state" / "nfwserver")
+    assert not channel.running() and channel.info() is None  # nothing left that says "running"
+
+
+def test_stop_with_no_station_says_so_in_one_sentence(tmp_path) -> None:
+    result = _cli(tmp_path, "stop")
+    assert result.returncode == 1 and result.stdout == ""
+    assert result.stderr == "nfwserver: no station is running for this user: nothing to stop\n"
+
+
+def test_a_killed_station_leaves_nothing_running_behind(station, tmp_path) -> None:
+    st = station()
+    st.wait_serving()
+    os.kill(st.proc.pid, signal.SIGKILL)
+    st.proc.wait(10)
+    channel = StationChannel(tmp_path / "state" / "nfwserver")
+    assert channel.info() is not None  # the description outlives a kill ...
+    assert not channel.running()  # ... but the lock, which says whether one runs, does not
+    result = _cli(tmp_path, "stop")
+    assert result.returncode == 1 and "no station is running" in result.stderr
+    again = subprocess.Popen(  # and the next station of that user starts
+        [sys.executable, "-m", "nfwserver", "run", "--headless", "--log-file", str(tmp_path / "again.log")],
+        cwd=ROOT, env={**os.environ, "PYTHONPATH": str(ROOT), "XDG_CONFIG_HOME": str(tmp_path / "config"),
+                       "XDG_STATE_HOME": str(tmp_path / "state")}, stdin=subprocess.DEVNULL,
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        wait_until(lambda: channel.info() is not None and channel.info().pid == again.pid, 30.0)
+        assert _cli(tmp_path, "stop").returncode == 0 and again.wait(10) == 0
+    finally:
+        if again.poll() is None:
+            again.kill()
+            again.wait(10)
+
+
+def test_a_second_station_of_the_same_user_is_refused_naming_the_first(station, tmp_path) -> None:
+    st = station()
+    st.wait_serving()
+    second = _cli(tmp_path, "run", "--headless", "--log-file", str(tmp_path / "second.log"), "--duration", "30")
+    assert second.returncode == 1
+    assert second.stderr.strip().splitlines()[-1] == (
+        f"nfwserver: a station is already running for this user (process {st.proc.pid}): `nfwserver stop` stops it")
+    assert st.proc.poll() is None and st.status()["tune"] == "on"  # the first one never noticed
+
+
+def test_dashboard_prints_the_running_stations_address(station, tmp_path) -> None:
+    st = station(extra="[web]\nenabled = true\nport = 0\n")
+    st.wait_serving()
+    result = _cli(tmp_path, "dashboard", "--print")
+    assert result.returncode == 0, result.stderr
+    url = result.stdout.strip()
+    assert url.startswith("http://127.0.0.1:") and not url.endswith(":0/")
+    with urllib.request.urlopen(url, timeout=10) as reply:
+        assert reply.status == 200 and b"<html" in reply.read(4096).lower()
+
+
+def test_dashboard_without_a_web_page_or_a_station_says_why(station, tmp_path) -> None:
+    none = _cli(tmp_path, "dashboard", "--print")
+    assert none.returncode == 1 and none.stdout == "" and "no station is running" in none.stderr
+    st = station()  # [web] not enabled
+    st.wait_serving()
+    off = _cli(tmp_path, "dashboard", "--print")
+    assert off.returncode == 1 and off.stdout == ""
+    assert "serves no web dashboard: `nfwserver config set web.enabled true`" in off.stderr
+
+
+def test_config_edit_writes_a_missing_file_from_the_template_and_opens_it_in_the_editor(tmp_path) -> None:
+    opened = tmp_path / "opened.txt"
+    editor = tmp_path / "editor.py"
+    editor.write_text(f"import sys\nopen({str(opened)!r}, 'a').write(sys.argv[1] + '\\n')\n")
+    result = _cli(tmp_path, "config", "edit", env={"VISUAL": "", "EDITOR": f"{sys.executable} {editor}"})
+    config = tmp_path / "config" / "nfwserver" / "config.toml"
+    assert result.returncode == 0, result.stderr
+    assert result.stdout == f"{config} (written from the template)\n"
+    assert opened.read_text() == f"{config}\n" and "[observer]" in config.read_text()
+    config.write_text("# mine\n")
+    again = _cli(tmp_path, "config", "edit", env={"VISUAL": f"{sys.executable} {editor}"})
+    assert again.returncode == 0 and again.stdout == f"{config}\n" and config.read_text() == "# mine\n"
+    failing = _cli(tmp_path, "config", "edit", env={"VISUAL": "false"})
+    assert failing.returncode == 1 and "the editor 'false' exited with status 1" in failing.stderr
+
+
+def test_config_init_web_serves_the_dashboard_and_keep_leaves_a_file_alone(tmp_path) -> None:
+    config = tmp_path / "config" / "nfwserver" / "config.toml"
+    first = _cli(tmp_path, "config", "init", "--web", "--keep")
+    assert first.returncode == 0 and first.stdout == f"{config}\n"
+    shown = _cli(tmp_path, "config", "show")
+    assert shown.returncode == 0 and any(line.split()[:3] == ["enabled", "=", "true"]
+                                         for line in shown.stdout.split("[web]", 1)[1].splitlines()[:3])
+    config.write_text("# changed by the user\n")
+    kept = _cli(tmp_path, "config", "init", "--web", "--keep")
+    assert kept.returncode == 0 and config.read_text() == "# changed by the user\n"
+    refused = _cli(tmp_path, "config", "init", "--web")
+    assert refused.returncode == 1 and "already exists" in refused.stderr
+
+
+def test_a_windowless_run_keeps_its_output_bounded_and_returns_usage_errors(monkeypatch) -> None:
+    tail = TailText(limit=10)
+    tail.write("0123456789abc")
+    assert tail.getvalue() == "3456789abc"
+    monkeypatch.setattr(sys, "stdout", None)
+    monkeypatch.setattr(sys, "stderr", None)
+    assert main(["stop", "--bogus"]) == 2  # no SystemExit out of a program with no console to print it on
+    assert isinstance(sys.stderr, TailText) and "unrecognized arguments: --bogus" in sys.stderr.getvalue()

@@ -1,0 +1,250 @@
+"""nfwserver's Windows installer, built by tools/windows/build, installed, used, upgraded and removed in a
+fresh Wine prefix with no Python in it (run by ``tools/windows/test``; docs/WINDOWS.md).
+
+The tests are steps of one story and run in this file's order on one prefix: the build is reproducible; a
+silent per-user install registers for Apps & features and makes its Start-menu entries; the installed
+``nfwserver.exe`` serves a native DDEML client (C, mingw-w64) on both service names and stops cleanly on
+``nfwserver stop``; an upgrade over a running station started at logon stops it, keeps the user's files and
+starts it again; the registered quiet uninstall removes the program and keeps the user's files.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import subprocess
+import time
+import urllib.request
+from collections.abc import Callable, Iterator
+from pathlib import Path, PureWindowsPath
+
+import pytest
+
+from nfwserver import __version__
+from tests.conftest import ROOT
+from tests.windows.conftest import NOVA
+from tests.windows.wine_prefix import WinePrefix
+
+SETUP = os.environ.get("NFW_INSTALLER")
+REBUILT = os.environ.get("NFW_INSTALLER_REBUILT")
+pytestmark = [pytest.mark.skipif(not SETUP, reason="run by tools/windows/test (builds the installer, needs Wine)"),
+              pytest.mark.timeout(900)]
+
+UNINSTALL_KEY = r"HKCU\Software\Microsoft\Windows\CurrentVersion\Uninstall\nfwserver"
+RUN_KEY = r"HKCU\Software\Microsoft\Windows\CurrentVersion\Run"
+#: The Start-menu entries and the command line each must run.
+MENU = {"nfwserver station.lnk": ("nfwserver.exe", "run"), "nfwserver dashboard.lnk": ("nfwserverw.exe", "dashboard"),
+        "nfwserver configuration.lnk": ("nfwserverw.exe", "config edit"),
+        "Stop the station.lnk": ("nfwserverw.exe", "stop")}
+
+
+def wait_until(predicate: Callable[[], bool], timeout_s: float, what: str) -> None:
+    """Return once ``predicate()`` holds; fail naming ``what`` when it has not within ``timeout_s``."""
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        assert time.monotonic() < deadline, f"not within {timeout_s:g} s: {what}"
+        time.sleep(0.2)
+
+
+def winpath(path: Path) -> str:
+    """A Linux path as Wine's Z: drive names it."""
+    return "Z:" + str(path.resolve()).replace("/", "\\")
+
+
+class Installed:
+    """What the tests share: the prefix, the program's folder and the user's folder, the probes."""
+
+    def __init__(self, prefix: WinePrefix, tools: Path) -> None:
+        self.prefix = prefix
+        self.folder = prefix.local_appdata / "Programs" / "nfwserver"
+        self.exe = str(self.folder / "nfwserver.exe")
+        self.exe_w = str(self.folder / "nfwserverw.exe")
+        self.user_files = prefix.unix(prefix.local_appdata / "nfwserver")
+        self.menu = prefix.unix(prefix.appdata / "Microsoft" / "Windows" / "Start Menu" / "Programs" / "nfwserver")
+        self.tools = tools
+
+    def nfwserver(self, *args: str, timeout_s: float = 180.0) -> subprocess.CompletedProcess[str]:
+        return self.prefix.run([self.exe, *args], timeout_s)
+
+    def setup(self, *args: str) -> int:
+        """The installer, silently (``/S``); its exit status."""
+        assert SETUP is not None
+        return self.prefix.run_detached([winpath(Path(SETUP)), "/S", *args])
+
+    def running_pid(self) -> int | None:
+        """The pid the user's running station describes itself with (station.json), or None."""
+        info = self.user_files / "station.json"
+        try:
+            return int(re.search(r'"pid": (\d+)', info.read_text()).group(1))  # type: ignore[union-attr]
+        except (OSError, AttributeError):
+            return None
+
+
+def _compile(source: str, out: Path, *libs: str) -> None:
+    unicode = ["-municode"] if "lnk" in source else []
+    subprocess.run(["x86_64-w64-mingw32-gcc", "-O2", "-Wall", *unicode, "-o", str(out),
+                    str(ROOT / "tests" / "windows" / source), *libs], check=True, timeout=120)
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory) -> Iterator[Installed]:
+    tools = tmp_path_factory.mktemp("probes")
+    _compile("ddeml_probe.c", tools / "ddeml_probe.exe", "-luser32")
+    _compile("lnk_probe.c", tools / "lnk_probe.exe", "-lole32", "-luuid", "-lshell32")
+    prefix = WinePrefix(tmp_path_factory.mktemp("wine") / "prefix")
+    try:
+        assert not list((prefix.root / "drive_c").rglob("python*.exe")), "the fresh prefix has a Python"
+        yield Installed(prefix, tools)
+    finally:
+        prefix.close()
+
+
+def test_two_builds_of_one_commit_are_the_same_bytes_and_the_setup_is_small() -> None:
+    assert SETUP is not None and REBUILT is not None
+    first, second = Path(SETUP), Path(REBUILT)
+    assert first.name == second.name == f"nfwserver-{__version__}-setup.exe"
+    assert first.read_bytes() == second.read_bytes()
+    assert first.stat().st_size <= 40 * 1024 * 1024
+
+
+def test_a_silent_install_registers_for_apps_and_features(installed: Installed) -> None:
+    assert installed.setup() == 0
+    values = installed.prefix.reg_values(UNINSTALL_KEY)
+    assert values is not None
+    folder = str(installed.folder)
+    assert values["DisplayName"] == f"nfwserver {__version__}" and values["DisplayVersion"] == __version__
+    assert values["Publisher"] and values["InstallLocation"] == folder
+    assert values["DisplayIcon"] == f'"{folder}\\nfwserver.exe",0'
+    assert values["UninstallString"] == f'"{folder}\\uninstall.exe"'
+    assert values["QuietUninstallString"] == f'"{folder}\\uninstall.exe" /S'
+    installed_kib = sum(p.stat().st_size for p in installed.prefix.unix(installed.folder).rglob("*")
+                        if p.is_file()) / 1024
+    assert 0.9 * installed_kib <= int(values["EstimatedSize"], 16) <= 1.1 * installed_kib
+    version = installed.nfwserver("--version")
+    assert version.returncode == 0 and version.stdout.strip() == f"nfwserver {__version__}"
+    program = installed.prefix.unix(installed.folder)
+    assert (program / "nfwserver.exe").is_file() and not (program / "python.exe").exists()
+    assert installed.prefix.reg_values(RUN_KEY) is None or "nfwserver" not in installed.prefix.reg_values(RUN_KEY)
+
+
+def test_the_start_menu_entries_run_files_that_exist(installed: Installed) -> None:
+    links = sorted(p.name for p in installed.menu.glob("*.lnk"))
+    assert links == sorted(MENU)
+    probe = installed.prefix.run([winpath(installed.tools / "lnk_probe.exe"), *(winpath(installed.menu / name)
+                                                                               for name in links)])
+    assert probe.returncode == 0, probe.stderr
+    for name, line in zip(links, probe.stdout.splitlines()):
+        target, args, _folder = line.split("|")
+        program, expected_args = MENU[name]
+        assert PureWindowsPath(target) == installed.folder / program and args == expected_args, name
+        assert installed.prefix.unix(target).is_file(), target
+
+
+def test_the_installed_configuration_serves_the_dashboard_on_loopback(installed: Installed) -> None:
+    config = installed.user_files / "config.toml"
+    assert config.is_file()
+    shown = installed.nfwserver("config", "show")
+    assert shown.returncode == 0, shown.stderr
+    web = shown.stdout.split("[web]", 1)[1].split("\n[", 1)[0]
+    assert re.search(r"^enabled = true\b", web, re.M) and re.search(r'^host = "127\.0\.0\.1"', web, re.M)
+
+
+def test_the_installed_program_serves_ddeml_clients_and_stops_on_request(installed: Installed) -> None:
+    station = installed.prefix.start([installed.exe, "run", "--headless"])
+    try:
+        probe = installed.prefix.run([winpath(installed.tools / "ddeml_probe.exe"), "120", "3", "NFW32",
+                                      "NFW_SERVER"], 300)
+        assert probe.returncode == 0, probe.stderr
+        lines = probe.stdout.splitlines()
+        for service in ("NFW32", "NFW_SERVER"):
+            got = [line.split(": ", 1)[1] for line in lines if line.split(": ", 1)[0].endswith(f" {service}")]
+            assert len(got) == 4 and all(NOVA.match(text) for text in got), (service, got)  # 1 request, 3 advises
+        dash = installed.nfwserver("dashboard", "--print")
+        assert dash.returncode == 0, dash.stderr
+        with urllib.request.urlopen(dash.stdout.strip(), timeout=20) as page:
+            assert page.status == 200 and b"<html" in page.read(4096).lower()
+        pid = installed.running_pid()
+        stop = installed.nfwserver("stop")
+        assert stop.returncode == 0, stop.stderr
+        assert stop.stdout.strip() == f"stopped the station (process {pid})"
+        assert station.wait(60) == 0  # a clean stop, not a kill
+        log = (installed.user_files / "Logs" / "nfwserver.log").read_text(encoding="utf-8", errors="replace")
+        assert "control file" in log and log.rstrip().endswith("stopped")
+        again = installed.nfwserver("stop")
+        assert again.returncode == 1 and again.stdout == ""
+        assert again.stderr.strip().endswith("no station is running for this user: nothing to stop")
+    finally:
+        if station.poll() is None:
+            station.kill()
+            station.wait(30)
+
+
+def test_an_upgrade_keeps_the_users_files_and_restarts_a_station_started_at_logon(installed: Installed) -> None:
+    assert installed.nfwserver("config", "set", "observer.location", "JO01ab").returncode == 0
+    config = installed.user_files / "config.toml"
+    before = config.read_text()
+    assert 'location = "JO01ab"' in before
+    state = installed.user_files / "state.json"
+    assert json.loads(state.read_text())["satellite"] == 25544, "the earlier run saved no state"
+    logon = installed.prefix.start([installed.exe_w, "run", "--headless"])  # as the Run key starts it
+    try:
+        wait_until(lambda: installed.running_pid() is not None, 120, "the windowless station started")
+        upgrade_started_ns = time.time_ns()
+        assert installed.setup("/LOGON") == 0
+        assert logon.wait(60) == 0  # the old station was stopped cleanly by the upgrade
+    finally:
+        if logon.poll() is None:
+            logon.kill()
+            logon.wait(30)
+    run_value = (installed.prefix.reg_values(RUN_KEY) or {}).get("nfwserver")
+    assert run_value == f'"{installed.folder}\\nfwserverw.exe" run --headless'
+    description = installed.user_files / "station.json"  # removed by the old station, written by the new one
+    wait_until(lambda: installed.running_pid() is not None and description.stat().st_mtime_ns > upgrade_started_ns,
+               120, "the upgraded station started again")
+    assert config.read_text() == before
+    assert json.loads(state.read_text())["satellite"] == 25544
+    assert (installed.user_files / "Logs" / "nfwserver.log").is_file()
+    stop = installed.nfwserver("stop")
+    assert stop.returncode == 0, stop.stderr
+    # Installed again without /LOGON: start at logon stays as the user chose; /LOGON=0 switches it off.
+    assert installed.setup() == 0
+    assert "nfwserver" in (installed.prefix.reg_values(RUN_KEY) or {})
+    assert installed.setup("/LOGON=0") == 0
+    assert "nfwserver" not in (installed.prefix.reg_values(RUN_KEY) or {})
+    assert config.read_text() == before
+
+
+def test_the_quiet_uninstall_removes_the_program_and_keeps_the_users_files(installed: Installed) -> None:
+    assert installed.setup("/LOGON") == 0  # so that the uninstall has a Run entry to remove
+    values = installed.prefix.reg_values(UNINSTALL_KEY)
+    assert values is not None
+    command = values["QuietUninstallString"]
+    program, switch = command.rsplit(" ", 1)
+    assert installed.prefix.run_detached([program.strip('"'), switch]) == 0
+    folder = installed.prefix.unix(installed.folder)
+    # The uninstaller runs on from a copy of itself in %TEMP%: wait for its work to be done.
+    wait_until(lambda: not folder.exists(), 120, f"{folder} removed")
+    wait_until(lambda: installed.prefix.reg_values(UNINSTALL_KEY) is None, 60, "the uninstall key removed")
+    assert not installed.menu.exists()
+    assert "nfwserver" not in (installed.prefix.reg_values(RUN_KEY) or {})
+    assert 'location = "JO01ab"' in (installed.user_files / "config.toml").read_text()
+    assert (installed.user_files / "state.json").is_file()
+    assert (installed.user_files / "Logs" / "nfwserver.log").is_file()
+
+
+def test_another_folder_chosen_with_d_is_installed_to_and_removed_from(installed: Installed) -> None:
+    folder = PureWindowsPath(r"C:\Radio\nfw server")
+    # NSIS takes /D= last and unquoted, spaces and all, as typed in cmd; Wine would quote an argument with a
+    # space, so the command line goes through cmd as one string.
+    assert SETUP is not None
+    assert installed.prefix.run_detached(["cmd", "/c", f"{winpath(Path(SETUP))} /S /D={folder}"]) == 0
+    values = installed.prefix.reg_values(UNINSTALL_KEY)
+    assert values is not None and values["InstallLocation"] == str(folder)
+    version = installed.prefix.run([str(folder / "nfwserver.exe"), "--version"])
+    assert version.returncode == 0 and version.stdout.strip() == f"nfwserver {__version__}"
+    assert not installed.prefix.unix(installed.folder).exists()
+    program, switch = values["QuietUninstallString"].rsplit(" ", 1)
+    assert installed.prefix.run_detached([program.strip('"'), switch]) == 0
+    wait_until(lambda: not installed.prefix.unix(folder).exists(), 120, f"{folder} removed")
+    assert installed.prefix.unix(folder.parent).is_dir()  # only the program's own folder goes

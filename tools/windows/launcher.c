@@ -1,0 +1,79 @@
+/* nfwserver.exe / nfwserverw.exe: the installed program's entry points.
+ *
+ * Each loads the embeddable CPython that sits beside it (python312.dll, its ._pth file naming the
+ * standard library zip and Lib\site-packages) and runs `python -I -m nfwserver ARGS...` inside this
+ * process, so the station shows as nfwserver.exe in the Task Manager and a console's Ctrl+C reaches
+ * Python directly.  nfwserver.exe is a console program (the station's console, every command);
+ * nfwserverw.exe is built with NFW_WINDOWLESS as a GUI-subsystem program with no console window (start at
+ * logon, the Start-menu entries that need no terminal).  Built by tools/windows/build with mingw-w64.
+ */
+#include <windows.h>
+#include <shellapi.h>
+#include <stdlib.h>
+#include <wchar.h>
+
+typedef int(__cdecl *py_main_fn)(int, wchar_t **);
+
+static int fail(const wchar_t *what, const wchar_t *detail)
+{
+    wchar_t text[2048];
+    _snwprintf(text, sizeof text / sizeof text[0] - 1, L"nfwserver: %ls%ls (reinstall nfwserver to repair)", what,
+               detail);
+    text[sizeof text / sizeof text[0] - 1] = 0;
+#ifdef NFW_WINDOWLESS
+    MessageBoxW(NULL, text, L"nfwserver", MB_OK | MB_ICONERROR);
+#else
+    fwprintf(stderr, L"%ls\n", text);
+#endif
+    return 3;
+}
+
+static int launch(void)
+{
+    static const wchar_t *const fixed[] = {L"-I", L"-m", L"nfwserver"};
+    const int nfixed = (int)(sizeof fixed / sizeof fixed[0]);
+    wchar_t dll[32768];
+    DWORD n = GetModuleFileNameW(NULL, dll, (DWORD)(sizeof dll / sizeof dll[0]));
+    if (n == 0 || n >= sizeof dll / sizeof dll[0] - 32)
+        return fail(L"cannot find where this program is installed", L"");
+    wchar_t *slash = wcsrchr(dll, L'\\');
+    if (slash == NULL)
+        return fail(L"cannot find where this program is installed", L"");
+    wcscpy(slash + 1, L"python312.dll");
+    HMODULE python = LoadLibraryExW(dll, NULL, LOAD_WITH_ALTERED_SEARCH_PATH);
+    if (python == NULL)
+        return fail(L"cannot load ", dll);
+    py_main_fn py_main = (py_main_fn)(void (*)(void))GetProcAddress(python, "Py_Main");
+    if (py_main == NULL)
+        return fail(L"no Py_Main in ", dll);
+
+    int argc = 0;
+    wchar_t **argv = CommandLineToArgvW(GetCommandLineW(), &argc);
+    if (argv == NULL || argc < 1)
+        return fail(L"cannot read the command line", L"");
+    wchar_t **args = calloc((size_t)argc + (size_t)nfixed + 1, sizeof *args);
+    if (args == NULL)
+        return fail(L"out of memory", L"");
+    args[0] = argv[0];
+    for (int i = 0; i < nfixed; i++)
+        args[1 + i] = (wchar_t *)fixed[i];
+    for (int i = 1; i < argc; i++)
+        args[nfixed + i] = argv[i];
+    return py_main(argc + nfixed, args);
+}
+
+#ifdef NFW_WINDOWLESS
+int WINAPI wWinMain(HINSTANCE instance, HINSTANCE previous, PWSTR command_line, int show)
+{
+    (void)instance;
+    (void)previous;
+    (void)command_line;
+    (void)show;
+    return launch();
+}
+#else
+int wmain(void)
+{
+    return launch();
+}
+#endif
