@@ -1,9 +1,10 @@
 """Run every ``bench/bench_*.py`` and write their Markdown sections to ``docs/BENCHMARKS.md``.
 
-Usage: ``python -m bench [NAME ...]`` (names without the ``bench_`` prefix select a subset; the
-file is then updated only for those sections; ``-`` and ``_`` are the same in names).  Each benchmark
-module is run as its own process (``python -m bench.bench_NAME``) and prints one Markdown section,
-starting with a ``## `` heading, on stdout; a benchmark that prints nothing leaves its section as it was.
+Usage: ``python -m bench [NAME ...]`` (``python -m bench --help`` lists them; names without the ``bench_``
+prefix select a subset; the file is then updated only for those sections; ``-`` and ``_`` are the same in
+names).  Each benchmark module is run as its own process (``python -m bench.bench_NAME``) and prints one
+Markdown section, starting with a ``## `` heading, on stdout; a benchmark that prints nothing leaves its section
+as it was.
 Benchmarks in ``OPT_IN`` run only when named: ``wine-dde`` needs a Wine prefix (tools/wine/setup).
 ``python -m bench reliability [OPTIONS]`` (``STANDALONE``) runs the hostile-input and fault campaign
 (bench/bench_reliability.py) with its output on the terminal and its options passed on; its figures go to
@@ -48,7 +49,31 @@ def _sections(text: str) -> dict[str, str]:
     return {p.splitlines()[0]: p.rstrip() + "\n" for p in parts if p.startswith("## ")}
 
 
+def _summary(name: str) -> str:
+    """The first line of ``bench/bench_NAME.py``'s docstring, without its quotes."""
+    for line in (ROOT / "bench" / f"bench_{name}.py").read_text().splitlines():
+        if line.strip():
+            return line.strip().strip('"').strip()
+    return ""
+
+
+def _help() -> str:
+    names = sorted(p.stem[len("bench_") :] for p in (ROOT / "bench").glob("bench_*.py"))
+    width = max(len(n) for n in names) + 2
+    lines = ["usage: python -m bench [NAME ...]   (or: python -m bench reliability|faults [OPTIONS])", "",
+             "Runs the benchmarks named (every one but the opt-in ones without a name) and writes their sections "
+             "to docs/BENCHMARKS.md.", "", "benchmarks:"]
+    for name in names:
+        note = " (opt-in: run only when named)" if name in OPT_IN else (
+            " (alone, with its own options; writes no section)" if name in STANDALONE else "")
+        lines.append(f"  {name.replace('_', '-'):{width}}{_summary(name)}{note}")
+    return "\n".join(lines)
+
+
 def main(argv: list[str]) -> int:
+    if argv and argv[0] in ("-h", "--help", "help"):
+        print(_help())
+        return 0
     if argv and argv[0] in STANDALONE:
         return subprocess.run([sys.executable, "-m", f"bench.bench_{argv[0]}", *argv[1:]], cwd=ROOT).returncode
     names = sorted(p.stem[len("bench_") :] for p in (ROOT / "bench").glob("bench_*.py")
@@ -79,7 +104,9 @@ def main(argv: list[str]) -> int:
             old[heading] = section
         print(f"  done in {time.monotonic() - started:.1f} s", file=sys.stderr)
     stamp = time.strftime("%Y-%m-%d", time.gmtime())
-    text = HEADER + f"\nLast run {stamp}. {_machine()}\n\n" + "\n".join(old[h] for h in sorted(old))
+    ran = ", ".join(n.replace("_", "-") for n in chosen)
+    text = HEADER + f"\nLast run {stamp}: {ran} (other sections are from earlier runs). {_machine()}\n\n" + \
+        "\n".join(old[h] for h in sorted(old))
     OUT.parent.mkdir(exist_ok=True)
     OUT.write_text(text)
     print(f"wrote {OUT.relative_to(ROOT)}", file=sys.stderr)

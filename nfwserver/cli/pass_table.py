@@ -16,11 +16,12 @@ import fnmatch
 import re
 import time
 from collections.abc import Iterable, Sequence
-from datetime import datetime, timezone
+from datetime import datetime
 
 import numpy as np
 
 from nfwserver.cli.output_columns import Cells, Column, Integer, Number, Text, Time, epoch_us_after, iso_codes
+from nfwserver.cli.pass_text import zone_label
 
 __all__ = ["ClockTime", "compact_columns", "local_offsets_us", "matching_names", "zone_label"]
 
@@ -55,13 +56,6 @@ def local_offsets_us(start: datetime, seconds: np.ndarray) -> np.ndarray:
     quarters, where = np.unique(epoch_s // 900, return_inverse=True)  # zones change on quarter hours
     offsets = [time.localtime(int(q) * 900).tm_gmtoff * 1_000_000 for q in quarters.tolist()]
     return np.asarray(offsets, dtype=np.int64)[where] if len(offsets) else np.zeros(0, dtype=np.int64)
-
-
-def zone_label(local: bool, when: datetime) -> str:
-    """``UTC``, or the local zone's abbreviation at ``when`` (``CEST``)."""
-    if not local:
-        return "UTC"
-    return time.strftime("%Z", time.localtime(when.astimezone(timezone.utc).timestamp())) or "local"
 
 
 def compact_columns(start: datetime, cols: dict[str, np.ndarray], names: Sequence[str], which: np.ndarray,

@@ -19,10 +19,9 @@ from typing import TYPE_CHECKING, Any
 
 from nfwserver.cli.arguments import number_in, satellite_value, time_value
 from nfwserver.cli.errors import CliError, say
-from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs
+from nfwserver.cli.tracking_options import TrackingInputs, add_tracking_options, format_time, load_tracking_inputs
 
 if TYPE_CHECKING:
-    from nfwserver.cli.tracking_options import TrackingInputs
     from nfwserver.tracking.catalog import Catalog, Satellite
     from nfwserver.tracking.observer import Observer
     from nfwserver.tracking.pass_records import PassList
@@ -76,8 +75,9 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     p.add_argument("--wide", action="store_true",
                    help="a table with every column (catalog number, full name, ISO times with milliseconds, "
                    "azimuths, duration in seconds, in_progress)")
-    p.add_argument("--workers", type=number_in(1, 64, integer=True), default=1, metavar="N",
-                   help="worker processes for large catalogs (POSIX; default 1)")
+    p.add_argument("--workers", type=_workers_value, default="auto", metavar="N|auto",
+                   help="worker processes for large catalogs (POSIX; the rows are the same whatever the number); "
+                   "auto (the default): one per idle core for 1,000 satellites or more, else 1")
     p.set_defaults(func=run_passes)
 
     p = subparsers.add_parser("visible", help="satellites above the horizon table at an instant",
@@ -87,9 +87,13 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     p.set_defaults(func=run_visible)
 
 
+def _workers_value(text: str) -> int | str:
+    """``type=`` for ``--workers``: ``auto`` or a whole number from 1 to 64."""
+    return "auto" if text.strip().lower() == "auto" else int(number_in(1, 64, integer=True)(text))
+
+
 def _pick(catalog: Catalog, text: str) -> Satellite:
     """The satellite ``text`` names (catalog number, DDE or element name); CliError when absent."""
-
     sat = catalog.find(text)
     if sat is None:
         raise CliError(f"satellite {text} is not in the catalog")
@@ -189,6 +193,18 @@ def run_ephemeris(args: argparse.Namespace) -> int:
 
 
 def run_passes(args: argparse.Namespace) -> int:
+    from nfwserver.cli.few_passes_command import run_few_passes
+
+    inputs = TrackingInputs(args)  # the configuration only if an option leaves a value to it
+    for name in ("horizon", "observer", "ut1_utc"):  # resolved (and reported) in this order, before the catalog
+        getattr(inputs, name)
+    sets = _chosen_sets(args, inputs, inputs.catalog)
+    if run_few_passes(args, inputs, sets):  # a few satellites: found and written without numpy
+        return 0
+    return _run_catalog_passes(args, inputs, sets)
+
+
+def _run_catalog_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: list[Any]) -> int:
     import numpy as np
 
     from nfwserver.cli.bulk_output import write_rows
@@ -196,26 +212,23 @@ def run_passes(args: argparse.Namespace) -> int:
     from nfwserver.cli.pass_table import compact_columns
 
     start = args.start
-    passes, names, short_names, searched = _find_passes(args)  # the catalog is gone: its memory serves the output
+    passes, names, short_names, searched = _find_passes(args, inputs, sets)  # the catalog's memory serves the output
     cols = passes.columns
     if args.min_el != 0.0:
         keep = cols["max_elevation_deg"] >= args.min_el
         cols = {key: value[keep] for key, value in cols.items()}
     numbers = np.array(sorted(names), dtype=np.int64)
     which = np.searchsorted(numbers, cols["catalog_number"])
-    if args.format == "table" and not args.wide:
+    compact = args.format == "table" and not args.wide
+    up = cols["catalog_number"][np.isnan(cols["aos_s"]) & np.isnan(cols["los_s"])].tolist()
+    always_up_note([(short_names if compact else names)[n] for n in up])
+    if compact:
         if not len(cols["catalog_number"]):
-            reach = f" reaching {args.min_el:g} deg" if args.min_el else ""
-            say(f"no passes{reach} of the {searched} satellite(s) in the {args.hours:g} h from "
-                 f"{format_time(start)}")
+            no_passes_warning(args, searched)
         write_rows(compact_columns(start, cols, [short_names[n] for n in numbers.tolist()], which, args.local),
                    "table", sys.stdout)
         return 0
-    if args.local and args.format == "table":
-        from nfwserver.cli.pass_table import zone_label
-
-        print(f"times in UTC: --local shortens the table's times only ({zone_label(True, start)} here); "
-              "drop --wide to see them", file=sys.stderr)
+    wide_table_local_note(args)
     aos_unknown, los_unknown = np.isnan(cols["aos_s"]), np.isnan(cols["los_s"])
     aos, los = Time("aos_utc", start, cols["aos_s"], aos_unknown), Time("los_utc", start, cols["los_s"], los_unknown)
     write_rows([Integer("catalog_number", cols["catalog_number"]), Text("name", [names[n] for n in numbers.tolist()],
@@ -228,50 +241,81 @@ def run_passes(args: argparse.Namespace) -> int:
     return 0
 
 
-def _find_passes(args: argparse.Namespace) -> tuple[PassList, dict[int, str], dict[int, str], int]:
-    """The passes the options ask for, the name and the DDE name (at most 12 characters; only for the compact
-    table, which alone shows them) to show for each satellite that has one (by catalog number), and how many
-    satellites were searched."""
-    from nfwserver.cli.tracking_options import TrackingInputs
-    from nfwserver.tracking.passes import find_passes
-    from nfwserver.tracking.screening import stale_satellites
+def no_passes_warning(args: argparse.Namespace, searched: int) -> None:
+    """The compact table's line on stderr when no pass is listed."""
+    reach = f" reaching {args.min_el:g} deg" if args.min_el else ""
+    say(f"no passes{reach} of the {searched} satellite(s) in the {args.hours:g} h from {format_time(args.start)}")
+
+
+def always_up_note(names: Sequence[str]) -> None:
+    """Name on stderr the satellites (``names``) whose rows have neither AOS nor LOS because they stay up."""
+    if names:
+        shown = ", ".join(names[:5]) + (", ..." if len(names) > 5 else "")
+        say(f"up for the whole window (above the horizon from before the search to after it, so no AOS or "
+             f"LOS): {shown}")
+
+
+def wide_table_local_note(args: argparse.Namespace) -> None:
+    """``--local`` with ``--wide``: say on stderr that the wide table stays in UTC."""
+    if args.local and args.format == "table":
+        from nfwserver.cli.pass_text import zone_label
+
+        print(f"times in UTC: --local shortens the table's times only ({zone_label(True, args.start)} here); "
+              "drop --wide to see them", file=sys.stderr)
+
+
+def _find_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: list[Any]
+                 ) -> tuple[PassList, dict[int, str], dict[int, str], int]:
+    """The passes of ``sets`` over the window the options ask for, the name and the DDE name (at most 12
+    characters; only for the compact table, which alone shows them) to show for each satellite that has one
+    (by catalog number), and how many satellites were searched."""
+    from nfwserver.tracking.passes import auto_workers, find_passes
 
     start = args.start
-    inputs = TrackingInputs(args)  # the configuration only if an option leaves a value to it
-    horizon, observer, ut1_utc, catalog = inputs.horizon, inputs.observer, inputs.ut1_utc, inputs.catalog
-    sets = _chosen_sets(args, inputs, catalog)
-    compact = args.format == "table" and not args.wide  # the only output that shows DDE names
-    stale_days = _stale_days(inputs)
+    workers = auto_workers(len(sets)) if args.workers == "auto" else int(args.workers)
     # The search leaves out the sets unusable at the start (it makes their models anyway); they and the
     # stale sets are reported after it, before any row (the compact table names them with its satellites).
-    passes = find_passes(sets, observer, start, start + timedelta(hours=args.hours), horizon=horizon,
-                         ut1_utc=ut1_utc, workers=args.workers)
-    left_out = set(passes.skipped)
+    passes = find_passes(sets, inputs.observer, start, start + timedelta(hours=args.hours), horizon=inputs.horizon,
+                         ut1_utc=inputs.ut1_utc, workers=workers)
+    numbers = passes.catalog_numbers()
+    names, short_names, searched = pass_names(args, inputs, sets, passes.skipped, numbers)
+    return passes, names, short_names, searched
+
+
+def pass_names(args: argparse.Namespace, inputs: TrackingInputs, sets: list[Any], skipped: Sequence[int],
+               numbers: Sequence[int]) -> tuple[dict[int, str], dict[int, str], int]:
+    """After a search of ``sets`` that left out ``skipped`` and found passes of ``numbers``: the unusable and
+    the stale sets reported on stderr; the name and the DDE name (compact table only) to show for each of
+    ``numbers``, and how many satellites were searched."""
+    from nfwserver.tracking.staleness import stale_satellites
+
+    compact = args.format == "table" and not args.wide  # the only output that shows DDE names
+    stale_days = _stale_days(inputs)
+    left_out = set(skipped)
     unusable = [s for s in sets if s.catalog_number in left_out]
     sets = [s for s in sets if s.catalog_number not in left_out] if left_out else sets
-    stale = stale_satellites(sets, start, stale_days)
-    numbers = passes.catalog_numbers()
+    stale = stale_satellites(sets, args.start, stale_days)
     by_number = {es.catalog_number: es.name for es in sets}
     element_names = {n: by_number[n] for n in numbers}
     # Every DDE name shown (the warnings', the compact table's, those of unnamed sets) from one naming.
-    dde = _dde_name_map(unusable[:5] + stale[:5], catalog,
+    dde = _dde_name_map(unusable[:5] + stale[:5], inputs.catalog,
                         numbers if compact else [n for n, name in element_names.items() if not name])
-    _report_unusable(unusable, dde, start)
-    _report_stale(stale, dde, start, stale_days)
-    return (passes, {n: name or dde[n] for n, name in element_names.items()},
-            {n: dde[n] for n in numbers} if compact else {}, len(sets))
+    _report_unusable(unusable, dde, args.start)
+    _report_stale(stale, dde, args.start, stale_days)
+    return ({n: name or dde[n] for n, name in element_names.items()}, {n: dde[n] for n in numbers} if compact else {},
+            len(sets))
 
 
 def _chosen_sets(args: argparse.Namespace, inputs: TrackingInputs, catalog: Catalog) -> list[Any]:
     """The element sets ``passes`` searches: --sat, --group, --favourites; else the configured favourites
     (when there are some and no --elements file or --all was given); else the whole catalog."""
-    from nfwserver.cli.pass_table import matching_names
-
     chosen: dict[int, Any] = {}
     for text in args.sat:
         sat = _pick(catalog, text)
         chosen[sat.catalog_number] = sat
     if args.group:
+        from nfwserver.cli.pass_table import matching_names  # with numpy: only for --group
+
         found = matching_names(args.group, ((s.catalog_number, s.dde_name, s.name) for s in catalog))
         if not found:
             raise CliError(f"no satellite's name matches {', '.join(args.group)}")

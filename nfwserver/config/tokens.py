@@ -10,9 +10,8 @@ characters from :mod:`secrets` (144 bits).
 
 from __future__ import annotations
 
-import hashlib
-import hmac
-import secrets
+# hashlib, hmac and secrets are imported where they are used: they load OpenSSL's libcrypto (about 3.5 MiB and a
+# few milliseconds), which every command reading the configuration (``passes --sat``) would pay for nothing.
 
 __all__ = ["MIN_TOKEN_CHARS", "TEMPLATE_TOKEN", "new_token", "token_matches", "weak_token_reason"]
 
@@ -42,6 +41,8 @@ def weak_token_reason(token: str) -> str | None:
 
 def new_token() -> str:
     """A fresh random token of 24 URL-safe characters (never weak by :func:`weak_token_reason`)."""
+    import secrets
+
     while True:
         token = secrets.token_urlsafe(18)
         if weak_token_reason(token) is None:
@@ -51,6 +52,9 @@ def new_token() -> str:
 def token_matches(given: str, expected: str) -> bool:
     """Whether ``given`` is ``expected``, in a time that depends on neither (their SHA-256 digests are
     compared with :func:`hmac.compare_digest`, so not even the length leaks)."""
+    import hashlib
+    import hmac
+
     digest = hashlib.sha256
     return hmac.compare_digest(digest(given.encode("utf-8", "surrogatepass")).digest(),
                                digest(expected.encode("utf-8", "surrogatepass")).digest())

@@ -129,13 +129,16 @@ def _left_out(out: Text, search: PassSearch, catalog: Catalog) -> Text:
 
 
 def next_pass_text(search: PassSearch | None, times: TimeDisplay, now: datetime) -> str:
-    """``Next pass 05-08 19:30:39 max 39 deg LOS 19:41:12 UTC`` (or in progress, or none)."""
+    """``Next pass 05-08 19:30:39 max 39 deg LOS 19:41:12 UTC`` (or in progress, up for the whole window, or
+    none)."""
     if search is None:
         return "Next pass: searching..."
     p = search.next_pass
     if p is None:
         return f"Next pass: none in the next {NEXT_PASS_HOURS:g} h"
     zone = times.zone(now)
+    if p.aos is None and p.los is None:  # above the horizon throughout the search (a geostationary satellite)
+        return f"Up for the whole window: max {p.max_elevation_deg:.0f} deg at {times.clock(p.tca)} {zone}"
     if p.aos is None or p.aos <= now:
         return (f"Pass in progress: max {p.max_elevation_deg:.0f} deg at {times.clock(p.tca)}, "
                 f"LOS {times.clock(p.los)} {zone}")

@@ -22,6 +22,7 @@ import csv
 import gc
 import json
 import os
+import sys
 from collections.abc import Callable
 from datetime import datetime, timedelta
 from pathlib import Path
@@ -39,7 +40,6 @@ from nfwserver.tracking.element_set import (
     is_csv_header,
 )
 from nfwserver.tracking.tle import TleError, epoch_from_tle, parse_tle
-from nfwserver.tracking.tle_bulk import read_canonical
 
 __all__ = ["MAX_CSV_ROW", "ElementSet", "LoadResult", "Rejection", "load_element_file", "load_elements"]
 #: Longest line read as a name line (characters); the name is then cut to MAX_NAME_LENGTH.
@@ -209,9 +209,14 @@ def _build_tles(pending: list[Any], source: str, result: LoadResult) -> None:
 
 def _build_block(pending: list[Any], source: str, result: LoadResult, years: dict[int, datetime]) -> None:
     pairs = [p for p in pending if not isinstance(p, Rejection)]
-    good, values = read_canonical([p[2] for p in pairs], [p[3] for p in pairs])
-    rows = zip(*(values[c].tolist() for c in _BULK_COLUMNS)) if values else iter(())
-    good_list = good.tolist()
+    rows: Any = iter(())
+    good_list = [False] * len(pairs)
+    if len(pairs) >= _BULK_MIN or "numpy" in sys.modules:  # else no numpy to import (a command for one satellite)
+        from nfwserver.tracking.tle_bulk import read_canonical
+
+        good, values = read_canonical([p[2] for p in pairs], [p[3] for p in pairs])
+        rows = zip(*(values[c].tolist() for c in _BULK_COLUMNS)) if values else iter(())
+        good_list = good.tolist()
     k = 0
     for item in pending:
         if isinstance(item, Rejection):
@@ -240,6 +245,9 @@ def _build_block(pending: list[Any], source: str, result: LoadResult, years: dic
 
 #: Columns of tle_bulk.read_canonical a set keeps as values (the others are read from its lines when asked).
 _BULK_COLUMNS = ("year2", "day", "catalog_number")
+#: Fewest TLE pairs of a block read in bulk (numpy, 12 us a set) unless numpy is loaded already; fewer are read by
+#: parse_tle (67 us a set), which gives the same values: below this, importing numpy (60-90 ms) costs more.
+_BULK_MIN = 768
 
 
 def _take_amsat(lines: list[str], i: int, source: str, result: LoadResult) -> int:

@@ -23,17 +23,20 @@ Passes already in progress at ``start`` are reported with
 their true AOS before ``start`` (``aos_before_start``), passes in progress at ``end`` with their
 LOS after it: the search looks back and ahead by up to one orbital period (at most a day; half a
 period for near-circular orbits shorter than three hours, whose passes last less than that).  A
-satellite that stays up over the whole extended search (a geostationary satellite, say) has no AOS
-or LOS and gets no pass, rather than bogus events; one whose rise or set lies beyond the
-extension gets ``None`` for that time.
+satellite that stays up over the whole extended search (a geostationary satellite in view, say) gets
+one pass with neither AOS nor LOS (``None``: both beyond the search), whose TCA is the highest point
+inside the window (:mod:`~nfwserver.tracking.pass_always_up`), rather than no pass or bogus events; one
+whose rise or set lies beyond the extension gets ``None`` for that time.
 """
 
 from __future__ import annotations
 
 import math
+import os
 import sys
 import threading
 from collections.abc import Sequence
+from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 from typing import TYPE_CHECKING, Any
 
@@ -43,6 +46,7 @@ from nfwserver.tracking.constants import MINUTES_PER_DAY, SECONDS_PER_DAY
 from nfwserver.tracking.frames import TopocentricFrame
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer
+from nfwserver.tracking.pass_always_up import always_up_columns
 from nfwserver.tracking.pass_assemble import assemble
 from nfwserver.tracking.pass_batch import Batch, Chunk
 from nfwserver.tracking.pass_kinematics import PairEvaluator
@@ -67,14 +71,30 @@ _LOW_STEP_S, _SLOW_STEP_S, _OTHER_STEP_S = 1200.0, 3600.0, 1200.0
 _CHUNK = 200
 #: Brackets refined together (at least; a batch takes whole chunks): bounds the memory of one refinement.
 _BATCH_BRACKETS = 10000
+#: Fewest satellites for which :func:`auto_workers` forks (below, forking and gathering cost about what they save).
+AUTO_WORKERS_FROM = 1000
+#: Most worker processes :func:`auto_workers` chooses.
+AUTO_WORKERS_MAX = 8
+
+
+def auto_workers(satellites: int) -> int:
+    """Worker processes that pay for a search of ``satellites`` here and now: one per core not already busy
+    (the cores this process may use less the 1-minute load average), from :data:`AUTO_WORKERS_FROM`
+    satellites; 1 on Windows (no fork).  Any number gives the same passes, bit for bit."""
+    if satellites < AUTO_WORKERS_FROM or sys.platform == "win32":
+        return 1
+    cores = os.cpu_count() or 1
+    if sys.platform == "linux":
+        cores = len(os.sched_getaffinity(0))  # the cores this process may run on
+    return max(1, min(cores - int(os.getloadavg()[0]), AUTO_WORKERS_MAX))
 
 
 def _fork_worker(satellites: list[Any], args: tuple[Any, ...], results: Connection) -> None:
-    """A forked worker's whole life: the passes of its share of the satellites, sent back through
-    ``results`` (or the exception that stopped it).  Runs in the child only; the satellites reached it by
-    the fork (Satrec objects cannot be pickled), only the result is pickled."""
+    """A forked worker's whole life: the passes of its share of the chunks (``args``: :func:`_search`'s after the
+    satellites), sent back through ``results`` (or the exception that stopped it).  Runs in the child only; the
+    satellites reached it by the fork (Satrec objects cannot be pickled), only the result is pickled."""
     try:
-        outcome: PassList | BaseException = find_passes(satellites, *args)
+        outcome: PassList | BaseException = _search(satellites, *args)
     except BaseException as exc:  # handed to the parent, which raises it
         outcome = exc
     try:
@@ -83,9 +103,11 @@ def _fork_worker(satellites: list[Any], args: tuple[Any, ...], results: Connecti
         results.close()
 
 
-def _in_forked_workers(satellites: list[Any], args: tuple[Any, ...], workers: int) -> list[PassList]:
-    """The passes of ``satellites`` found by ``workers`` forked processes, one share each (every
-    ``workers``-th satellite), in the order of the shares (POSIX: the caller checked that fork exists)."""
+def _in_forked_workers(satellites: list[Any], plan: list[_Chunk], args: tuple[Any, ...], workers: int
+                       ) -> list[PassList]:
+    """The passes of the chunks of ``plan`` found by ``workers`` forked processes, one share each (every
+    ``workers``-th chunk: the chunks of one process, so the passes are those of one process bit for bit), in
+    the order of the shares (POSIX: the caller checked that fork exists)."""
     import multiprocessing
 
     if sys.platform == "win32":  # never true here (the caller checked); it tells the type checker the rest is POSIX
@@ -97,7 +119,8 @@ def _in_forked_workers(satellites: list[Any], args: tuple[Any, ...], workers: in
     try:
         for k in range(workers):
             receiver, sender = context.Pipe(duplex=False)
-            process = context.Process(target=_fork_worker, args=(satellites[k::workers], args, sender), daemon=True)
+            process = context.Process(target=_fork_worker, args=(satellites, (plan[k::workers], *args), sender),
+                                      daemon=True)
             process.start()
             sender.close()  # the child holds its own end: EOF here if it dies without an answer
             receivers.append(receiver)
@@ -149,18 +172,11 @@ def find_passes(
     satellites are sampled proportionally more coarsely.
 
     ``workers`` > 1 splits large catalogs over that many forked processes (POSIX only; meant for
-    command-line use).  Forking a process that runs other threads can deadlock the child, so the
-    work stays in this process unless it is single-threaded.  The passes found are the same as
-    with one worker.
+    command-line use), each searching whole chunks of the one-process search.  Forking a process that runs
+    other threads can deadlock the child, so the work stays in this process unless it is single-threaded.
+    The passes found are those of one process, bit for bit.
     """
     satellites = [getattr(s, "elements", s) for s in satellites]  # a catalog satellite's element set
-    if workers > 1 and len(satellites) >= 200 * workers and threading.active_count() == 1:
-        import multiprocessing
-
-        if "fork" in multiprocessing.get_all_start_methods():
-            worker_parts = _in_forked_workers(satellites, (observer, start, end, horizon, ut1_utc, fine_step_s),
-                                              workers)
-            return PassList.concat(worker_parts[0].start, worker_parts[0].window_s, worker_parts)
     horizon = horizon or _FLAT
     if start.tzinfo is None:
         start = start.replace(tzinfo=timezone.utc)
@@ -169,6 +185,32 @@ def find_passes(
     window_s = (end - start).total_seconds()
     if end <= start or not satellites:
         return PassList(start, max(window_s, 0.0))
+    plan = _plan(satellites, window_s)
+    args = (observer, start, end, horizon, ut1_utc, fine_step_s)
+    if workers > 1 and len(plan) > 1 and threading.active_count() == 1:
+        import multiprocessing
+
+        if "fork" in multiprocessing.get_all_start_methods():
+            parts = _in_forked_workers(satellites, plan, args, min(workers, len(plan)))
+            return PassList.concat(start, window_s, parts)
+    return _search(satellites, plan, *args)
+
+
+@dataclass(frozen=True)
+class _Chunk:
+    """Satellites searched together (indices into the search's list, and their catalog numbers), their coarse
+    step (s), how far the search looks back and ahead (s), and room for their passes (rows)."""
+
+    members: np.ndarray
+    catalog_numbers: np.ndarray
+    step_s: float
+    extension_s: float
+    room: int
+
+
+def _plan(satellites: Sequence[Any], window_s: float) -> list[_Chunk]:
+    """The chunks of a search, which alone decide its passes: satellites are grouped by orbit, sorted by
+    look-back, and cut into chunks of ``_CHUNK``."""
     no, ecc, catalog_numbers = _orbits(satellites)
     periods = 2.0 * math.pi / np.maximum(no, 1e-9) * 60.0  # s
     rev_per_day = no * MINUTES_PER_DAY / (2.0 * math.pi)
@@ -178,11 +220,8 @@ def find_passes(
     look_back = np.where((ecc < 0.05) & short, 0.5, 1.0) * periods  # s
     # Room for every pass there can be over a flat horizon (one per orbit in the searched span, plus the
     # first); an obstructed horizon can split passes, and then the columns grow.
-    found = PassColumns(int(np.sum(np.ceil((window_s + 2.0 * np.minimum(look_back, SECONDS_PER_DAY)) / periods))
-                            + len(periods)))
-    batch = Batch()
-    jd_start, fr_start = julian_date(start)
-    skipped: list[int] = []
+    room = np.ceil((window_s + 2.0 * np.minimum(look_back, SECONDS_PER_DAY)) / periods) + 1.0
+    plan = []
     # The rest is split by period so that each part looks back and ahead only as far as it needs.
     for group, step in ((short, _LOW_STEP_S), (slow, _SLOW_STEP_S), (other & (periods <= 8 * 3600.0), _OTHER_STEP_S),
                         (other & (periods > 8 * 3600.0) & (periods <= 13 * 3600.0), _OTHER_STEP_S),
@@ -192,20 +231,36 @@ def find_passes(
         members = members[np.argsort(look_back[members], kind="stable")]
         for c0 in range(0, len(members), _CHUNK):
             idx = members[c0 : c0 + _CHUNK]
-            extension = float(min(np.max(look_back[idx]), SECONDS_PER_DAY))
-            models = [_model(satellites[i]) for i in idx]
-            usable = usable_models(models, observer, jd_start, fr_start, ut1_utc)
-            if not usable.all():  # the check every caller would make, on the models made here anyway
-                skipped += catalog_numbers[idx[~usable]].tolist()
-                models = [m for m, ok in zip(models, usable.tolist()) if ok]
-                idx = idx[usable]
-                if not models:
-                    continue
-            batch.add(_screen_chunk(models, catalog_numbers[idx], observer, start, end, horizon, ut1_utc,
-                                    fine_step_s, step, extension))
-            if batch.size >= _BATCH_BRACKETS:
-                found.add(_refine(batch, observer, horizon, ut1_utc))
-                batch = Batch()
+            plan.append(_Chunk(idx, catalog_numbers[idx], step, float(min(np.max(look_back[idx]), SECONDS_PER_DAY)),
+                               int(np.sum(room[idx]))))
+    return plan
+
+
+def _search(satellites: Sequence[Any], plan: list[_Chunk], observer: Observer, start: datetime, end: datetime,
+            horizon: HorizonTable, ut1_utc: float, fine_step_s: float) -> PassList:
+    """The passes of the chunks of ``plan`` (aware ``start`` and ``end``), in this process."""
+    window_s = (end - start).total_seconds()
+    found = PassColumns(sum(c.room for c in plan))
+    batch = Batch()
+    jd_start, fr_start = julian_date(start)
+    skipped: list[int] = []
+    for chunk in plan:
+        numbers = chunk.catalog_numbers
+        models = [_model(satellites[i]) for i in chunk.members.tolist()]
+        usable = usable_models(models, observer, jd_start, fr_start, ut1_utc)
+        if not usable.all():  # the check every caller would make, on the models made here anyway
+            skipped += numbers[~usable].tolist()
+            models = [m for m, ok in zip(models, usable.tolist()) if ok]
+            numbers = numbers[usable]
+            if not models:
+                continue
+        screened, always_up = _screen_chunk(models, numbers, observer, start, end, horizon, ut1_utc, fine_step_s,
+                                            chunk.step_s, chunk.extension_s)
+        batch.add(screened)
+        found.add(always_up)
+        if batch.size >= _BATCH_BRACKETS:
+            found.add(_refine(batch, observer, horizon, ut1_utc))
+            batch = Batch()
     if batch.chunks:
         found.add(_refine(batch, observer, horizon, ut1_utc))
     return found.pass_list(start, window_s, skipped)
@@ -232,8 +287,9 @@ def _model(satellite: object) -> object:
 
 def _screen_chunk(satrecs: list[Any], catalog_numbers: np.ndarray, observer: Observer, start: datetime, end: datetime,
                   horizon: HorizonTable, ut1_utc: float, fine_step_s: float, coarse_step_s: float,
-                  extension: float) -> Chunk:
-    """One chunk of satellites screened over ``[start - extension, end + extension]``."""
+                  extension: float) -> tuple[Chunk, dict[str, np.ndarray]]:
+    """One chunk of satellites screened over ``[start - extension, end + extension]``, and the passes of those
+    above the horizon throughout (PassList columns)."""
     t0 = start - timedelta(seconds=extension)
     window_s = (end - start).total_seconds()
     span = window_s + 2.0 * extension
@@ -241,7 +297,8 @@ def _screen_chunk(satrecs: list[Any], catalog_numbers: np.ndarray, observer: Obs
     ev = PairEvaluator(satrecs, observer, jd0, fr0, ut1_utc, horizon)
     brackets = screen(satrecs, TopocentricFrame(observer), horizon, jd0, fr0, span, coarse_step_s, fine_step_s,
                       ut1_utc, ev)
-    return Chunk(satrecs, catalog_numbers, jd0, fr0, span, extension, extension + window_s, brackets)
+    always_up = always_up_columns(ev, brackets, len(satrecs), catalog_numbers, extension, window_s)
+    return Chunk(satrecs, catalog_numbers, jd0, fr0, span, extension, extension + window_s, brackets), always_up
 
 
 def _refine(batch: Batch, observer: Observer, horizon: HorizonTable, ut1_utc: float) -> dict[str, np.ndarray]:

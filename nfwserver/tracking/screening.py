@@ -12,22 +12,22 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from datetime import datetime, timedelta
-from typing import Any, TypeVar
+from datetime import datetime
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from nfwserver.tracking.look_angles import look_angles_array
 from nfwserver.tracking.observer import Observer
+from nfwserver.tracking.staleness import STALE_AFTER_DAYS, stale_satellites
 from nfwserver.tracking.timescale import julian_date
 
 #: Ranges beyond this (km) are treated as propagation failures.
 MAX_PLAUSIBLE_RANGE_KM = 1.5e6
-#: Element sets older than this (days) before the time asked for are reported as stale.
-STALE_AFTER_DAYS = 30.0
 
-T = TypeVar("T")
+__all__ = ["MAX_PLAUSIBLE_RANGE_KM", "STALE_AFTER_DAYS", "Screened", "screen_satellites", "stale_satellites",
+           "usable_mask", "usable_models"]
 #: Satellites propagated at a time by :func:`usable_mask` (bounds the SGP4 models held at once).
 _BLOCK = 512
 
@@ -82,15 +82,3 @@ def _model(satellite: Any) -> Any:
     elements = getattr(satellite, "elements", satellite)
     transient = getattr(elements, "transient_satrec", None)
     return transient() if transient is not None else satellite.satrec
-
-
-def stale_satellites(satellites: Sequence[T], at: datetime, max_age_days: float = STALE_AFTER_DAYS) -> list[T]:
-    """The satellites (or element sets) whose element epoch is more than ``max_age_days`` before ``at``."""
-    oldest = at - timedelta(days=max_age_days)
-    return [s for s in satellites if _epoch(s) < oldest]
-
-
-def _epoch(item: Any) -> datetime:
-    """The element epoch (UTC) of a satellite or of an element set."""
-    epoch: datetime = getattr(item, "elements", item).epoch
-    return epoch

@@ -253,7 +253,7 @@ class PassBoard:
             own = [p for p in find_passes([sat], observer, now, now + timedelta(hours=NEXT_PASS_HOURS),
                                           horizon=snap.horizon, ut1_utc=snap.ut1_utc_s)
                    if p.los is None or p.los > now]
-        if not own:
+        if not own or (own[0].aos is None and own[0].los is None):  # the search's pass of a satellite up throughout
             return self._always_up(sat, snap, calc, now)
         p = own[0]
         try:

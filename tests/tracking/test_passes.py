@@ -81,8 +81,9 @@ def test_geostationary_objects_give_no_bogus_events() -> None:
                 before = calc.compute(ACTIVE[p.catalog_number].satrec, when - timedelta(seconds=1)).elevation_deg
                 after = calc.compute(ACTIVE[p.catalog_number].satrec, when + timedelta(seconds=1)).elevation_deg
                 assert before * after < 0
+    # one always above the horizon has one pass, with neither AOS nor LOS (tests/tracking/test_always_up.py)
     up = [s for s in geo[:40] if calc.compute(s.satrec, START).elevation_deg > 1.0]
-    assert up and not any(p.catalog_number == up[0].catalog_number for p in passes)
+    assert up and [(p.aos, p.los) for p in passes if p.catalog_number == up[0].catalog_number] == [(None, None)]
 
 
 def _brute_force(es, observer, horizon, step_s=0.5):
@@ -151,13 +152,9 @@ obs = Observer(52.2, 0.12, 20.0)
 serial = find_passes(sats, obs, start, start + timedelta(hours=6))
 parallel = find_passes(sats, obs, start, start + timedelta(hours=6), workers=2)
 assert len(serial) > 100 and len(parallel) == len(serial), (len(serial), len(parallel))
-key = lambda p: (p.catalog_number, p.tca)
-for a, b in zip(sorted(serial, key=key), sorted(parallel, key=key)):
-    assert a.catalog_number == b.catalog_number
-    for x, y in ((a.aos, b.aos), (a.los, b.los)):
-        assert (x is None) == (y is None) and (x is None or abs((x - y).total_seconds()) < 0.01)
-    assert abs((a.tca - b.tca).total_seconds()) < 0.5
-    assert abs(a.max_elevation_deg - b.max_elevation_deg) < 1e-3
+import numpy as np
+for name, column in serial.columns.items():  # bit for bit: each worker searches whole chunks of one process
+    assert np.array_equal(column, parallel.columns[name], equal_nan=True), name
 print("same", len(serial))
 """
     done = subprocess.run([sys.executable, "-c", script, str(DATA / "active.txt")], capture_output=True, text=True,

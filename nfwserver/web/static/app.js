@@ -146,7 +146,7 @@ function renderPasses() {
   if (!passes.passes.length) { row(["none in the next 12 h", "", "", "", "", "", ""], body); return; }
   for (const p of passes.passes) {
     const tr = row([p.name, [hhmmss(p.aos), local(p.aos)], [hhmmss(p.tca), local(p.tca)], [hhmmss(p.los), local(p.los)],
-      p.max_el.toFixed(0) + "\u00b0", duration(p.duration_s), p.flipped === null ? "-" : (p.flipped ? "yes" : "no")], body);
+      p.max_el.toFixed(0) + "\u00b0", p.aos === null && p.los === null ? "up for the whole window" : duration(p.duration_s), p.flipped === null ? "-" : (p.flipped ? "yes" : "no")], body);
     tr.dataset.catalogNumber = p.catalog_number;
     if (p.catalog_number === selected) tr.classList.add("current");
     if (control) {

@@ -1,0 +1,54 @@
+"""``passes --workers``: ``auto`` by default; any number of worker processes writes the same bytes."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from nfwserver.tracking import passes
+from tests.conftest import DATA, ROOT
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="fork")
+def test_one_two_and_three_workers_write_the_same_bytes(tmp_path) -> None:
+    """Before, each worker searched every n-th satellite, in chunks of other satellites than one process
+    makes: its times differed in the microseconds (CSV's sixth decimal of a duration, a TCA's millisecond)."""
+    elements = tmp_path / "some.txt"
+    elements.write_text("\n".join((DATA / "active.txt").read_text().splitlines()[: 3 * 1500]) + "\n")
+    outputs = []
+    for workers in ("1", "2", "3"):
+        done = subprocess.run(
+            [sys.executable, "-m", "nfwserver", "passes", "--elements", str(elements), "--all", "--observer",
+             "52.2,0.12,20", "--start", "2026-05-08T00:00:00Z", "--hours", "24", "--format", "csv",
+             "--workers", workers], cwd=ROOT, capture_output=True, text=True, timeout=300, check=True)
+        outputs.append(done.stdout)
+    assert outputs[0].count("\n") > 3000
+    assert outputs[1] == outputs[0] and outputs[2] == outputs[0]
+
+
+def test_auto_forks_only_for_large_searches_and_idle_cores(monkeypatch) -> None:
+    assert passes.auto_workers(passes.AUTO_WORKERS_FROM - 1) == 1
+    if sys.platform == "win32":
+        assert passes.auto_workers(20_000) == 1
+        return
+    monkeypatch.setattr(os, "getloadavg", lambda: (0.2, 0.0, 0.0))
+    cores = len(os.sched_getaffinity(0)) if sys.platform == "linux" else os.cpu_count()
+    assert passes.auto_workers(20_000) == min(cores, passes.AUTO_WORKERS_MAX)
+    monkeypatch.setattr(os, "getloadavg", lambda: (cores + 0.5, 0.0, 0.0))  # every core busy already
+    assert passes.auto_workers(20_000) == 1
+
+
+def test_workers_option_takes_auto_or_a_whole_number(capsys) -> None:
+    from nfwserver.cli import build_parser
+
+    parser = build_parser(["passes"])
+    assert parser.parse_args(["passes"]).workers == "auto"
+    assert parser.parse_args(["passes", "--workers", "AUTO"]).workers == "auto"
+    assert parser.parse_args(["passes", "--workers", "3"]).workers == 3
+    for bad in ("0", "1.5", "65", "many"):
+        with pytest.raises(SystemExit):
+            parser.parse_args(["passes", "--workers", bad])
+        assert "--workers" in capsys.readouterr().err
