@@ -16,13 +16,14 @@ import re
 import subprocess
 import time
 import urllib.request
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path, PureWindowsPath
 
 import pytest
 
 from nfwserver import __version__
 from tests.conftest import ROOT
+from tests.waiting import wait_for
 from tests.windows.conftest import NOVA
 from tests.windows.wine_prefix import WinePrefix
 
@@ -37,14 +38,6 @@ RUN_KEY = r"HKCU\Software\Microsoft\Windows\CurrentVersion\Run"
 MENU = {"nfwserver station.lnk": ("nfwserver.exe", "run"), "nfwserver dashboard.lnk": ("nfwserverw.exe", "dashboard"),
         "nfwserver configuration.lnk": ("nfwserverw.exe", "config edit"),
         "Stop the station.lnk": ("nfwserverw.exe", "stop")}
-
-
-def wait_until(predicate: Callable[[], bool], timeout_s: float, what: str) -> None:
-    """Return once ``predicate()`` holds; fail naming ``what`` when it has not within ``timeout_s``."""
-    deadline = time.monotonic() + timeout_s
-    while not predicate():
-        assert time.monotonic() < deadline, f"not within {timeout_s:g} s: {what}"
-        time.sleep(0.2)
 
 
 def winpath(path: Path) -> str:
@@ -135,9 +128,10 @@ def test_the_start_menu_entries_run_files_that_exist(installed: Installed) -> No
                                                                                for name in links)])
     assert probe.returncode == 0, probe.stderr
     for name, line in zip(links, probe.stdout.splitlines()):
-        target, args, _folder = line.split("|")
+        target, args, folder = line.split("|")
         program, expected_args = MENU[name]
         assert PureWindowsPath(target) == installed.folder / program and args == expected_args, name
+        assert PureWindowsPath(folder) == installed.prefix.profile, name  # relative paths are the user's
         assert installed.prefix.unix(target).is_file(), target
 
 
@@ -189,7 +183,12 @@ def test_an_upgrade_keeps_the_users_files_and_restarts_a_station_started_at_logo
     assert json.loads(state.read_text())["satellite"] == 25544, "the earlier run saved no state"
     logon = installed.prefix.start([installed.exe_w, "run", "--headless"])  # as the Run key starts it
     try:
-        wait_until(lambda: installed.running_pid() is not None, 120, "the windowless station started")
+        wait_for(lambda: installed.running_pid() is not None, 120, "the windowless station started", interval_s=0.2)
+        site = installed.prefix.unix(installed.folder / "Lib" / "site-packages")
+        planted = [site / "nfwserver" / "removed_in_this_version.py", site / "nfwserver" / "__pycache__" / "old.pyc"]
+        for path in planted:  # what an older version had and this one has not
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text("# old\n")
         upgrade_started_ns = time.time_ns()
         assert installed.setup("/LOGON") == 0
         assert logon.wait(60) == 0  # the old station was stopped cleanly by the upgrade
@@ -200,9 +199,10 @@ def test_an_upgrade_keeps_the_users_files_and_restarts_a_station_started_at_logo
     run_value = (installed.prefix.reg_values(RUN_KEY) or {}).get("nfwserver")
     assert run_value == f'"{installed.folder}\\nfwserverw.exe" run --headless'
     description = installed.user_files / "station.json"  # removed by the old station, written by the new one
-    wait_until(lambda: installed.running_pid() is not None and description.stat().st_mtime_ns > upgrade_started_ns,
-               120, "the upgraded station started again")
+    wait_for(lambda: installed.running_pid() is not None and description.stat().st_mtime_ns > upgrade_started_ns,
+             120, "the upgraded station started again", interval_s=0.2, tolerate=(OSError,))
     assert config.read_text() == before
+    assert not any(path.exists() for path in planted)  # nothing of the older program stays importable
     assert json.loads(state.read_text())["satellite"] == 25544
     assert (installed.user_files / "Logs" / "nfwserver.log").is_file()
     stop = installed.nfwserver("stop")
@@ -216,16 +216,22 @@ def test_an_upgrade_keeps_the_users_files_and_restarts_a_station_started_at_logo
 
 
 def test_the_quiet_uninstall_removes_the_program_and_keeps_the_users_files(installed: Installed) -> None:
-    assert installed.setup("/LOGON") == 0  # so that the uninstall has a Run entry to remove
+    assert installed.setup("/LOGON") == 0  # a Run entry to remove, and a station started, as at logon
+    wait_for(lambda: installed.running_pid() is not None, 120, "the station started at the end of the install",
+             interval_s=0.2)
     values = installed.prefix.reg_values(UNINSTALL_KEY)
     assert values is not None
     command = values["QuietUninstallString"]
     program, switch = command.rsplit(" ", 1)
     assert installed.prefix.run_detached([program.strip('"'), switch]) == 0
     folder = installed.prefix.unix(installed.folder)
-    # The uninstaller runs on from a copy of itself in %TEMP%: wait for its work to be done.
-    wait_until(lambda: not folder.exists(), 120, f"{folder} removed")
-    wait_until(lambda: installed.prefix.reg_values(UNINSTALL_KEY) is None, 60, "the uninstall key removed")
+    # The uninstaller runs on from a copy of itself in %TEMP%: wait for its work to be done.  The station was
+    # stopped first (cleanly: its log ends so), or its files in use would have stayed.
+    wait_for(lambda: not folder.exists(), 120, f"{folder} removed", interval_s=0.2)
+    log = (installed.user_files / "Logs" / "nfwserver.log").read_text(encoding="utf-8", errors="replace")
+    assert installed.running_pid() is None and log.rstrip().splitlines()[-1].endswith(" stopped")
+    wait_for(lambda: installed.prefix.reg_values(UNINSTALL_KEY) is None, 60, "the uninstall key removed",
+             interval_s=1.0)
     assert not installed.menu.exists()
     assert "nfwserver" not in (installed.prefix.reg_values(RUN_KEY) or {})
     assert 'location = "JO01ab"' in (installed.user_files / "config.toml").read_text()
@@ -246,7 +252,7 @@ def test_another_folder_chosen_with_d_is_installed_to_and_removed_from(installed
     assert not installed.prefix.unix(installed.folder).exists()
     program, switch = values["QuietUninstallString"].rsplit(" ", 1)
     assert installed.prefix.run_detached([program.strip('"'), switch]) == 0
-    wait_until(lambda: not installed.prefix.unix(folder).exists(), 120, f"{folder} removed")
+    wait_for(lambda: not installed.prefix.unix(folder).exists(), 120, f"{folder} removed", interval_s=0.2)
     assert installed.prefix.unix(folder.parent).is_dir()  # only the program's own folder goes
 
 

@@ -32,6 +32,7 @@ class WinePrefix:
         self._quiet(["wine", "cmd", "/c", "exit"], 120)  # the system processes, on /dev/null
         self.local_appdata = PureWindowsPath(self.run(["cmd", "/c", "echo %LOCALAPPDATA%"]).stdout.strip())
         self.appdata = PureWindowsPath(self.run(["cmd", "/c", "echo %APPDATA%"]).stdout.strip())
+        self.profile = PureWindowsPath(self.run(["cmd", "/c", "echo %USERPROFILE%"]).stdout.strip())
 
     def _quiet(self, argv: list[str], timeout_s: float) -> None:
         subprocess.run(argv, env=self.env, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,

@@ -9,6 +9,7 @@
  */
 #include <windows.h>
 #include <shellapi.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <wchar.h>
 
@@ -59,7 +60,20 @@ static int launch(void)
         args[1 + i] = (wchar_t *)fixed[i];
     for (int i = 1; i < argc; i++)
         args[nfixed + i] = argv[i];
-    return py_main(argc + nfixed, args);
+    int status = py_main(argc + nfixed, args);
+#ifndef NFW_WINDOWLESS
+    /* Started from the Start menu or Explorer, this program owns its console window, which closes when it
+     * exits: a failure ("a station is already running") would flash by unread.  Then wait for Enter. */
+    DWORD owners[2];
+    DWORD mode;
+    if (status != 0 && GetConsoleProcessList(owners, 2) == 1
+        && GetConsoleMode(GetStdHandle(STD_INPUT_HANDLE), &mode)) {
+        fwprintf(stderr, L"\nPress Enter to close this window.\n");
+        fflush(stderr);
+        (void)getwchar();
+    }
+#endif
+    return status;
 }
 
 #ifdef NFW_WINDOWLESS

