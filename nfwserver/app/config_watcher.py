@@ -46,6 +46,17 @@ def file_signature(path: Path) -> Signature:
     return st.st_mtime_ns, st.st_size, st.st_ino
 
 
+def settled_signature(path: Path, now: Signature, clock: Clock, stop: threading.Event, settle_s: float) -> Signature:
+    """``path``'s signature once it has stayed the same for ``settle_s`` seconds of ``clock`` (a writer has
+    finished), starting from ``now``; returns at once, with the last one seen, when ``stop`` is set."""
+    while not clock.wait(stop, settle_s):
+        later = file_signature(path)
+        if later == now:
+            break
+        now = later
+    return now
+
+
 class ConfigWatcher(ServiceThread):
     """Calls ``apply(config)`` for each valid change of ``path``; ``refused(message)`` for an invalid one."""
 
@@ -86,12 +97,8 @@ class ConfigWatcher(ServiceThread):
         now = file_signature(self.path)
         if now == self._seen and not force:
             return False
-        # Let a writer finish: read only once the file has stayed the same for settle_s.
-        while not force and not self.clock.wait(self._stop, self.settle_s):
-            later = file_signature(self.path)
-            if later == now:
-                break
-            now = later
+        if not force:  # let a writer finish: read only once the file has stayed the same for settle_s
+            now = settled_signature(self.path, now, self.clock, self._stop, self.settle_s)
         if self._stop.is_set():
             return False
         if now is None:

@@ -34,7 +34,7 @@ def default_store_path() -> Path:
 
 @dataclass
 class PruneSummary:
-    """What :meth:`ElementStore.plan_prune` would remove (or :meth:`ElementStore.prune` removed) and what stays."""
+    """What :meth:`ElementStore.plan_prune` would remove and what stays."""
 
     decayed: list[ElementSet] = field(default_factory=list)  #: InstantTrack's CRASH
     old: list[ElementSet] = field(default_factory=list)  #: InstantTrack's OLD
@@ -114,9 +114,3 @@ class ElementStore:
             if len(kept) != len(sets):
                 atomic_write_text(self.path, "".join(es.tle_text() for es in kept))
         return len(kept)
-
-    def prune(self, now: datetime, max_age_days: float, keep: frozenset[int] = frozenset()) -> PruneSummary:
-        """:meth:`plan_prune`, then :meth:`apply_prune` at once."""
-        summary = self.plan_prune(now, max_age_days, keep)
-        summary.kept = self.apply_prune(summary)
-        return summary

@@ -17,7 +17,7 @@ import threading
 from collections.abc import Callable
 from pathlib import Path
 
-from nfwserver.app.config_watcher import Signature, file_signature
+from nfwserver.app.config_watcher import Signature, file_signature, settled_signature
 from nfwserver.clock import Clock
 from nfwserver.core.service_thread import ServiceThread
 
@@ -55,11 +55,8 @@ class StoreWatcher(ServiceThread):
         now = file_signature(self.path)
         if now == self._seen and not force:
             return False
-        while not force and not self.clock.wait(self._stop, self.settle_s):
-            later = file_signature(self.path)
-            if later == now:
-                break
-            now = later
+        if not force:  # let a writer finish
+            now = settled_signature(self.path, now, self.clock, self._stop, self.settle_s)
         if self._stop.is_set():
             return False
         self._seen = now
