@@ -8,7 +8,6 @@ clock, one service call per 0.2 virtual seconds (the station's 5 Hz tick).
 
 from __future__ import annotations
 
-import time
 from datetime import datetime, timezone
 
 import pytest
@@ -20,6 +19,7 @@ from nfwserver.rotor.geometry import RotorGeometry
 from nfwserver.rotor.kct_driver import KctDriver
 from nfwserver.rotor.rotctld_backend import RotctldBackend
 from tests.hamlib_daemons import HamlibDaemon
+from tests.waiting import wait_for
 
 pytestmark = pytest.mark.hamlib
 GEOMETRY = RotorGeometry(-180.0, 450.0, 0.0, 90.0)  # rotctld's default limits for the dummy
@@ -37,16 +37,6 @@ def _driver(daemon: HamlibDaemon, clock: VirtualClock, stall_timeout_s: float | 
     return KctDriver(clock, backend, GEOMETRY, stall_timeout_s=stall_timeout_s)
 
 
-def _wait_real(predicate, limit_s: float) -> bool:
-    """Poll ``predicate`` for up to ``limit_s`` real seconds (the dummy turns in real time)."""
-    deadline = time.monotonic() + limit_s
-    while time.monotonic() < deadline:
-        if predicate():
-            return True
-        time.sleep(0.05)
-    return predicate()
-
-
 def test_a_still_target_is_sent_again_as_soon_as_rotctld_returns() -> None:
     """The issue: a still target (GEO), rotctld restarted; the station sent nothing for 20.9 s and then took
     the motionless rotor for a stalled one.  Now the first reading after the return sends the target."""
@@ -55,7 +45,7 @@ def test_a_still_target_is_sent_again_as_soon_as_rotctld_returns() -> None:
         driver = _driver(daemon, clock)
         driver.service()
         assert driver.set_target(azimuth_deg=20.0, elevation_deg=10.0)
-        assert _wait_real(lambda: abs(_position(daemon)[0] - 20.0) < 1.0, 15.0), "the dummy never arrived"
+        wait_for(lambda: abs(_position(daemon)[0] - 20.0) < 1.0, 15.0, "the dummy at 20 deg", interval_s=0.05)
         driver.service()
         assert driver.link_state() == "ok"
         daemon.restart()  # back at 0/0, its target forgotten
@@ -65,7 +55,7 @@ def test_a_still_target_is_sent_again_as_soon_as_rotctld_returns() -> None:
             driver.service()
         assert driver.link_state() != "unreachable", "no reconnection within 3 s of the daemon's return"
         # No more service calls: whatever moves the dummy now was sent by then.
-        assert _wait_real(lambda: _position(daemon)[0] > 1.0, 5.0), "the target was not sent again"
+        wait_for(lambda: _position(daemon)[0] > 1.0, 5.0, "the target sent again (the dummy moving)", interval_s=0.05)
         assert driver.health.ok and not driver.stalled
 
 
@@ -79,7 +69,7 @@ def test_a_rotor_neither_on_target_nor_moving_there_is_off_target_not_ok() -> No
         status = device_status(coupling, None, None)
         driver.service()
         assert driver.set_target(azimuth_deg=80.0, elevation_deg=40.0)
-        assert _wait_real(lambda: _position(daemon)[0] > 2.0, 5.0)
+        wait_for(lambda: _position(daemon)[0] > 2.0, 5.0, "the dummy moving", interval_s=0.05)
         assert daemon.command("S").strip() == "RPRT 0"  # the rotor stops short of 80
         stopped = _position(daemon)
         assert stopped[0] < 70.0
