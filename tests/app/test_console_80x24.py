@@ -9,20 +9,26 @@ from __future__ import annotations
 
 import asyncio
 import re
+from dataclasses import replace
 from datetime import timedelta
 
 import pytest
 
 from nfwserver.app.devices import make_rotor
+from nfwserver.channels.channel import Channel
 from nfwserver.commands.help_text import help_lines
 from nfwserver.commands.table import Face
 from nfwserver.config.schema import RotorConfig
 from nfwserver.console.app import NfwConsole
+from nfwserver.console.state_view import realtime, realtime_lines, satellite_line
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.radio.defaults import DEFAULT_CHANNELS
 from nfwserver.radio.rigctld_backend import RigctldBackend
 from nfwserver.radio.tuning import DopplerTuner
+from nfwserver.tracking.catalog import Catalog
+from nfwserver.tracking.elements import load_element_file
 from tests.app.console_helpers import log_text, off_screen, screen_text, settle, static_text
+from tests.conftest import DATA
 from tests.dde.conftest import ISS, ISS_PASS, NOVA, make_station
 
 pytestmark = pytest.mark.hamlib
@@ -122,3 +128,22 @@ def test_pass_marks_are_explained_and_stale_elements_flagged_at_the_top(rigctld)
         assert f"Elements {age:.0f} days old (over 1)" in state, state  # the top panel says it
 
     _run(rigctld, scenario, stale_days=1.0)
+
+
+def test_long_names_are_shortened_not_wrapped() -> None:
+    # A 24-character satellite name and a 40-character channel name, the pane 76 columns wide: the names are
+    # cut (with an ellipsis), and what follows them (TUNE/TRACK/clients, Doppler and path loss) stays whole.
+    long_name = "INTERNATIONAL SPACE STAT"
+    catalog = Catalog([replace(s, name=long_name) if s.catalog_number == ISS else s
+                       for s in load_element_file(DATA / "visual.txt").sets])
+    channel = Channel(name="a downlink channel with a forty-char name", downlink_hz=437_800_000.0)
+    station = make_station(start=ISS_PASS.tca, channels={ISS: channel}, catalog=catalog)
+    snap = station.core.snapshot()
+    line = satellite_line(snap, station.core, (1, 1), 76).plain
+    assert len(line) <= 76 and line.startswith("Satellite ISS (25544) INTERN") and "\u2026" in line, line
+    assert line.endswith("TUNE OFF  TRACK OFF  clients 1 (1 advise)"), line
+    values, why = realtime(station.core, ISS, station.clock.now())
+    downlink = next(t.plain for t in realtime_lines(values, why, station.core, ISS, True, 76)
+                    if t.plain.startswith("Downlink"))
+    assert len(downlink) <= 76 and "(a downlink" in downlink and "\u2026)" in downlink, downlink
+    assert re.search(r"\) Doppler [+-][\d,]+ Hz  path loss \d+\.\d dB$", downlink), downlink
