@@ -6,7 +6,8 @@ EasyComm on a pty, a watched configuration file, a state file), and prints one M
 fault, how long STATUS took to show it, how long after its cause ended the output worked again (in
 ticks and seconds), ticks without a string, ticks that were silent or broken while STATUS said all was
 well, false alarms after recovery, tracebacks.  Exit status 1 when any fault misses the targets
-(recovered, explained, no traceback).  ``--only TEXT`` runs the faults whose name contains TEXT.
+(recovered, explained, no traceback); then what the slow-loris fault counted.  ``--only TEXT`` runs the
+faults whose name contains TEXT.
 """
 
 from __future__ import annotations
@@ -49,9 +50,14 @@ def main(argv: list[str]) -> int:
         for fault in chosen:
             print(f"fault: {fault.name} ...", file=sys.stderr, flush=True)
             results.append(run_fault(rig, fault))
+        loris = rig.loris
     print(f"## Fault campaign\n\n`python -m bench faults`: {len(results)} faults, one station, 5 Hz ticks in "
           f"virtual time; {time.monotonic() - started:.0f} s of real time.\n")
     print(table(results))
+    if loris is not None:
+        print(f"\nSlow-loris, from 127.0.0.1: {loris.refused} connections refused with an ERROR line at the burst "
+              f"(none idle 1 s yet), {loris.evicted} idle one(s) closed to make room, {loris.local_served} checks "
+              "from 127.0.0.1 (as `nfwserver status` connects) answered.")
     return 0 if all(r.passed for r in results) else 1
 
 

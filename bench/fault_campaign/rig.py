@@ -86,6 +86,19 @@ class TickRecord:
 
 
 @dataclass
+class LorisCounts:
+    """What the slow-loris fault counted: the TCP server's refusals and evictions while it lasted, and how often
+    a client from 127.0.0.1 (the operator's own tools' address) was served under the flood."""
+
+    since: float | None  #: clock monotonic seconds the connections were opened; None once they are closed
+    evicted_before: int
+    refused_before: int
+    evicted: int = 0  #: idle connections the server closed to make room
+    refused: int = 0  #: connections refused with an ERROR line (over the cap, none idle long enough)
+    local_served: int = 0  #: STATUS answered to a new client from 127.0.0.1
+
+
+@dataclass
 class FaultRig:
     """See the module docstring.  Use as a context manager."""
 
@@ -116,6 +129,7 @@ class FaultRig:
         self.real_time = False
         self.rotor_distance = float("inf")  #: last seen distance (deg) of the real rotor from its target
         self.held_connections: list[socket.socket] = []  #: the slow-loris fault's open connections
+        self.loris: LorisCounts | None = None  #: what the last slow-loris fault counted
         self.edits_lost: list[str] = []  #: what the concurrent-edits fault lost (settings, element sets)
         self._last_tick = time.monotonic()
 

@@ -17,8 +17,9 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from bench.fault_campaign.rig import ELEMENTS, ISS, ROOT, FaultRig, TickRecord
+from bench.fault_campaign.rig import ELEMENTS, ISS, ROOT, FaultRig, LorisCounts, TickRecord
 from nfwserver.config import parse_config
+from nfwserver.tcp.connection import EVICT_AFTER_S
 from nfwserver.tracking.elements import load_element_file, load_elements
 from nfwserver.tracking.tle import tle_checksum
 
@@ -195,26 +196,35 @@ def _nothing(rig: FaultRig) -> None:
 
 
 def _slow_loris(rig: FaultRig) -> None:
-    """Forty connections from 127.0.0.1, each sending a byte now and then and never a line: more than the
-    per-address cap, so the later ones are refused with a line; the station's other clients must not notice."""
-    assert rig.station.tcp is not None
+    """Forty connections from 127.0.0.1, the address every local tool shares on the loopback default, opened
+    at one instant, a byte each and never a line: over the per-address cap (32), and none of the first 32 has
+    been idle :data:`~nfwserver.tcp.connection.EVICT_AFTER_S` yet, so the last 8 get one ``ERROR`` line each.
+    From then on a new connection from 127.0.0.1 closes the one idle longest (:func:`tcp_served` makes one)."""
+    tcp = rig.station.tcp
+    assert tcp is not None
+    rig.loris = LorisCounts(since=rig.clock.monotonic(), evicted_before=tcp.stats.evicted,
+                            refused_before=tcp.stats.refused)
     for _ in range(40):
-        s = socket.create_connection(rig.station.tcp.address, timeout=2.0)
+        s = socket.create_connection(tcp.address, timeout=2.0)
         s.sendall(b"S")
         rig.held_connections.append(s)
 
 
 def _loris_gone(rig: FaultRig) -> None:
+    tcp = rig.station.tcp
+    if rig.loris is not None and tcp is not None:
+        rig.loris.evicted = tcp.stats.evicted - rig.loris.evicted_before
+        rig.loris.refused = tcp.stats.refused - rig.loris.refused_before
+        rig.loris.since = None
     while rig.held_connections:
         rig.held_connections.pop().close()
 
 
-def tcp_served(rig: FaultRig, record: TickRecord) -> bool:
-    """The feed publishes and a client from another address (127.0.0.2) is greeted and answered."""
-    if not record.published or rig.station.tcp is None or rig.index % 5:
-        return record.published
+def _served_status(rig: FaultRig, source: str) -> bool:
+    """A client bound to ``source`` is greeted and answered ``STATUS``."""
+    assert rig.station.tcp is not None
     with socket.socket() as s:
-        s.bind(("127.0.0.2", 0))
+        s.bind((source, 0))
         s.settimeout(2.0)
         s.connect(rig.station.tcp.address)
         s.sendall(b"STATUS\r\n")
@@ -225,6 +235,24 @@ def tcp_served(rig: FaultRig, record: TickRecord) -> bool:
                 return False
             data += chunk
     return data.startswith(b"Hello") and b"satellite=" in data
+
+
+def tcp_served(rig: FaultRig, record: TickRecord) -> bool:
+    """The feed publishes; every fifth tick a client from another address (127.0.0.2) is greeted and answered,
+    and, while the slow-loris connections hold 127.0.0.1's cap and have been idle ``EVICT_AFTER_S`` (clock
+    seconds), so is one from 127.0.0.1, as ``nfwserver status`` and ``poke`` connect: it needs an idle
+    connection closed to make room, and ``rig.loris`` counts it."""
+    if not record.published or rig.station.tcp is None or rig.index % 5:
+        return record.published
+    if not _served_status(rig, "127.0.0.2"):
+        return False
+    loris = rig.loris
+    if loris is None or loris.since is None or rig.clock.monotonic() - loris.since < EVICT_AFTER_S:
+        return True
+    if not _served_status(rig, "127.0.0.1"):
+        return False
+    loris.local_served += 1
+    return True
 
 
 def _still_target_then_kill(rig: FaultRig) -> None:
@@ -322,8 +350,8 @@ FAULTS = (
     Fault("process stopped for 120 s (SIGSTOP/SIGCONT)", None, _stop_process, _nothing, feed_and_easycomm_current,
           duration_s=0.2),
     Fault("TCP lines of VT, FF and 0x1C-0x1F", None, _tcp_junk, _nothing, feed_works, duration_s=0.2),
-    Fault("TCP slow-loris: 40 connections from one address, never a line", None, _slow_loris, _loris_gone,
-          tcp_served, duration_s=10.0),
+    Fault("TCP slow-loris: 40 idle connections from 127.0.0.1; other addresses and local tools served", None,
+          _slow_loris, _loris_gone, tcp_served, duration_s=10.0),
     Fault("pokes with other scripts' digits (SAT=², ANTAZ=٣) over TCP and DDE", None, _foreign_digits, _nothing,
           feed_works, duration_s=0.2),
     Fault("five config set and two elements update runs in parallel", None, _concurrent_edits, _edits_undone,

@@ -87,7 +87,8 @@ class Station:
         self.core.rotor_configured = self.rotor is not None
         self.core.rotor = self.rotor  # FLIP and PARK, from every face
         self.radio: RadioCoupling | None = make_radio(config.radio, self.core, clock)
-        self.saver = (SessionSaver(self.state_file, config.server.satellite,
+        configured = config.server.satellite if isinstance(config.server.satellite, int) else None  # a name: at start
+        self.saver = (SessionSaver(self.state_file, configured,
                                    self.core.health.link("state-file", Backoff(0.2, 0.4)),
                                    current=lambda: self.core.state.catalog_number)
                       if self.state_file else None)
@@ -246,12 +247,17 @@ class Station:
     def _restore_session(self) -> None:
         srv = self.config.server
         saved = self.state_file.load() if self.state_file is not None else SessionState()
-        choice, source = srv.satellite, "config"
-        if (saved.satellite is not None and saved.satellite != srv.satellite and saved.satellite in self.catalog
-                and saved.configured == srv.satellite):
+        configured, unresolved = configured_satellite(srv.satellite, self.catalog)
+        if self.saver is not None:
+            self.saver.configured = configured  # the state file records the number, as before
+        choice, source = configured, "config"
+        if (not unresolved and saved.satellite is not None and saved.satellite != configured
+                and saved.satellite in self.catalog and saved.configured == configured):
             choice, source = saved.satellite, "saved-state"  # chosen at run time; the configuration unchanged
-        self.selection_note = _selection_note(choice, source, srv.satellite, saved, self.state_file)
-        if choice is not None and not self.core.select_satellite(choice, source=source):
+        self.selection_note = unresolved or _selection_note(choice, source, configured, saved, self.state_file)
+        if unresolved and choice is None:
+            log.warning("%s", unresolved)
+        elif choice is not None and not self.core.select_satellite(choice, source=source):
             self.selection_note = f"configured satellite {choice} is not in the loaded elements"
             log.warning("%s", self.selection_note)
         else:
@@ -333,6 +339,22 @@ class Station:
                 log.exception("closing the transport failed")
         if self.saver is not None:  # last: no face can change the selection any more
             self.saver.stop()
+
+
+def configured_satellite(value: int | str | None, catalog: Catalog) -> tuple[int | None, str]:
+    """``[server] satellite`` as a catalog number: a number as it is, a name resolved against ``catalog`` as
+    ``SAT=`` resolves it; with one sentence saying why when a name matches no satellite or several (then None)."""
+    if not isinstance(value, str):
+        return value, ""
+    found = catalog.named(value)
+    if len(found) == 1:
+        return found[0].catalog_number, ""
+    if not found:
+        return None, (f"[server] satellite {value!r} names no satellite in the loaded elements, so none is selected "
+                      "(give its catalog number or its name as `nfwserver passes` lists it)")
+    numbers = ", ".join(str(s.catalog_number) for s in found[:5]) + (", ..." if len(found) > 5 else "")
+    return None, f"[server] satellite {value!r} names {len(found)} satellites ({numbers}), so none is selected: " \
+                 "give the catalog number"
 
 
 def _selection_note(choice: int | None, source: str, configured: int | None, saved: SessionState,

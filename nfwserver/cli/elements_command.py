@@ -205,8 +205,14 @@ def _protected(config: Config) -> dict[int, str]:
     from nfwserver.app.session_state import StateFile
 
     keep: dict[int, str] = {n: "a favourite" for n in config.favourites}
-    if config.server.satellite is not None:
-        keep[config.server.satellite] = "the configured satellite"
+    configured = config.server.satellite
+    if isinstance(configured, str):  # a name, as SAT= takes it: the stored sets it names
+        from nfwserver.tracking.catalog import Catalog
+
+        named = Catalog(_store(config).load()).named(configured)
+        configured = named[0].catalog_number if len(named) == 1 else None
+    if configured is not None:
+        keep[configured] = "the configured satellite"
     if config.state_file:
         saved = StateFile(None if config.state_file == "default" else config.state_file).load().satellite
         if saved is not None:

@@ -102,8 +102,9 @@ class TrackingInputs:
         return _station_catalog(self.config())
 
     @property
-    def satellite(self) -> int | None:
-        """The configured AutoTracking satellite (``[server] satellite``)."""
+    def satellite(self) -> int | str | None:
+        """The configured AutoTracking satellite (``[server] satellite``: a catalog number, or a name that the
+        caller resolves as it resolves ``--sat``)."""
         return self.config().server.satellite
 
     def resolve(self) -> TrackingInputs:

@@ -97,6 +97,15 @@ def _catnr(setting: Setting, value: Any, base: Path | None) -> int:
     return int(value)
 
 
+def _satellite(setting: Setting, value: Any, base: Path | None) -> int | str:
+    """A catalog number, or a satellite's name as ``SAT=`` takes it (resolved against the catalog at start)."""
+    if isinstance(value, str) and value.strip() and len(value) <= 64 and value.isprintable():
+        return value.strip()
+    if isinstance(value, str):
+        raise ValueError("must be a catalog number or a satellite's name (1 to 64 printable characters)")
+    return _catnr(setting, value, base)
+
+
 def _catnrs(setting: Setting, value: Any, base: Path | None) -> tuple[int, ...]:
     return tuple(_catnr(setting, v, base) for v in _list(value, "catalog numbers"))
 
@@ -277,7 +286,8 @@ def _channels(setting: Setting, value: Any, base: Path | None) -> dict[int, Chan
 
 CONVERTERS: dict[str, Converter] = {
     "bool": _bool, "int": _int, "number": _number, "choice": _choice, "text": _text, "texts": _texts,
-    "choices": _choices, "catnr": _catnr, "catnrs": _catnrs, "host": _host, "networks": _networks,
+    "choices": _choices, "catnr": _catnr, "satellite": _satellite, "catnrs": _catnrs, "host": _host,
+    "networks": _networks,
     "urls": _urls, "url": _url, "file": _file, "files": _files, "store": _store, "location": _location,
     "points": _points, "names": _names, "schedules": _schedules, "channels": _channels, "device": _text,
 }

@@ -87,7 +87,8 @@ SETTINGS: tuple[Setting, ...] = (
     _S("server", "services", "texts", ["NFW32", "NFW_SERVER"], "DDE service names served", "server.services", hi=255),
     _S("server", "topic", "text", "NFW_DATA", "DDE topic", "server.topic", hi=255),
     _S("server", "items", "texts", ["NFW_SERVER", "NFW_DATA"], "DDE items served", "server.items", hi=255),
-    _S("server", "satellite", "catnr", 25544, "AutoTracking satellite at start (catalog number)",
+    _S("server", "satellite", "satellite", 25544, "AutoTracking satellite at start (catalog number, or a name "
+       "that matches one satellite only, as SAT= takes it)",
        "server.satellite"),
     _S("server", "ut1_utc_s", "number", 0.0, "UT1-UTC from IERS Bulletin A, seconds", "server.ut1_utc_s", -1, 1),
     _S("server", "state_file", "store", "default", "remembers the AutoTracking satellite across restarts: "

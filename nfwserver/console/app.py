@@ -13,8 +13,9 @@ timer, so a flood of strings at 50 Hz never blocks the publisher.  Pass searches
 run on a worker thread (:mod:`nfwserver.console.pass_view`); key handling never waits for them.
 Every name is shown as literal text (never parsed as markup).
 
-On a narrow terminal (< 110 columns) one log pane is shown at a time (F1/F3 choose); on a short
-one (< 34 lines) the sky plot is left out.  The console works from 80x24.
+On a narrow terminal (< 110 columns) one log pane is shown at a time (F1/F3 choose), F1's beside no pass
+list, so that each Nova string takes one row; on a short one (< 34 lines) the sky plot is left out.  The
+console works from 80x24, where no line of the header wraps; HELP opens a screen of its own.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from __future__ import annotations
 import collections
 import logging
 import threading
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from datetime import datetime, tzinfo
 from functools import partial
 from typing import Any
@@ -38,12 +39,15 @@ from nfwserver.commands.actions import NO_ROTOR
 from nfwserver.commands.parsing import parse_request
 from nfwserver.commands.table import Face, Target, escape_for_log
 from nfwserver.console.command_port import ConsolePort
-from nfwserver.console.pass_view import STALE_DAYS, PassSearch, next_pass_text, pass_table, search_passes
+from nfwserver.console.help_screen import HelpScreen
+from nfwserver.console.pass_view import LEGEND, STALE_DAYS, PassSearch, next_pass_text, pass_table, search_passes
 from nfwserver.console.picker import SatellitePicker
 from nfwserver.console.reflow_log import ReflowLog
 from nfwserver.console.skyplot import render_sky
 from nfwserver.console.state_view import (
-    antenna_line,
+    antenna_lines,
+    elements_line,
+    fit,
     guarded,
     outputs_line,
     radio_line,
@@ -117,7 +121,7 @@ class NfwConsole(App[None]):
         self.failure: BaseException | None = None  #: the exception that stopped the console, if one did
         self._queue: collections.deque[Event] = collections.deque(maxlen=2000)
         self._lock = threading.Lock()
-        self._port = ConsolePort(self._note, self.action_toggle_zone)  #: HELP's and Z's target
+        self._port = ConsolePort(self._show_help, self.action_toggle_zone)  #: HELP's and Z's target
         self._unsubscribe: Callable[[], None] | None = None
         self._search: PassSearch | None = None
         self._search_key: tuple[Any, ...] | None = None
@@ -143,6 +147,7 @@ class NfwConsole(App[None]):
         self.query_one("#outgoing-pane").border_title = "F1 outgoing"
         self.query_one("#incoming-pane").border_title = "F3 incoming"
         self.query_one("#side").border_title = "Passes"
+        self.query_one("#side").border_subtitle = LEGEND
         self._unsubscribe = self.core.events.subscribe(self._enqueue)
         self.set_interval(0.1, partial(self._while_shown, self._drain))
         self.set_interval(0.25, partial(self._while_shown, self._refresh_state))
@@ -160,12 +165,15 @@ class NfwConsole(App[None]):
 
     def on_resize(self) -> None:
         self._layout()
+        self.call_after_refresh(partial(self._while_shown, self._refresh_state))  # fitted to the new width
 
     def _layout(self) -> None:
         narrow = self.size.width < NARROW_COLUMNS
         self.query_one("#outgoing-pane").set_class(narrow and self._shown_log != "outgoing", "hidden")
         self.query_one("#incoming-pane").set_class(narrow and self._shown_log != "incoming", "hidden")
         self.query_one("#sky").set_class(self.size.height < SHORT_LINES, "hidden")
+        # F1 on a narrow terminal takes the width of the passes too: a Nova string and its time on one row
+        self.query_one("#side").set_class(narrow and self._shown_log == "outgoing", "hidden")
 
     def on_unmount(self) -> None:
         if self._unsubscribe is not None:
@@ -222,17 +230,21 @@ class NfwConsole(App[None]):
         search = self._search if self._search is not None and self._search.selected == catnr else None
         sample = snap.last_sample
         above = sample.above_horizon if sample is not None and sample.catalog_number == catnr else None
-        lines: list[Text | None] = [guarded("Satellite", lambda: satellite_line(snap, self.core, self.clients()))]
+        width = self.query_one("#state").content_region.width  #: 0 before the first layout: no limit yet
+        lines: list[Text | None] = [guarded("Satellite", lambda: satellite_line(snap, self.core, self.clients(),
+                                                                                width))]
         values, why = realtime(self.core, catnr, now, self.schedules.get(catnr) if catnr is not None else None)
-        lines.extend(realtime_lines(values, why, self.core, catnr, above))
+        lines.extend(realtime_lines(values, why, self.core, catnr, above, width))
         lines.append(Text(next_pass_text(search, self.times, now)))
+        lines.append(elements_line(self.core, catnr, now, self.stale_days))
         radio = guarded("Radio", lambda: radio_line(self.radio, snap.state.radio_tuning))
-        lines.append(antenna_line(snap, radio or Text()))
+        lines.extend(antenna_lines(snap, radio or Text(), width))
         if self.rotor is not None:
             lines.append(guarded("Rotor", partial(rotor_line, self.rotor)))
         lines.append(guarded("Outputs", lambda: outputs_line(self.tcp, self.easycomm)))
         lines.append(status_line(snap, self.times, now))
-        self.query_one("#state", Static).update(Text("\n").join(line for line in lines if line is not None))
+        shown = [fit(line, width) for line in lines if line is not None]  # none wraps
+        self.query_one("#state", Static).update(Text("\n").join(shown))
         self.query_one("#side").border_title = f"Passes ({self.times.zone(now)})"
         self.query_one("#passes", Static).update(pass_table(self._search, self.core.state.catalog, self.times, now,
                                                                  self.stale_days))
@@ -291,8 +303,16 @@ class NfwConsole(App[None]):
         self._drain()
         self._refresh_state()
 
+    def _show_help(self, lines: Sequence[str]) -> None:
+        """HELP's answer in a screen of its own, the terminal's whole width (the log panes are too narrow)."""
+        if not isinstance(self.screen, HelpScreen):
+            self.push_screen(HelpScreen(lines), self._help_closed)
+
+    def _help_closed(self, _: None) -> None:
+        self.query_one("#poke", Input).focus()
+
     def action_pick_satellite(self) -> None:
-        if isinstance(self.screen, SatellitePicker):
+        if isinstance(self.screen, (SatellitePicker, HelpScreen)):
             return
         picker = SatellitePicker(self.core.state.catalog, self.core.state.catalog_number, self.favourites)
         self.push_screen(picker, self._picked)

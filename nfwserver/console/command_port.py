@@ -1,4 +1,4 @@
-"""What the console's own commands act on: its display (``Z``) and its answer to ``HELP``.
+"""What the console's own commands act on: its display (``Z``) and its answer to ``HELP`` (a screen of its own).
 
 The console hands every command to the station core (:meth:`nfwserver.core.station_core.StationCore.execute`),
 which runs the entry's action from the command table; the actions of the console's commands call back here.
@@ -8,7 +8,7 @@ table does not let the console send them, so reaching them here is a bug in the 
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 from nfwserver.commands.help_text import help_lines
 from nfwserver.commands.table import Face
@@ -19,13 +19,12 @@ __all__ = ["ConsolePort"]
 class ConsolePort:
     """The console's session and display, for the core's command actions."""
 
-    def __init__(self, note: Callable[[str, str], None], toggle_zone: Callable[[], None]) -> None:
-        self._note = note
+    def __init__(self, show_help: Callable[[Sequence[str]], None], toggle_zone: Callable[[], None]) -> None:
+        self._show_help = show_help
         self._toggle_zone = toggle_zone
 
     def help(self) -> None:
-        for line in help_lines(Face.CONSOLE):
-            self._note(line, "cyan")
+        self._show_help(help_lines(Face.CONSOLE))
 
     def toggle_zone(self) -> None:
         self._toggle_zone()

@@ -29,7 +29,9 @@ NEXT_PASS_HOURS = 24.0
 TRACK_STEP_S = 20.0
 #: Rows of the pass list.
 MAX_ROWS = 8
-NAME_WIDTH = 10
+NAME_WIDTH = 9  #: a row with both marks is 34 characters, the pass pane's width at 80 columns
+#: What the marks on a pass row mean (the pass pane's subtitle).
+LEGEND = "* in progress  ! old elements"
 #: Element sets older than this (days) are flagged under the list (``[elements] stale_days``' default).
 STALE_DAYS: float = default("elements", "stale_days")
 
@@ -86,7 +88,8 @@ def pass_table(search: PassSearch | None, catalog: Catalog, times: TimeDisplay, 
                stale_days: float = STALE_DAYS) -> Text:
     """The pass list under a header: satellite, date, AOS, max elevation, LOS (the pane's title names
     the zone).  A pass already in progress is marked ``*``; a satellite whose elements are more than
-    ``stale_days`` old is marked ``!``, and a line under the list says how old and what to run; another names
+    ``stale_days`` old is marked ``!`` (:data:`LEGEND` explains both), and a line under the list says how old
+    and what to run; another names
     the satellites the search left out because their positions cannot be computed.
     """
     out = Text()
@@ -107,10 +110,11 @@ def pass_table(search: PassSearch | None, catalog: Catalog, times: TimeDisplay, 
         in_progress = p.aos is None or p.aos <= now
         start = p.aos if p.aos is not None else now
         out.append(f"{name[:NAME_WIDTH]:{NAME_WIDTH}} ")
-        out.append(f"{times.date(start):5} {times.short(p.aos):5} {p.max_elevation_deg:3.0f} {times.short(p.los):5}"
-                   f"{' *' if in_progress else ''}")
+        out.append(f"{times.date(start):5} {times.short(p.aos):5} {p.max_elevation_deg:3.0f} {times.short(p.los):5}")
+        if in_progress or age > stale_days:  # the marks' column, no trailing blanks
+            out.append(f" {'*' if in_progress else ' '}")
         if age > stale_days:
-            out.append(" !", style="bold yellow")
+            out.append("!", style="bold yellow")
         if i < len(rows) - 1:
             out.append("\n")
     if oldest > stale_days:

@@ -4,7 +4,10 @@ Every function returns :class:`rich.text.Text` built by appending plain strings,
 name such as ``[bold red]PWNED[/]`` is shown exactly as typed and can never be read as markup.
 Lines that read devices (rotor, radio, the TCP server, EasyComm) are built by :func:`guarded`: a
 device that reports garbage (a rotctld answering ``nan``) makes its line say so instead of stopping
-the console.
+the console.  No line wraps: given the pane's width, the parts that can be long (a satellite's or a
+channel's name) are shortened first, the antenna and the radio share a line only when they fit, and
+:func:`fit` cuts whatever is still too long with an ellipsis (a device's error text in full is in the log
+and in STATUS).
 
 Units: angles in degrees, range in km, range rate in km/s, frequencies in MHz on screen, Doppler in
 Hz, path loss in dB; times in the zone the :class:`~nfwserver.console.time_display.TimeDisplay` shows.
@@ -40,8 +43,26 @@ def guarded(label: str, build: Callable[[], Text | None]) -> Text | None:
         return Text(f"{label}: cannot show ({type(exc).__name__}: {exc})", style="red")
 
 
-def satellite_line(snap: CoreSnapshot, core: StationCore, clients: tuple[int, int]) -> Text:
-    """``Satellite ISS (25544) ISS (ZARYA)  TUNE ON  TRACK OFF  clients 1 (1 advise)`` (DDE clients)."""
+def fit(line: Text, width: int) -> Text:
+    """``line`` cut to ``width`` characters with an ellipsis when longer (``width`` <= 0: as it is)."""
+    if 0 < width < line.cell_len:
+        line = line.copy()
+        line.truncate(width, overflow="ellipsis")
+    return line
+
+
+def _shortened(text: str, room: int) -> str:
+    """``text`` in at most ``room`` characters (at least 4), its end replaced by an ellipsis when cut."""
+    room = max(room, 4)
+    return text if len(text) <= room else text[:room - 1] + "\u2026"
+
+
+def satellite_line(snap: CoreSnapshot, core: StationCore, clients: tuple[int, int], width: int = 0) -> Text:
+    """``Satellite ISS (25544) ISS (ZARYA)  TUNE ON  TRACK OFF  clients 1 (1 advise)`` (DDE clients); the
+    satellite's long name is shortened to keep the line within ``width`` (0: no limit)."""
+    state = snap.state
+    tail = (f"  TUNE {'ON' if state.dde_output else 'OFF'}  TRACK {'ON' if state.tracking else 'OFF'}"
+            f"  clients {clients[0]} ({clients[1]} advise)")
     line = Text("Satellite ")
     sat = core.state.catalog.get(snap.catalog_number) if snap.catalog_number is not None else None
     if sat is None:
@@ -50,10 +71,9 @@ def satellite_line(snap: CoreSnapshot, core: StationCore, clients: tuple[int, in
         line.append(sat.dde_name, style="bold")
         line.append(f" ({sat.catalog_number})")
         if sat.name != sat.dde_name:
-            line.append(f" {sat.name}")
-    state = snap.state
-    line.append(f"  TUNE {'ON' if state.dde_output else 'OFF'}  TRACK {'ON' if state.tracking else 'OFF'}"
-                f"  clients {clients[0]} ({clients[1]} advise)")
+            room = width - len(line) - 1 - len(tail) if width > 0 else len(sat.name)
+            line.append(f" {_shortened(sat.name, room)}")
+    line.append(tail)
     return line
 
 
@@ -81,8 +101,9 @@ def realtime(core: StationCore, catalog_number: int | None, now: datetime,
 
 
 def realtime_lines(values: RealtimeValues | None, why: str, core: StationCore, catalog_number: int | None,
-                   above_horizon: bool | None) -> list[Text]:
-    """Position, sub-satellite point, orbit and the downlink's Doppler and path loss."""
+                   above_horizon: bool | None, width: int = 0) -> list[Text]:
+    """Position, sub-satellite point, orbit and the downlink's Doppler and path loss (the channel's name
+    shortened to keep that line within ``width``; 0: no limit)."""
     if values is None:
         return [Text(why or "no position", style="yellow")]
     v = values
@@ -100,12 +121,15 @@ def realtime_lines(values: RealtimeValues | None, why: str, core: StationCore, c
         lines.append(Text("Downlink: no channel for this satellite, so no Doppler or path loss ([satellites] "
                           "channels)", style="dim"))
     else:
-        line = Text(f"Downlink {channel.satellite_downlink_hz() / 1e6:.4f} MHz (")
-        line.append(channel.name)
-        loss = "path loss - (below horizon)"
+        head = f"Downlink {channel.satellite_downlink_hz() / 1e6:.4f} MHz ("
+        loss = "path loss -"  # below the horizon (AH N on the line above)
         if up and v.path_loss_db is not None:
             loss = f"path loss {v.path_loss_db:.1f} dB"
-        line.append(f"): Doppler {v.doppler_hz:+,.0f} Hz  {loss}")
+        tail = f") Doppler {v.doppler_hz:+,.0f} Hz  {loss}"
+        name = channel.name if width <= 0 else _shortened(channel.name, width - len(head) - len(tail))
+        line = Text(head)
+        line.append(name)
+        line.append(tail)
         lines.append(line)
     return lines
 
@@ -116,12 +140,30 @@ def _angle(value: float | None) -> str:
     return f"{value:.1f}" if math.isfinite(value) else str(value)
 
 
-def antenna_line(snap: CoreSnapshot, radio: Text) -> Text:
-    """``Antenna az/el (source)  Radio: ...``."""
+def elements_line(core: StationCore, catalog_number: int | None, now: datetime, stale_days: float) -> Text | None:
+    """``Elements 20 days old (over 14): positions drift; nfwserver elements update`` for the selected
+    satellite when its element set is older than ``stale_days``; None otherwise."""
+    sat = core.state.catalog.get(catalog_number) if catalog_number is not None else None
+    if sat is None:
+        return None
+    age = sat.age_days(now)
+    if age <= stale_days:
+        return None
+    return Text(f"Elements {age:.0f} days old (over {stale_days:g}): positions drift; nfwserver elements update",
+                style="yellow")
+
+
+def antenna_lines(snap: CoreSnapshot, radio: Text, width: int = 0) -> list[Text]:
+    """``Antenna az/el (source)  Radio: ...`` on one line when it fits in ``width`` (0: no limit), else two."""
     ant = snap.state.antenna
-    line = Text(f"Antenna {_angle(ant.azimuth_deg)}/{_angle(ant.elevation_deg)} ({ant.source or 'unknown'})  ")
+    line = Text(f"Antenna {_angle(ant.azimuth_deg)}/{_angle(ant.elevation_deg)} ({ant.source or 'unknown'})")
+    if not radio:
+        return [line]
+    if width > 0 and line.cell_len + 2 + radio.cell_len > width:
+        return [line, radio]
+    line.append("  ")
     line.append_text(radio)
-    return line
+    return [line]
 
 
 def rotor_line(rotor: RotorCoupling) -> Text:

@@ -195,8 +195,7 @@ class StationCore:
         if isinstance(value, int):
             sat = catalog.get(value)
             return (sat, None) if sat is not None else (None, f"satellite {value} is not in the catalog")
-        key = value.upper()
-        found = [s for s in catalog if key in (s.dde_name.upper(), s.name.upper())]
+        found = catalog.named(value)
         if len(found) == 1:
             return found[0], None
         shown = escape_for_log(value, 40)

@@ -173,6 +173,11 @@ class Catalog:
                                  {k: v for k, v in overrides.items() if k in elements})
         return [names.get(n, str(n)) for n in catalog_numbers]
 
+    def named(self, name: str) -> list[Satellite]:
+        """The satellites whose DDE name or element-set name is ``name`` (case ignored), as ``SAT=`` matches."""
+        key = name.strip().upper()
+        return [s for s in self if key in (s.dde_name.upper(), s.name.upper())]
+
     def __contains__(self, catalog_number: object) -> bool:
         return catalog_number in self._elements
 

@@ -38,7 +38,7 @@ def test_80x24_notes_wrap_footer_shows_ctrl_d_and_every_pane_is_there() -> None:
             assert len(rows) == 24 and not off_screen(app), off_screen(app)
             assert "^d Doppler" in rows[-1]  # Ctrl+D in the footer from the start
             assert "Satellite ISS (25544)" in screen and "Passes (UTC)" in screen
-            assert "Satellite  Date  AOS   Max LOS" in screen
+            assert "Satellite Date  AOS   Max LOS" in screen
             # Every word of the long note is on screen, wrapped inside the pane (nothing cut at its edge).
             incoming = log_text(app, "incoming")
             width = app.query_one("#incoming").scrollable_content_region.width

@@ -63,7 +63,7 @@ def test_the_console_pass_list_flags_old_elements() -> None:
         passes = find_passes([catalog.get(25544)], HOME, now, now + timedelta(hours=12))
         text = pass_table(PassSearch(now, 25544, passes), catalog, times, now).plain
         assert text.splitlines()[1].startswith("ISS ")
-        assert (" !" in text.splitlines()[1]) is flagged
+        assert ("!" in text.splitlines()[1]) is flagged
         assert ("! elements up to 20 days old (over 14): positions drift; run `nfwserver elements update`"
                 in text) is flagged
     now = ISS.epoch + timedelta(days=20)
