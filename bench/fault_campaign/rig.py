@@ -28,6 +28,7 @@ from nfwserver.app.station import Station
 from nfwserver.clock import VirtualClock
 from nfwserver.config import parse_config
 from nfwserver.fake_dde import FakeDdeSystem
+from nfwserver.tcp.status_line import parse_status
 from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.observer import Observer
@@ -219,7 +220,7 @@ class FaultRig:
         text = sample.text if sample is not None else ""
         got = any(i == self.index and t for i, t in self.received[-3:])
         assert self.station.tcp is not None
-        status = dict(pair.split("=", 1) for pair in self.station.tcp.protocol.status_line().split(" "))
+        status = parse_status(self.station.tcp.protocol.status_line())
         traces, self._seen_tracebacks = self.tracebacks.count - self._seen_tracebacks, self.tracebacks.count
         lines = [line for line in self.drain_tty().decode("ascii", "replace").split("\r\n") if line]
         la = sample.look_angles if sample is not None else None

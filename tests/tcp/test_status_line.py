@@ -6,14 +6,16 @@ import re
 
 from nfwserver.tcp.status_line import format_status, parse_status
 
-#: The protocol's words: key=value pairs separated by single blanks, no blank or control character inside.
-WELL_FORMED = re.compile(r"[^\s=]+=\S+( [^\s=]+=\S+)*")
+#: The protocol's words: key=value pairs separated by single blanks; a value is a word with no blank or control
+#: character, or prose in double quotes (``\"`` and ``\\`` escaped inside), never with a control character.
+_VALUE = r'(?:"(?:[^"\\\x00-\x1f\x7f]|\\["\\])*"|[^\s"]\S*)'
+WELL_FORMED = re.compile(rf"[^\s=]+={_VALUE}( [^\s=]+={_VALUE})*")
 
 
 def test_the_line_is_written_as_the_protocol_says() -> None:
     line = format_status({"satellite": 25544, "name": None, "tune": True, "track": False,
                           "rotor_fault": "lost link\tto rotctld", "empty": ""})
-    assert line == "satellite=25544 name=- tune=on track=off rotor_fault=lost_link_to_rotctld empty=-"
+    assert line == 'satellite=25544 name=- tune=on track=off rotor_fault="lost link to rotctld" empty=-'
 
 
 def test_reading_gives_back_the_pairs_in_order() -> None:
@@ -30,4 +32,11 @@ def test_a_running_station_sends_a_well_formed_line(tcp_station, client) -> None
     line = client.ask("STATUS")
     assert WELL_FORMED.fullmatch(line), line
     fields = parse_status(line)
-    assert format_status(fields) == line and fields["note"] == "two_words__and_a_line"
+    assert format_status(fields) == line and fields["note"] == "two words and a line"
+
+
+def test_prose_reads_back_as_written_quotes_and_backslashes_included() -> None:
+    reason = 'rigctld: "busy" at C:\\COM3 (2 failures)'
+    line = format_status({"radio_fault": reason, "faults": "radio"})
+    assert line == 'radio_fault="rigctld: \\"busy\\" at C:\\\\COM3 (2 failures)" faults=radio'
+    assert parse_status(line) == {"radio_fault": reason, "faults": "radio"}
