@@ -25,6 +25,7 @@ if TYPE_CHECKING:
     from nfwserver.tracking.catalog import Catalog, Satellite
     from nfwserver.tracking.observer import Observer
     from nfwserver.tracking.pass_records import PassList
+    from nfwserver.tracking.pass_spill import SpilledPasses
 
 EPHEMERIS_COLUMNS = ["time_utc", "azimuth_deg", "elevation_deg", "range_km", "range_rate_km_s", "above_horizon"]
 PASS_COLUMNS = ["catalog_number", "name", "aos_utc", "tca_utc", "los_utc", "max_elevation_deg",
@@ -208,36 +209,33 @@ def _run_catalog_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: 
     import numpy as np
 
     from nfwserver.cli.bulk_output import write_rows
-    from nfwserver.cli.output_columns import Duration, Flag, Integer, Number, Text, Time
+    from nfwserver.cli.pass_rows import above, wide_columns, write_spilled
     from nfwserver.cli.pass_table import compact_columns
+    from nfwserver.tracking.pass_records import PassList
 
     start = args.start
-    passes, names, short_names, searched = _find_passes(args, inputs, sets)  # the catalog's memory serves the output
-    cols = passes.columns
-    if args.min_el != 0.0:
-        keep = cols["max_elevation_deg"] >= args.min_el
-        cols = {key: value[keep] for key, value in cols.items()}
+    # CSV and JSON are written as they come: the search's passes wait in temporary files, not in memory.
+    passes, names, short_names, searched = _find_passes(args, inputs, sets, args.format in ("csv", "json"))
+    if not isinstance(passes, PassList):
+        try:
+            always_up_note([names[n] for n in passes.always_up(args.min_el)])
+            write_spilled(passes, start, args.min_el, names, PASS_COLUMNS, args.format, sys.stdout)
+        finally:
+            passes.close()
+        return 0
+    cols = above(passes.columns, args.min_el)
     numbers = np.array(sorted(names), dtype=np.int64)
-    which = np.searchsorted(numbers, cols["catalog_number"])
     compact = args.format == "table" and not args.wide
     up = cols["catalog_number"][np.isnan(cols["aos_s"]) & np.isnan(cols["los_s"])].tolist()
     always_up_note([(short_names if compact else names)[n] for n in up])
     if compact:
         if not len(cols["catalog_number"]):
             no_passes_warning(args, searched)
-        write_rows(compact_columns(start, cols, [short_names[n] for n in numbers.tolist()], which, args.local),
-                   "table", sys.stdout)
+        write_rows(compact_columns(start, cols, [short_names[n] for n in numbers.tolist()],
+                                   np.searchsorted(numbers, cols["catalog_number"]), args.local), "table", sys.stdout)
         return 0
     wide_table_local_note(args)
-    aos_unknown, los_unknown = np.isnan(cols["aos_s"]), np.isnan(cols["los_s"])
-    aos, los = Time("aos_utc", start, cols["aos_s"], aos_unknown), Time("los_utc", start, cols["los_s"], los_unknown)
-    write_rows([Integer("catalog_number", cols["catalog_number"]), Text("name", [names[n] for n in numbers.tolist()],
-                                                                          which),
-                aos, Time("tca_utc", start, cols["tca_s"]), los,
-                Number("max_elevation_deg", cols["max_elevation_deg"], 1),
-                Number("aos_azimuth_deg", cols["aos_azimuth_deg"], 1, aos_unknown),
-                Number("los_azimuth_deg", cols["los_azimuth_deg"], 1, los_unknown), Duration("duration_s", aos, los, 0),
-                Flag("in_progress", aos_unknown | (cols["aos_s"] < 0.0))], args.format, sys.stdout)
+    write_rows(wide_columns(start, cols, numbers, [names[n] for n in numbers.tolist()]), args.format, sys.stdout)
     return 0
 
 
@@ -264,21 +262,29 @@ def wide_table_local_note(args: argparse.Namespace) -> None:
               "drop --wide to see them", file=sys.stderr)
 
 
-def _find_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: list[Any]
-                 ) -> tuple[PassList, dict[int, str], dict[int, str], int]:
-    """The passes of ``sets`` over the window the options ask for, the name and the DDE name (at most 12
-    characters; only for the compact table, which alone shows them) to show for each satellite that has one
-    (by catalog number), and how many satellites were searched."""
-    from nfwserver.tracking.passes import auto_workers, find_passes
+def _find_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: list[Any], spilled: bool
+                 ) -> tuple[PassList | SpilledPasses, dict[int, str], dict[int, str], int]:
+    """The passes of ``sets`` over the window the options ask for (``spilled``: in temporary files, which the
+    caller deletes), the name and the DDE name (at most 12 characters; only for the compact table, which alone
+    shows them) to show for each satellite that has one (by catalog number), and how many satellites were
+    searched."""
+    from nfwserver.tracking.pass_records import PassList
+    from nfwserver.tracking.passes import auto_workers, find_passes, find_passes_spilled
 
     start = args.start
     workers = auto_workers(len(sets)) if args.workers == "auto" else int(args.workers)
     # The search leaves out the sets unusable at the start (it makes their models anyway); they and the
     # stale sets are reported after it, before any row (the compact table names them with its satellites).
-    passes = find_passes(sets, inputs.observer, start, start + timedelta(hours=args.hours), horizon=inputs.horizon,
-                         ut1_utc=inputs.ut1_utc, workers=workers)
-    numbers = passes.catalog_numbers()
-    names, short_names, searched = pass_names(args, inputs, sets, passes.skipped, numbers)
+    search = find_passes_spilled if spilled else find_passes
+    passes: PassList | SpilledPasses = search(sets, inputs.observer, start, start + timedelta(hours=args.hours),
+                                              horizon=inputs.horizon, ut1_utc=inputs.ut1_utc, workers=workers)
+    try:
+        numbers = passes.catalog_numbers()
+        names, short_names, searched = pass_names(args, inputs, sets, passes.skipped, numbers)
+    except BaseException:
+        if not isinstance(passes, PassList):
+            passes.close()
+        raise
     return passes, names, short_names, searched
 
 

@@ -171,7 +171,7 @@ class PassColumns:
         if not self._columns or n + k > self._capacity:
             capacity = self._capacity if not self._columns else max(2 * self._capacity, n + k)
             for name, dtype in COLUMNS:
-                grown = _mapped(capacity, dtype)
+                grown = mapped(capacity, dtype)
                 if name in self._columns:
                     grown[:n] = self._columns[name][:n]
                 self._columns[name] = grown
@@ -196,7 +196,7 @@ class PassColumns:
         return PassList(start, window_s, merged, sort=False, skipped=skipped)
 
 
-def _mapped(rows: int, dtype: type) -> np.ndarray:
+def mapped(rows: int, dtype: type) -> np.ndarray:
     """An array of ``rows`` in its own anonymous memory map: its pages take memory only once written, and it
     is unmapped (given back to the system) when the array is freed, whatever the C heap does meanwhile."""
     buffer = mmap.mmap(-1, max(rows, 1) * np.dtype(dtype).itemsize)

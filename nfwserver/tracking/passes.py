@@ -38,7 +38,7 @@ import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
-from typing import TYPE_CHECKING, Any
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -52,13 +52,14 @@ from nfwserver.tracking.pass_batch import Batch, Chunk
 from nfwserver.tracking.pass_kinematics import PairEvaluator
 from nfwserver.tracking.pass_records import Pass, PassColumns, PassList
 from nfwserver.tracking.pass_screen import screen
+from nfwserver.tracking.pass_spill import SpilledPasses
 from nfwserver.tracking.screening import usable_models
 from nfwserver.tracking.timescale import julian_date
 
 if TYPE_CHECKING:  # multiprocessing is imported only when workers are forked (1.3 MiB, 5 ms)
     from multiprocessing.connection import Connection
 
-__all__ = ["Pass", "PassList", "find_passes"]
+__all__ = ["Pass", "PassList", "SpilledPasses", "find_passes", "find_passes_spilled"]
 
 _FLAT = HorizonTable()
 #: Satellites with periods up to this (s) form the low group.
@@ -92,9 +93,12 @@ def auto_workers(satellites: int) -> int:
 def _fork_worker(satellites: list[Any], args: tuple[Any, ...], results: Connection) -> None:
     """A forked worker's whole life: the passes of its share of the chunks (``args``: :func:`_search`'s after the
     satellites), sent back through ``results`` (or the exception that stopped it).  Runs in the child only; the
-    satellites reached it by the fork (Satrec objects cannot be pickled), only the result is pickled."""
+    satellites reached it by the fork (Satrec objects cannot be pickled), only the result is pickled.  A search
+    that spills (``args``' last, a SpilledPasses on a file the parent made) writes its rows to that file and
+    sends back only what orders them (:meth:`SpilledPasses.keys`) and the satellites it left out."""
     try:
-        outcome: PassList | BaseException = _search(satellites, *args)
+        found = _search(satellites, *args)
+        outcome: object = (found.keys(), found.skipped) if isinstance(found, SpilledPasses) else found
     except BaseException as exc:  # handed to the parent, which raises it
         outcome = exc
     try:
@@ -103,11 +107,12 @@ def _fork_worker(satellites: list[Any], args: tuple[Any, ...], results: Connecti
         results.close()
 
 
-def _in_forked_workers(satellites: list[Any], plan: list[_Chunk], args: tuple[Any, ...], workers: int
-                       ) -> list[PassList]:
+def _in_forked_workers(satellites: list[Any], plan: list[_Chunk], args: tuple[Any, ...], workers: int,
+                       spills: Sequence[IO[bytes]] = ()) -> list[Any]:
     """The passes of the chunks of ``plan`` found by ``workers`` forked processes, one share each (every
     ``workers``-th chunk: the chunks of one process, so the passes are those of one process bit for bit), in
-    the order of the shares (POSIX: the caller checked that fork exists)."""
+    the order of the shares (POSIX: the caller checked that fork exists).  With ``spills`` (one temporary file
+    per worker), each worker writes its rows to its file and hands back their keys (:func:`_fork_worker`)."""
     import multiprocessing
 
     if sys.platform == "win32":  # never true here (the caller checked); it tells the type checker the rest is POSIX
@@ -119,7 +124,8 @@ def _in_forked_workers(satellites: list[Any], plan: list[_Chunk], args: tuple[An
     try:
         for k in range(workers):
             receiver, sender = context.Pipe(duplex=False)
-            process = context.Process(target=_fork_worker, args=(satellites, (plan[k::workers], *args), sender),
+            spill = (SpilledPasses(args[1], (args[2] - args[1]).total_seconds(), spills[k]),) if spills else ()
+            process = context.Process(target=_fork_worker, args=(satellites, (plan[k::workers], *args, *spill), sender),
                                       daemon=True)
             process.start()
             sender.close()  # the child holds its own end: EOF here if it dies without an answer
@@ -176,6 +182,32 @@ def find_passes(
     other threads can deadlock the child, so the work stays in this process unless it is single-threaded.
     The passes found are those of one process, bit for bit.
     """
+    found = _find(satellites, observer, start, end, horizon, ut1_utc, fine_step_s, workers, False)
+    assert isinstance(found, PassList)
+    return found
+
+
+def find_passes_spilled(
+    satellites: Sequence[Any],
+    observer: Observer,
+    start: datetime,
+    end: datetime,
+    horizon: HorizonTable | None = None,
+    ut1_utc: float = 0.0,
+    fine_step_s: float = 60.0,
+    workers: int = 1,
+) -> SpilledPasses:
+    """The passes :func:`find_passes` finds, kept in temporary files and read back in order a slab at a time
+    (:class:`~nfwserver.tracking.pass_spill.SpilledPasses`): for writing a large search's passes out without
+    holding them all.  The caller closes the result (deleting the files)."""
+    found = _find(satellites, observer, start, end, horizon, ut1_utc, fine_step_s, workers, True)
+    assert isinstance(found, SpilledPasses)
+    return found
+
+
+def _find(satellites: Sequence[Any], observer: Observer, start: datetime, end: datetime, horizon: HorizonTable | None,
+          ut1_utc: float, fine_step_s: float, workers: int, spilled: bool) -> PassList | SpilledPasses:
+    """:func:`find_passes`, or with ``spilled`` :func:`find_passes_spilled`."""
     satellites = [getattr(s, "elements", s) for s in satellites]  # a catalog satellite's element set
     horizon = horizon or _FLAT
     if start.tzinfo is None:
@@ -184,16 +216,27 @@ def find_passes(
         end = end.replace(tzinfo=timezone.utc)
     window_s = (end - start).total_seconds()
     if end <= start or not satellites:
-        return PassList(start, max(window_s, 0.0))
+        return SpilledPasses(start, max(window_s, 0.0)).seal() if spilled else PassList(start, max(window_s, 0.0))
     plan = _plan(satellites, window_s)
     args = (observer, start, end, horizon, ut1_utc, fine_step_s)
     if workers > 1 and len(plan) > 1 and threading.active_count() == 1:
         import multiprocessing
 
         if "fork" in multiprocessing.get_all_start_methods():
-            parts = _in_forked_workers(satellites, plan, args, min(workers, len(plan)))
-            return PassList.concat(start, window_s, parts)
-    return _search(satellites, plan, *args)
+            workers = min(workers, len(plan))
+            if not spilled:
+                return PassList.concat(start, window_s, _in_forked_workers(satellites, plan, args, workers))
+            import tempfile
+
+            spills = [tempfile.TemporaryFile() for _ in range(workers)]  # noqa: SIM115 (closed by the result)
+            try:
+                parts = _in_forked_workers(satellites, plan, args, workers, spills)
+            except BaseException:
+                for spill in spills:
+                    spill.close()
+                raise
+            return SpilledPasses.joined(start, window_s, spills, parts)
+    return _search(satellites, plan, *args, SpilledPasses(start, window_s) if spilled else None)
 
 
 @dataclass(frozen=True)
@@ -237,10 +280,12 @@ def _plan(satellites: Sequence[Any], window_s: float) -> list[_Chunk]:
 
 
 def _search(satellites: Sequence[Any], plan: list[_Chunk], observer: Observer, start: datetime, end: datetime,
-            horizon: HorizonTable, ut1_utc: float, fine_step_s: float) -> PassList:
-    """The passes of the chunks of ``plan`` (aware ``start`` and ``end``), in this process."""
+            horizon: HorizonTable, ut1_utc: float, fine_step_s: float, spill: SpilledPasses | None = None
+            ) -> PassList | SpilledPasses:
+    """The passes of the chunks of ``plan`` (aware ``start`` and ``end``), in this process (into ``spill`` when
+    given)."""
     window_s = (end - start).total_seconds()
-    found = PassColumns(sum(c.room for c in plan))
+    found = spill if spill is not None else PassColumns(sum(c.room for c in plan))
     batch = Batch()
     jd_start, fr_start = julian_date(start)
     skipped: list[int] = []
@@ -263,6 +308,8 @@ def _search(satellites: Sequence[Any], plan: list[_Chunk], observer: Observer, s
             batch = Batch()
     if batch.chunks:
         found.add(_refine(batch, observer, horizon, ut1_utc))
+    if isinstance(found, SpilledPasses):
+        return found.seal(skipped)
     return found.pass_list(start, window_s, skipped)
 
 

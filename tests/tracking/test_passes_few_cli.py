@@ -23,6 +23,7 @@ from nfwserver.cli import main
 from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.few_passes import FewPasses
 from nfwserver.tracking.pass_records import PassList
+from nfwserver.tracking.pass_spill import SpilledPasses
 from tests.conftest import DATA
 
 START = datetime(2026, 5, 8, tzinfo=timezone.utc)
@@ -63,8 +64,16 @@ def _run_both(capsys, monkeypatch, argv: list[str]) -> tuple[str, str]:
                                         "aos_azimuth_deg", "los_azimuth_deg"), zip(*ROWS))}
     monkeypatch.setattr(few_command, "FEW", 0)
     monkeypatch.setattr(passes_module, "find_passes", lambda *a, **k: PassList(START, 86400.0, columns))
+    # CSV and JSON are written from passes kept in a temporary file
+    monkeypatch.setattr(passes_module, "find_passes_spilled", lambda *a, **k: _spilled(columns))
     assert main(argv) == 0
     return small, capsys.readouterr().out
+
+
+def _spilled(columns: dict[str, np.ndarray]) -> SpilledPasses:
+    spilled = SpilledPasses(START, 86400.0)
+    spilled.add(columns)
+    return spilled.seal()
 
 
 @pytest.mark.parametrize("options", [["--format", "table"], ["--format", "table", "--wide"], ["--format", "csv"],
