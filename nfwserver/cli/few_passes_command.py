@@ -27,14 +27,14 @@ def run_few_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: list[
     when the catalog search must do it."""
     if not 0 < len(sets) <= FEW or not inputs.horizon.is_flat:
         return False
-    from nfwserver.cli.pass_text import write_pass_text
-    from nfwserver.cli.tracking_commands import (
+    from nfwserver.cli.pass_reports import (
         PASS_COLUMNS,
         always_up_note,
         no_passes_warning,
         pass_names,
         wide_table_local_note,
     )
+    from nfwserver.cli.pass_text import write_pass_text
     from nfwserver.tracking.few_passes import NeedsCatalogSearch, find_few_passes
     from nfwserver.tracking.timescale import julian_date
 

@@ -13,12 +13,22 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Mapping, Sequence
 from datetime import datetime, timedelta
 from typing import TYPE_CHECKING, Any
 
 from nfwserver.cli.arguments import number_in, satellite_value, time_value
 from nfwserver.cli.errors import CliError, say
+from nfwserver.cli.pass_reports import (
+    PASS_COLUMNS,
+    always_up_note,
+    dde_name_map,
+    no_passes_warning,
+    pass_names,
+    report_stale,
+    report_unusable,
+    stale_days_of,
+    wide_table_local_note,
+)
 from nfwserver.cli.tracking_options import TrackingInputs, add_tracking_options, format_time, load_tracking_inputs
 
 if TYPE_CHECKING:
@@ -28,8 +38,6 @@ if TYPE_CHECKING:
     from nfwserver.tracking.pass_spill import SpilledPasses
 
 EPHEMERIS_COLUMNS = ["time_utc", "azimuth_deg", "elevation_deg", "range_km", "range_rate_km_s", "above_horizon"]
-PASS_COLUMNS = ["catalog_number", "name", "aos_utc", "tca_utc", "los_utc", "max_elevation_deg",
-                "aos_azimuth_deg", "los_azimuth_deg", "duration_s", "in_progress"]
 VISIBLE_COLUMNS = ["catalog_number", "name", "azimuth_deg", "elevation_deg", "range_km", "range_rate_km_s"]
 TIME_HELP = "'now' (default), relative (+2h, -30m, +90s, +1d) or ISO-8601 (UTC when no zone is given)"
 MAX_DURATION_S = 366 * 86400.0
@@ -112,46 +120,10 @@ def _screen(sats: list[Any], catalog: Catalog, observer: Observer, ut1_utc: floa
     if unusable:
         sats = [s for s, ok in zip(sats, usable) if ok]
     stale = stale_satellites(sats, at, stale_days)
-    names = _dde_name_map(unusable[:5] + stale[:5], catalog)
-    _report_unusable(unusable, names, at)
-    _report_stale(stale, names, at, stale_days)
+    names = dde_name_map(unusable[:5] + stale[:5], catalog)
+    report_unusable(unusable, names, at)
+    report_stale(stale, names, at, stale_days)
     return sats
-
-
-def _report_unusable(unusable: list[Any], names: Mapping[int, str], at: datetime) -> None:
-    """Warn of the satellites (or element sets) left out because their positions at ``at`` are unusable,
-    naming up to five by DDE name (``names``, by catalog number)."""
-    if unusable:
-        shown = ", ".join(names[s.catalog_number] for s in unusable[:5]) + (", ..." if len(unusable) > 5 else "")
-        say(f"skipped {len(unusable)} object(s) whose position at {format_time(at)} cannot be computed "
-             f"or is implausibly far (decayed or elements far outside their validity): {shown}")
-
-
-def _report_stale(stale: list[Any], names: Mapping[int, str], at: datetime, stale_days: float) -> None:
-    """Warn of the sets older than ``stale_days`` before ``at``, naming up to five by DDE name (``names``)."""
-    if stale:
-        shown = ", ".join(names[s.catalog_number] for s in stale[:5]) + (", ..." if len(stale) > 5 else "")
-        ages = [(at - getattr(s, "elements", s).epoch).total_seconds() / 86400.0 for s in stale]
-        span = f"{min(ages):.0f} to {max(ages):.0f}" if round(min(ages)) != round(max(ages)) else f"{max(ages):.0f}"
-        sets, drift = ("1 element set is", "its position drifts") if len(stale) == 1 else \
-            (f"{len(stale)} element sets are", "their positions drift")
-        say(f"{sets} {span} days old at {format_time(at)} (more than [elements] stale_days, {stale_days:g}), "
-            f"so {drift} ({shown}); `nfwserver elements update` fetches newer ones")
-
-
-def _stale_days(inputs: TrackingInputs) -> float:
-    """``[elements] stale_days`` of the configuration in use."""
-    return float(inputs.config().elements.stale_days)
-
-
-def _dde_name_map(items: list[Any], catalog: Catalog, more: Sequence[int] = ()) -> dict[int, str]:
-    """The DDE names of satellites or element sets (a satellite's own; the sets' from the catalog) and of the
-    catalog numbers ``more``, by catalog number: one naming of the catalog for all of them (each call names
-    the whole catalog when nothing has named it yet)."""
-    names = {s.catalog_number: s.dde_name for s in items if hasattr(s, "dde_name")}
-    wanted = [s.catalog_number for s in items if not hasattr(s, "dde_name")] + [n for n in more if n not in names]
-    names.update(zip(wanted, catalog.dde_names_of(wanted)) if wanted else ())
-    return names
 
 
 def run_ephemeris(args: argparse.Namespace) -> int:
@@ -168,7 +140,7 @@ def run_ephemeris(args: argparse.Namespace) -> int:
     if args.sat is None and inputs.satellite is None:
         raise CliError("no --sat given and no [server] satellite configured")
     sat = _pick(inputs.catalog, str(args.sat if args.sat is not None else inputs.satellite))
-    _screen([sat], inputs.catalog, inputs.observer, inputs.ut1_utc, start, _stale_days(inputs))
+    _screen([sat], inputs.catalog, inputs.observer, inputs.ut1_utc, start, stale_days_of(inputs))
     calc = LookAngleCalculator(inputs.observer, inputs.ut1_utc)
     writer = RowWriter(EPHEMERIS_COLUMNS, args.format, sys.stdout)
     count = int(args.duration // args.step) + 1
@@ -239,29 +211,6 @@ def _run_catalog_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: 
     return 0
 
 
-def no_passes_warning(args: argparse.Namespace, searched: int) -> None:
-    """The compact table's line on stderr when no pass is listed."""
-    reach = f" reaching {args.min_el:g} deg" if args.min_el else ""
-    say(f"no passes{reach} of the {searched} satellite(s) in the {args.hours:g} h from {format_time(args.start)}")
-
-
-def always_up_note(names: Sequence[str]) -> None:
-    """Name on stderr the satellites (``names``) whose rows have neither AOS nor LOS because they stay up."""
-    if names:
-        shown = ", ".join(names[:5]) + (", ..." if len(names) > 5 else "")
-        say(f"up for the whole window (above the horizon from before the search to after it, so no AOS or "
-             f"LOS): {shown}")
-
-
-def wide_table_local_note(args: argparse.Namespace) -> None:
-    """``--local`` with ``--wide``: say on stderr that the wide table stays in UTC."""
-    if args.local and args.format == "table":
-        from nfwserver.cli.pass_text import zone_label
-
-        print(f"times in UTC: --local shortens the table's times only ({zone_label(True, args.start)} here); "
-              "drop --wide to see them", file=sys.stderr)
-
-
 def _find_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: list[Any], spilled: bool
                  ) -> tuple[PassList | SpilledPasses, dict[int, str], dict[int, str], int]:
     """The passes of ``sets`` over the window the options ask for (``spilled``: in temporary files, which the
@@ -286,30 +235,6 @@ def _find_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: list[An
             passes.close()
         raise
     return passes, names, short_names, searched
-
-
-def pass_names(args: argparse.Namespace, inputs: TrackingInputs, sets: list[Any], skipped: Sequence[int],
-               numbers: Sequence[int]) -> tuple[dict[int, str], dict[int, str], int]:
-    """After a search of ``sets`` that left out ``skipped`` and found passes of ``numbers``: the unusable and
-    the stale sets reported on stderr; the name and the DDE name (compact table only) to show for each of
-    ``numbers``, and how many satellites were searched."""
-    from nfwserver.tracking.staleness import stale_satellites
-
-    compact = args.format == "table" and not args.wide  # the only output that shows DDE names
-    stale_days = _stale_days(inputs)
-    left_out = set(skipped)
-    unusable = [s for s in sets if s.catalog_number in left_out]
-    sets = [s for s in sets if s.catalog_number not in left_out] if left_out else sets
-    stale = stale_satellites(sets, args.start, stale_days)
-    by_number = {es.catalog_number: es.name for es in sets}
-    element_names = {n: by_number[n] for n in numbers}
-    # Every DDE name shown (the warnings', the compact table's, those of unnamed sets) from one naming.
-    dde = _dde_name_map(unusable[:5] + stale[:5], inputs.catalog,
-                        numbers if compact else [n for n, name in element_names.items() if not name])
-    _report_unusable(unusable, dde, args.start)
-    _report_stale(stale, dde, args.start, stale_days)
-    return ({n: name or dde[n] for n, name in element_names.items()}, {n: dde[n] for n in numbers} if compact else {},
-            len(sets))
 
 
 def _chosen_sets(args: argparse.Namespace, inputs: TrackingInputs, catalog: Catalog) -> list[Any]:
@@ -353,7 +278,7 @@ def run_visible(args: argparse.Namespace) -> int:
     at = args.at
     inputs = load_tracking_inputs(args)
     sats = _screen(inputs.catalog.satellites(), inputs.catalog, inputs.observer, inputs.ut1_utc, at,
-                   _stale_days(inputs))
+                   stale_days_of(inputs))
     if sats:
         jd, fr = julian_date(at)
         arr = look_angles_array([s.satrec for s in sats], inputs.observer, np.array([jd]), np.array([fr]),

@@ -13,7 +13,7 @@ import pytest
 import nfwserver.cli.pass_rows as pass_rows
 from nfwserver.cli import main
 from nfwserver.cli.bulk_output import write_rows
-from nfwserver.cli.tracking_commands import PASS_COLUMNS
+from nfwserver.cli.pass_reports import PASS_COLUMNS
 from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.observer import Observer
 from nfwserver.tracking.pass_records import COLUMNS, PassColumns, PassList
