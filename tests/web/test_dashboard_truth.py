@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from selenium.webdriver.common.by import By
 
-from tests.web.conftest import open_page, wait_for
+from tests.web.conftest import config_text, open_page, start_station, wait_for
 
 
 def test_a_connecting_page_shows_each_log_line_once(browser, web_station) -> None:
@@ -43,3 +43,23 @@ def test_the_live_badge_says_when_frames_stop(browser, web_station) -> None:
     web.parts.rotor = None
     web_station.advance(0.6)
     wait_for(lambda: badge.text == "live", what="live again after the first good frame")
+
+
+def test_doppler_tuning_without_a_channel_is_not_shown_as_on(browser) -> None:
+    """#34 item 8: a green "DOPPLER ON" stood beside "no radio channel for this satellite"."""
+    web = start_station(config_text())  # ISS has a built-in channel; 694 (in visual.txt) has none
+    try:
+        web.station.core.set_radio_tuning(True)
+        open_page(browser, web)
+        radio = browser.find_element(By.CSS_SELECTOR, '[data-testid="radio-state"]')
+        wait_for(lambda: radio.text == "DOPPLER ON", what="DOPPLER ON for the ISS, which has a channel")
+        assert "on" in radio.get_attribute("class").split()
+        assert web.station.core.command("SAT=694", source="test").accepted
+        web.advance(0.6)
+        wait_for(lambda: radio.text == "DOPPLER IDLE: NO CHANNEL", what="the badge to say no channel")
+        classes = radio.get_attribute("class").split()
+        assert "warn" in classes and "on" not in classes
+        doppler = browser.find_element(By.CSS_SELECTOR, '[data-testid="doppler"]')
+        assert doppler.text == "no radio channel for this satellite"
+    finally:
+        web.station.stop()

@@ -48,7 +48,10 @@ function renderNow(f) {
   text("sat-full", sat && sat.name !== sat.dde_name ? sat.name : "");
   badge("tune-state", "TUNE " + (n.tune ? "ON" : "OFF"), n.tune);
   badge("track-state", "TRACK " + (n.track ? "ON" : "OFF"), n.track);
-  badge("radio-state", "DOPPLER " + (n.radio_tuning ? "ON" : "OFF"), n.radio_tuning);
+  // Doppler tuning switched on does nothing for a satellite without a radio channel: say so, not a green ON.
+  const idle = n.radio_tuning && !n.doppler;
+  badge("radio-state", "DOPPLER " + (idle ? "IDLE: NO CHANNEL" : n.radio_tuning ? "ON" : "OFF"), n.radio_tuning,
+        idle ? "warn" : undefined);
   badge("ah", "AH " + (pos ? (pos.above_horizon ? "Y" : "N") : "-"), pos && pos.above_horizon);
   text("az", pos ? fixed(pos.az, 1) : "-");
   text("el", pos ? fixed(pos.el, 1) : "-");
