@@ -159,7 +159,7 @@ Section "nfwserver (required)" SecProgram
   RMDir /r "${MENU}"
   CreateDirectory "${MENU}"
   CreateShortCut "${MENU}\nfwserver station.lnk" "$INSTDIR\nfwserver.exe" "run" "$INSTDIR\nfwserver.exe" 0 \
-    SW_SHOWNORMAL "" "The station with its console (Ctrl+C or F10 stops it)"
+    SW_SHOWNORMAL "" "The station with its console (Ctrl+Q stops it)"
   CreateShortCut "${MENU}\nfwserver dashboard.lnk" "$INSTDIR\nfwserverw.exe" "dashboard" \
     "$INSTDIR\nfwserver.exe" 0 SW_SHOWNORMAL "" "The running station's web page in your browser"
   CreateShortCut "${MENU}\nfwserver configuration.lnk" "$INSTDIR\nfwserverw.exe" "config edit" \
