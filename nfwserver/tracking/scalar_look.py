@@ -42,8 +42,10 @@ class ScalarLookAngles:
         w = theta_dot / SECONDS_PER_DAY
         return x, y, r[2], c * v[0] + s * v[1] + w * y, -s * v[0] + c * v[1] - w * x, v[2]
 
-    def look(self, r: Sequence[float], v: Sequence[float], jd: float, fr: float) -> tuple[float, float, float, float]:
-        """(azimuth deg, elevation deg, range km, range rate km/s) of a TEME state."""
+    def _topocentric(self, r: Sequence[float], v: Sequence[float], jd: float, fr: float
+                     ) -> tuple[float, float, float, float, float]:
+        """(azimuth deg, up km, range km, range rate km/s, up rate km/s) of a TEME state: the local frame's
+        parts :meth:`look` and :meth:`rise_state` are made of."""
         x, y, z, vx, vy, vz = self.itrs(r, v, jd, fr)
         dx, dy, dz = x - self._ox, y - self._oy, z - self._oz
         e, n, u = self._e, self._n, self._u
@@ -54,22 +56,16 @@ class ScalarLookAngles:
         az = math.atan2(east, north) * _DEG
         if az < 0.0:
             az += 360.0
-        return az, math.asin(up / rng) * _DEG, rng, (dx * vx + dy * vy + dz * vz) / rng
+        return az, up, rng, (dx * vx + dy * vy + dz * vz) / rng, u[0] * vx + u[1] * vy + u[2] * vz
+
+    def look(self, r: Sequence[float], v: Sequence[float], jd: float, fr: float) -> tuple[float, float, float, float]:
+        """(azimuth deg, elevation deg, range km, range rate km/s) of a TEME state."""
+        az, up, rng, range_rate, _ = self._topocentric(r, v, jd, fr)
+        return az, math.asin(up / rng) * _DEG, rng, range_rate
 
     def rise_state(self, r: Sequence[float], v: Sequence[float], jd: float, fr: float
                    ) -> tuple[float, float, float]:
         """(elevation deg, azimuth deg, d(sin elevation)/dt in 1/s) of a TEME state: the elevation and the
         rate whose sign tells rising from setting (smooth through the zenith, unlike the elevation's)."""
-        x, y, z, vx, vy, vz = self.itrs(r, v, jd, fr)
-        dx, dy, dz = x - self._ox, y - self._oy, z - self._oz
-        e, n, u = self._e, self._n, self._u
-        east = e[0] * dx + e[1] * dy
-        north = n[0] * dx + n[1] * dy + n[2] * dz
-        up = u[0] * dx + u[1] * dy + u[2] * dz
-        rng = math.sqrt(dx * dx + dy * dy + dz * dz)
-        az = math.atan2(east, north) * _DEG
-        if az < 0.0:
-            az += 360.0
-        up_rate = u[0] * vx + u[1] * vy + u[2] * vz
-        range_rate = (dx * vx + dy * vy + dz * vz) / rng
+        az, up, rng, range_rate, up_rate = self._topocentric(r, v, jd, fr)
         return math.asin(up / rng) * _DEG, az, (up_rate - up * range_rate / rng) / rng
