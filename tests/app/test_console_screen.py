@@ -32,7 +32,9 @@ def test_80x24_notes_wrap_footer_shows_ctrl_d_and_every_pane_is_there() -> None:
         app = NfwConsole(station.core, "serving on the in-process transport, for clients in this process only",
                          LONG_HINT, favourites=(ISS,), clients=station.nova.client_count)
         async with app.run_test(size=(80, 24)) as pilot:
-            await settle(app, pilot)
+            # the footer is drawn after the panes: under load a first read can find its row still blank
+            await settle(app, pilot, until=lambda: "^d Doppler" in screen_text(app).splitlines()[-1],
+                         what="Ctrl+D in the footer")
             screen = screen_text(app)
             rows = screen.splitlines()
             assert len(rows) == 24 and not off_screen(app), off_screen(app)
