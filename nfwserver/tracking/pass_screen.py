@@ -39,6 +39,7 @@ from nfwserver.tracking.constants import SECONDS_PER_DAY, WGS72_MU_KM3_S2
 from nfwserver.tracking.frames import TopocentricFrame
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.pass_kinematics import PairEvaluator
+from nfwserver.tracking.pass_plane import EARTH_RATE, MAX_ECCENTRICITY, plane_possible, propagate_possible
 from nfwserver.tracking.timescale import gmst1982
 
 #: Geocentric angular rate (rad/s) of a low satellite, for which the fine step is ``fine_step_s``.
@@ -47,8 +48,9 @@ _LEO_RATE = 1.2e-3
 _FLAT_STEP_S = 1200.0
 #: Sat-time pairs per compiled screen call (bounds the screen's memory).
 _SCREEN_PAIRS = 10000
-#: The Earth's rotation rate (rad/s), generously rounded up.
-_EARTH_RATE = 7.3e-5
+#: Above this share of a chunk's coarse intervals left possible by the orbits' planes, the whole grid is
+#: propagated in one compiled call (cheaper than a call per satellite for the few points saved).
+_PLANE_WORTH = 0.8
 
 
 INTERVAL_FIELDS = ("sat", "a", "b", "ga", "gb", "guess")
@@ -166,7 +168,7 @@ def _up_jerk_bound(satrecs: list[Any]) -> np.ndarray:
     ecc = np.array([sr.ecco for sr in satrecs])
     with np.errstate(invalid="ignore", divide="ignore"):
         a = (WGS72_MU_KM3_S2 / (no * no)) ** (1.0 / 3.0)
-        rate = no * (1.0 + ecc) ** 2 / (1.0 - ecc * ecc) ** 1.5 + _EARTH_RATE
+        rate = no * (1.0 + ecc) ** 2 / (1.0 - ecc * ecc) ** 1.5 + EARTH_RATE
         bound = 2.0 * a * (1.0 + ecc) * rate ** 4
     return np.where((ecc < 0.1) & np.isfinite(bound), bound, np.inf)
 
@@ -206,11 +208,21 @@ def screen(satrecs: list[Any], frame: TopocentricFrame, horizon: HorizonTable, j
     chunk = max(1, _SCREEN_PAIRS // len(grid))
     for i0 in range(0, len(satrecs), chunk):
         part = satrecs[i0 : i0 + chunk]
-        err, r, v = SatrecArray(part).sgp4(jd, fr)
+        # Under a flat horizon, the intervals the orbits' planes prove invisible are not propagated (under a
+        # sloping one the sampling step depends on the rate bound, which all the grid's points give).
+        possible = plane_possible(part, frame.origin, _lowest(horizon), jd0, fr0, grid, ut1_utc) if flat else None
+        if possible is not None and possible.mean() <= _PLANE_WORTH:
+            err, r, v = propagate_possible(evaluator, i0, possible, grid)
+        else:
+            possible = None
+            err, r, v = SatrecArray(part).sgp4(jd, fr)
         pos, vel = _earth_fixed(r, v, rotation)
         del r, v
         ecc = np.array([sr.ecco for sr in part])
-        kept, bound = _visibility(frame, horizon, pos, vel, err == 0, ecc, coarse_step_s)
+        partly: np.ndarray | None = None if possible is None else ~np.all(possible, axis=1)
+        kept, bound = _visibility(frame, horizon, pos, vel, err == 0, ecc, coarse_step_s, partly)
+        if possible is not None:
+            kept &= possible
         # Sampling step: under a flat horizon f turns only where the elevation does, twice an orbit,
         # so a step under half the time between the turns (1200 s at a low orbit's rate) leaves at
         # most one turn per step; a sloping horizon adds turns at its own corners.
@@ -249,14 +261,25 @@ def _earth_fixed(r: np.ndarray, v: np.ndarray, rotation: tuple[np.ndarray, np.nd
     return (x, y, r[..., 2]), (c * vx + s * vy + w * y, ms * vx + c * vy - w * x, v[..., 2])
 
 
+def _lowest(horizon: HorizonTable) -> float:
+    """An elevation (rad) a degree below the horizon's lowest point: what the screen proves a satellite under."""
+    return math.radians(max(horizon.minimum - 1.0, -89.0))
+
+
 def _visibility(frame: TopocentricFrame, horizon: HorizonTable, pos: tuple[Any, ...], vel: tuple[Any, ...],
-                ok: np.ndarray, ecc: np.ndarray, coarse_step_s: float) -> tuple[np.ndarray, np.ndarray]:
+                ok: np.ndarray, ecc: np.ndarray, coarse_step_s: float, partly: np.ndarray | None = None
+                ) -> tuple[np.ndarray, np.ndarray]:
     """Which coarse intervals (sats, times - 1) may hold visibility, and each satellite's bound on how fast its
-    visibility margin can shrink (rad/s), from Earth-fixed positions and velocities at the grid times."""
+    visibility margin can shrink (rad/s), from Earth-fixed positions and velocities at the grid times.
+
+    ``partly``: the satellites propagated at some grid points only (near-circular orbits, ``e`` under
+    :data:`~nfwserver.tracking.pass_plane.MAX_ECCENTRICITY`): their sampled rates may all lie on one side of the
+    orbit, so the largest is raised by what the orbit's eccentricity (``((1 + e) / (1 - e))^2``, the ratio of the
+    angular rates at perigee and apogee) and the Earth's rotation (twice its rate) can add elsewhere."""
     obs = frame.origin
     r_obs = float(np.linalg.norm(obs))
     obs_unit = obs / r_obs
-    e_lo = math.radians(max(horizon.minimum - 1.0, -89.0))
+    e_lo = _lowest(horizon)
     k_lo = r_obs * math.cos(e_lo)
     x, y, z = pos
     vx, vy, vz = vel
@@ -274,7 +297,11 @@ def _visibility(frame: TopocentricFrame, horizon: HorizonTable, pos: tuple[Any, 
         del cx, cy, cz, rdot, rad
     # Sampled maxima miss the true one by little on near-circular orbits; eccentric orbits
     # (fast perigee passages) get a wider safety factor.
-    bound = np.nanmax(np.where(ok, rate, np.nan), axis=1, initial=0.0) * (1.1 + 2.0 * ecc) + 1e-5
+    fastest = np.nanmax(np.where(ok, rate, np.nan), axis=1, initial=0.0)
+    if partly is not None:
+        e = np.minimum(ecc, MAX_ECCENTRICITY)
+        fastest = np.where(partly, fastest * ((1.0 + e) / (1.0 - e)) ** 2 + 2.0 * EARTH_RATE, fastest)
+    bound = fastest * (1.1 + 2.0 * ecc) + 1e-5
     reach = bound[:, None] * coarse_step_s
     kept = (margin[:, :-1] + margin[:, 1:] - reach) * 0.5 <= 0.0
     # A failed propagation at one end hides nothing: keep the interval if the other end is close.
