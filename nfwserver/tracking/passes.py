@@ -80,14 +80,35 @@ AUTO_WORKERS_MAX = 8
 
 def auto_workers(satellites: int) -> int:
     """Worker processes that pay for a search of ``satellites`` here and now: one per core not already busy
-    (the cores this process may use less the 1-minute load average), from :data:`AUTO_WORKERS_FROM`
-    satellites; 1 on Windows (no fork).  Any number gives the same passes, bit for bit."""
+    (the cores this process may use less :func:`busy_cores`), from :data:`AUTO_WORKERS_FROM` satellites; 1 on
+    Windows (no fork).  Any number gives the same passes, bit for bit."""
     if satellites < AUTO_WORKERS_FROM or sys.platform == "win32":
         return 1
     cores = os.cpu_count() or 1
     if sys.platform == "linux":
         cores = len(os.sched_getaffinity(0))  # the cores this process may run on
-    return max(1, min(cores - int(os.getloadavg()[0]), AUTO_WORKERS_MAX))
+    return max(1, min(cores - busy_cores(), AUTO_WORKERS_MAX))
+
+
+def busy_cores(loadavg: str | None = None) -> int:
+    """Cores other processes keep busy now: the 1-minute load average, but on Linux no more than the processes
+    running at this instant besides this one (``/proc/loadavg``'s fourth field, or ``loadavg``, that file's
+    text).  The average alone lags by a minute: a command run right after another heavy one (a script running
+    several searches in a row) would see its predecessor's load and give up cores that are idle now."""
+    if sys.platform == "win32":  # no load average (and no fork: auto_workers chooses 1 there)
+        return 0
+    average = int(os.getloadavg()[0])
+    if loadavg is None:
+        try:
+            with open("/proc/loadavg", encoding="ascii") as f:
+                loadavg = f.read()
+        except OSError:
+            return average
+    try:
+        running = int(loadavg.split()[3].split("/")[0])
+    except (IndexError, ValueError):
+        return average
+    return max(0, min(average, running - 1))
 
 
 def _fork_worker(satellites: list[Any], args: tuple[Any, ...], results: Connection) -> None:

@@ -34,11 +34,23 @@ def test_auto_forks_only_for_large_searches_and_idle_cores(monkeypatch) -> None:
     if sys.platform == "win32":
         assert passes.auto_workers(20_000) == 1
         return
-    monkeypatch.setattr(os, "getloadavg", lambda: (0.2, 0.0, 0.0))
     cores = len(os.sched_getaffinity(0)) if sys.platform == "linux" else os.cpu_count()
+    monkeypatch.setattr(passes, "busy_cores", lambda: 0)
     assert passes.auto_workers(20_000) == min(cores, passes.AUTO_WORKERS_MAX)
-    monkeypatch.setattr(os, "getloadavg", lambda: (cores + 0.5, 0.0, 0.0))  # every core busy already
+    monkeypatch.setattr(passes, "busy_cores", lambda: cores)  # every core busy already
     assert passes.auto_workers(20_000) == 1
+
+
+def test_busy_cores_counts_what_runs_now_not_what_ran_a_minute_ago(monkeypatch) -> None:
+    """The load average lags: right after another search, it still counts that search's core."""
+    monkeypatch.setattr(os, "getloadavg", lambda: (1.9, 1.2, 0.8))
+    assert passes.busy_cores("1.90 1.20 0.80 1/80 4242\n") == 0  # only this process runs now
+    assert passes.busy_cores("1.90 1.20 0.80 2/80 4242\n") == 1
+    assert passes.busy_cores("1.90 1.20 0.80 9/80 4242\n") == 1  # a burst of a moment: the average bounds it
+    monkeypatch.setattr(os, "getloadavg", lambda: (0.3, 0.2, 0.1))
+    assert passes.busy_cores("0.30 0.20 0.10 5/80 4242\n") == 0
+    monkeypatch.setattr(os, "getloadavg", lambda: (2.4, 1.2, 0.8))
+    assert passes.busy_cores("not a loadavg line") == 2  # unreadable: the average alone
 
 
 def test_workers_option_takes_auto_or_a_whole_number(capsys) -> None:
