@@ -16,6 +16,8 @@ import time
 
 import pytest
 
+from tests.waiting import wait_for
+
 
 def free_port() -> int:
     """A TCP port on 127.0.0.1 that nothing listens on right now."""
@@ -62,24 +64,27 @@ class HamlibDaemon:
         deadline = time.monotonic() + timeout
         for _attempt in range(5):
             cmd = [self.program, "-m", str(self.model), "-T", self.host, "-t", str(self.port), *self.extra]
-            self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-            while time.monotonic() < deadline and self.proc.poll() is None:
-                if self._listening_here():
-                    try:
-                        with socket.create_connection((self.host, self.port), timeout=0.2):
-                            self._started_once = True
-                            return self
-                    except OSError:
-                        pass
-                time.sleep(0.02)
-            if self.proc.poll() is None:
-                break
+            proc = self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            outcome = wait_for(lambda proc=proc: "exited" if proc.poll() is not None else self._accepting(),
+                               max(0.0, deadline - time.monotonic()), f"{' '.join(cmd)} to listen",
+                               interval_s=0.02)
+            if outcome == "listening":
+                self._started_once = True
+                return self
             if self._started_once:  # a restart must keep its port: the test is about that port
                 raise RuntimeError(f"{cmd[0]} exited with {self.proc.returncode}: {' '.join(cmd)}")
             self.port = free_port()
-        else:
-            raise RuntimeError(f"{self.program} could not listen on a free port in 5 attempts")
-        raise RuntimeError(f"{' '.join(cmd)} did not listen within {timeout} s")
+        raise RuntimeError(f"{self.program} could not listen on a free port in 5 attempts")
+
+    def _accepting(self) -> str | None:
+        """The word ``listening`` once this daemon holds the port and a connection to it is accepted."""
+        if not self._listening_here():
+            return None
+        try:
+            with socket.create_connection((self.host, self.port), timeout=0.2):
+                return "listening"
+        except OSError:
+            return None
 
     def _listening_here(self) -> bool:
         """True once this daemon process holds the listening socket on ``port`` (where /proc can tell;
