@@ -64,7 +64,7 @@ def test_ctrl_d_without_a_radio_explains_itself() -> None:
             assert "Ctrl+D explains" in static_text(app, "state")
             await pilot.press("ctrl+d")
             await pilot.pause()
-            assert station.core.state.radio_tuning
+            assert station.core.state.doppler_on
             note = " ".join(log_text(app, "incoming").split())
             assert "no radio is configured, so nothing is tuned" in note
             assert 'backend = "rigctld"' in note and "/etc/nfw/station.toml" in note

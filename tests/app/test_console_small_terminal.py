@@ -13,7 +13,7 @@ from tests.dde.conftest import ISS, make_station
 
 def _run(scenario) -> None:
     station = make_station()
-    station.core.set_tune(True)
+    station.core.set_feed(True)
     station.run(1.0)
 
     async def body() -> None:
@@ -29,12 +29,12 @@ def test_typed_commands_still_reach_the_station_after_f1_and_f3() -> None:
     async def scenario(app, pilot, station) -> None:
         await pilot.press("f1")
         await pilot.press(*"TUNE OFF", "enter")
-        await settle(app, pilot, until=lambda: not station.core.state.snapshot().dde_output)
-        assert not station.core.state.snapshot().dde_output
+        await settle(app, pilot, until=lambda: not station.core.state.snapshot().feed_on)
+        assert not station.core.state.snapshot().feed_on
         await pilot.press("f3")
         await pilot.press(*"TUNE ON", "enter")
-        await settle(app, pilot, until=lambda: station.core.state.snapshot().dde_output)
-        assert station.core.state.snapshot().dde_output
+        await settle(app, pilot, until=lambda: station.core.state.snapshot().feed_on)
+        assert station.core.state.snapshot().feed_on
         assert isinstance(app.focused, Input)
 
     _run(scenario)

@@ -51,7 +51,7 @@ def test_a_headless_station_follows_a_pass_with_rotctld_and_answers_status_and_p
         station = Station(load_config(str(path)), clock, transport=FakeDdeSystem().server_transport())
         station.start()  # the dummy rotor starts at 0/0, about 95 degrees away
         try:
-            assert station.core.state.snapshot().tracking and station.core.state.snapshot().dde_output
+            assert station.core.state.snapshot().tracking and station.core.state.snapshot().feed_on
 
             def distance() -> float:
                 az, el = (float(v) for v in rotctld.query("p", 2))

@@ -129,7 +129,7 @@ def test_coupling_tunes_from_ticks_on_its_worker(rigctld) -> None:
     tuner = DopplerTuner(FM, RigctldBackend(clock, port=rigctld.port), step_hz=STEP)
     coupling = RadioCoupling(tuner, StationState(Catalog([ISS]), OBS, channels={25544: FM}))
     la = LookAngleCalculator(OBS).compute(ISS.satrec, PASS.tca)
-    sample = TickSample(PASS.tca, 25544, "ISS", la, True, True, False, "", 0, radio_tuning=True)
+    sample = TickSample(PASS.tca, 25544, "ISS", la, True, True, False, "", 0, doppler_on=True)
     coupling.start()
     try:
         for _ in range(300):  # ticks keep coming, as from the publisher; bounded wait for the worker
@@ -142,4 +142,4 @@ def test_coupling_tunes_from_ticks_on_its_worker(rigctld) -> None:
         coupling.stop()
     assert coupling.last_result is not None
     assert abs(_read(rigctld, "f") - FM.downlink_hz * (1 - la.range_rate_km_s / C)) <= STEP + 1
-    assert coupling.process(replace(sample, radio_tuning=False)) is None  # OrbitDRV tuning disabled
+    assert coupling.process(replace(sample, doppler_on=False)) is None  # OrbitDRV tuning disabled

@@ -26,7 +26,7 @@ from tests.web.conftest import TOKEN, config_text, start_station
 def test_a_browser_that_stops_reading_is_dropped_and_never_delays_a_tick() -> None:
     clock = VirtualClock(ISS_PASS.aos + timedelta(seconds=200))
     core = StationCore(CATALOG, OBSERVER, clock, satellite=25544, rate_hz=5.0)
-    core.set_tune(True)
+    core.set_feed(True)
     web = WebServer(core, WebConfig(enabled=True, port=0), io_timeout_s=0.5, send_buffer_bytes=4096)
     web.start()
     try:
@@ -103,7 +103,7 @@ def test_control_requests_are_checked_whole_before_the_core_sees_them() -> None:
         assert status == 400 and "not a station command" in body["message"]
         assert web.post(["TRACK ON"])[0] == 400
         snap = core.state.snapshot()
-        assert not snap.tracking and snap.dde_output
+        assert not snap.tracking and snap.feed_on
         status, body = web.post({"command": "track on", "token": TOKEN})
         assert status == 200 and body["ok"] and core.state.snapshot().tracking
         assert body["message"].startswith("TRACK ON with no rotor configured")  # this station has no rotor
@@ -199,7 +199,7 @@ def test_a_newer_sample_is_framed_even_if_the_clock_then_stands_still() -> None:
 
     clock = VirtualClock(ISS_PASS.aos + timedelta(seconds=200))
     core = StationCore(CATALOG, OBSERVER, clock, satellite=25544, rate_hz=5.0)
-    core.set_tune(True)
+    core.set_feed(True)
     web = WebServer(core, WebConfig(enabled=True, port=0))
     web.start()
     assert web.address is not None
