@@ -35,7 +35,7 @@ def tick_cost_us(clients: int, ticks: int = 3000) -> float:
             system.connect("NFW32", "NFW_DATA").start_advise("NFW_SERVER")
         except DdeError:  # the service is full (max_conversations_per_service): refused
             pass
-    server.set_tune(True)
+    server.set_feed(True)
     times = []
     step = timedelta(milliseconds=100)
     when = START
@@ -69,7 +69,7 @@ def loop_error_ms(rate: float, seconds: float) -> tuple[float, float, float, int
     NovaDdeService(server).attach(system.server_transport())
     for _ in range(10):
         system.connect("NFW32", "NFW_DATA").start_advise("NFW_SERVER")
-    server.set_tune(True)
+    server.set_feed(True)
     publisher = Publisher(server, SystemClock())
     publisher.start()
     time.sleep(seconds)

@@ -31,6 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
+from tests.waiting import wait_for
+
 ROOT = Path(__file__).resolve().parent.parent
 SECONDS = float(os.environ.get("NFW_BENCH_STATION_S", "15"))
 RATE_HZ = 5
@@ -165,18 +167,18 @@ class Station:
         self.proc = subprocess.Popen([sys.executable, "-m", "nfwserver", "run", "--headless", "--config", str(config),
                                       "--log-file", str(folder / "station.log")], cwd=ROOT,
                                      stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-        deadline = time.monotonic() + 60.0
-        while time.monotonic() < deadline:
-            try:
-                socket.create_connection(("127.0.0.1", self.web), timeout=1).close()
-                socket.create_connection(("127.0.0.1", self.tcp), timeout=1).close()
-                return
-            except OSError:
-                if self.proc.poll() is not None:
-                    why = self.proc.stderr.read().decode() if self.proc.stderr else ""
-                    raise RuntimeError(f"the station exited: {why}") from None
-                time.sleep(0.1)
-        raise RuntimeError("the station did not open its ports within 60 s")
+        wait_for(self._serving, 60.0, "the station to open its web and TCP ports", interval_s=0.1)
+
+    def _serving(self) -> bool:
+        if self.proc.poll() is not None:
+            why = self.proc.stderr.read().decode() if self.proc.stderr else ""
+            raise RuntimeError(f"the station exited: {why}")
+        try:
+            socket.create_connection(("127.0.0.1", self.web), timeout=1).close()
+            socket.create_connection(("127.0.0.1", self.tcp), timeout=1).close()
+        except OSError:
+            return False
+        return True
 
     def stop(self) -> None:
         self.proc.terminate()

@@ -80,7 +80,7 @@ def tick_cost(clients: int, ticks: int = 2000, pace_s: float = 0.005) -> tuple[f
     server.start()
     watchers = Watchers(server.address, clients) if clients else None
     wait_for(lambda: server.watcher_count() == clients, 20.0, "the watchers to connect", interval_s=0.001)
-    core.set_tune(True)
+    core.set_feed(True)
     costs, sent = [], []
     when = START
     for _ in range(ticks):
@@ -108,7 +108,7 @@ def loop_lateness(clients: int, rate: float, seconds: float) -> tuple[float, flo
     server.start()
     watchers = Watchers(server.address, clients)
     wait_for(lambda: server.watcher_count() == clients, 20.0, "the watchers to connect", interval_s=0.001)
-    core.set_tune(True)
+    core.set_feed(True)
     p50, p99, worst, ticks = run_publisher(core, seconds)
     got = min(len(a) for a in watchers.arrivals(str(ticks)))
     server.stop()

@@ -94,7 +94,7 @@ def tick_cost(clients: int, ticks: int = 600, pace_s: float = 0.1) -> tuple[floa
     assert web.address is not None
     browsers = Browsers(web.address, clients) if clients else None
     wait_for(lambda: web.stats.streams == clients, 20.0, "the streams to open", interval_s=0.001)
-    core.set_tune(True)
+    core.set_feed(True)
     costs, sent = [], {}
     when = START
     for _ in range(ticks):
@@ -125,7 +125,7 @@ def loop_lateness(clients: int, rate: float, seconds: float) -> tuple[float, flo
     assert web.address is not None
     browsers = Browsers(web.address, clients)
     wait_for(lambda: web.stats.streams == clients, 20.0, "the streams to open", interval_s=0.001)
-    core.set_tune(True)
+    core.set_feed(True)
     p50, p99, worst, ticks = run_publisher(core, seconds)
     got = min(len(a) for a in browsers.arrivals())
     web.stop()
@@ -155,7 +155,7 @@ def main() -> None:
     for n in (0, 50):
         if n == 0:
             core = StationCore(CATALOG, OBS, SystemClock(), satellite=25544, rate_hz=5.0)
-            core.set_tune(True)
+            core.set_feed(True)
             p50, p99, worst, ticks = run_publisher(core, 30.0)
             print(f"| 0 | {ticks} | - | {p50:.3f} ms | {p99:.3f} ms | {worst:.3f} ms |")
             continue

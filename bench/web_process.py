@@ -26,6 +26,8 @@ import time
 from datetime import datetime
 from pathlib import Path
 
+from tests.waiting import wait_for
+
 ROOT = Path(__file__).resolve().parent.parent
 _TIME = re.compile(rb'"now": \{"time": "([^"]+)"')
 
@@ -56,16 +58,12 @@ class Station:
         self.proc = subprocess.Popen([sys.executable, "-m", "nfwserver", "run", "--config", str(config), "--headless",
                                       "--log-file", str(folder / "station.log"), "--web"],
                                      cwd=folder, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        deadline = time.monotonic() + 60
-        while time.monotonic() < deadline:
-            try:
-                with socket.create_connection(("127.0.0.1", self.port), timeout=2) as sock:
-                    sock.sendall(b"GET /api/help HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n")
-                    if sock.recv(12).startswith(b"HTTP/1.0 200"):
-                        return
-            except OSError:
-                time.sleep(0.2)
-        raise RuntimeError("the station did not answer on its web port")
+        wait_for(self._answers, 60.0, "the station to answer on its web port", interval_s=0.2, tolerate=(OSError,))
+
+    def _answers(self) -> bool:
+        with socket.create_connection(("127.0.0.1", self.port), timeout=2) as sock:
+            sock.sendall(b"GET /api/help HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n")
+            return sock.recv(12).startswith(b"HTTP/1.0 200")
 
     def cpu_s(self) -> float:
         fields = Path(f"/proc/{self.proc.pid}/stat").read_text().rsplit(")", 1)[1].split()

@@ -69,3 +69,22 @@ def test_off_screen_sees_a_widget_the_screen_text_hides() -> None:
             assert off_screen(app) == ["Static#wide Region(x=0, y=0, width=300, height=1)"]
 
     asyncio.run(scenario())
+
+
+def test_settle_has_no_pause_without_a_condition_and_names_what_it_awaited() -> None:
+    """Every console wait names its condition (there is no fixed-pause form), and its failure says which."""
+    import inspect
+
+    from tests.app.console_helpers import spin_until
+
+    assert inspect.signature(settle).parameters["until"].default is inspect.Parameter.empty
+
+    async def scenario() -> None:
+        app: App[None] = App()
+        async with app.run_test() as pilot:
+            with pytest.raises(WaitTimeout, match="did not show the footer within 0.2 s"):
+                await settle(app, pilot, until=lambda: False, limit_s=0.2, what="the footer")
+            with pytest.raises(WaitTimeout, match="did not reach the search within 0.1 s"):
+                await spin_until(lambda: False, 0.1, "the search")
+
+    asyncio.run(scenario())

@@ -36,9 +36,9 @@ def _set_dde_names(core: StationCore, new: Config) -> None:
     core.state.catalog_changed()
 
 
-def _set_radio_tuning(core: StationCore, new: Config) -> None:
+def _set_doppler(core: StationCore, new: Config) -> None:
     """Doppler tuning switched on or off, as the console's Ctrl+D does."""
-    core.set_radio_tuning(new.radio.enabled, source="configuration")
+    core.set_doppler(new.radio.enabled, source="configuration")
 
 
 def _web_server_follows(core: StationCore, new: Config) -> None:
@@ -51,7 +51,7 @@ CONFIG_PARTS: tuple[ConfigPart[StationCore], ...] = (
     ConfigPart("[observer], [horizon], [server] ut1_utc_s and rate_hz, [satellites] channels",
                ("observer", "horizon", "server.ut1_utc_s", "server.rate_hz", "channels"), _configure_state),
     ConfigPart("[satellites] names", ("dde_names",), _set_dde_names),
-    ConfigPart("[radio] enabled", ("radio.enabled",), _set_radio_tuning),
+    ConfigPart("[radio] enabled", ("radio.enabled",), _set_doppler),
     ConfigPart("[elements]", ("elements",)),
     ConfigPart("[rotor]", ("rotor",)),
     ConfigPart("[radio] backend", ("radio.backend", "radio.host", "radio.port")),

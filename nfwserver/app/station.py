@@ -264,11 +264,11 @@ class Station:
             log.info("%s", self.selection_note)
             self.core.selected_by = source
         if srv.tune:
-            self.core.set_tune(True, source="config")
+            self.core.set_feed(True, source="config")
         if srv.track:
             self.core.set_track(True, source="config")
         if self.config.radio.enabled:
-            self.core.set_radio_tuning(True, source="config")
+            self.core.set_doppler(True, source="config")
 
     # -- life cycle ----------------------------------------------------------------------------------
     def start(self) -> None:

@@ -84,13 +84,13 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     p.set_defaults(func=run, usage_error=p.error)
 
 
-def _client_tunes(pokes: list[tuple[float, str]]) -> bool:
+def _pokes_decide_feed(pokes: list[tuple[float, str]]) -> bool:
     """True when the first TUNE command among ``pokes`` (sorted by offset) is TUNE ON or is sent at the start:
     the user then decides when the feed starts, and no TUNE ON is poked for them.  The pokes are read as the
     server reads them (a poke it refuses switches nothing)."""
-    tunes = [(offset, parsed.value) for offset, command in pokes for parsed in commands_of(command)
-             if parsed.command.word == "TUNE"]
-    return bool(tunes) and (tunes[0][1] is True or tunes[0][0] == 0)
+    switches = [(offset, parsed.value) for offset, command in pokes for parsed in commands_of(command)
+                if parsed.command.word == "TUNE"]
+    return bool(switches) and (switches[0][1] is True or switches[0][0] == 0)
 
 
 def _first_sat(pokes: list[tuple[float, str]]) -> float | None:
@@ -127,12 +127,12 @@ def run(args: argparse.Namespace) -> int:
                 "published")
         elif sat_poke > 0:
             say(f"no satellite until the SAT= poke at {sat_poke:g} s: nothing is published before it")
-    auto_tune = not _client_tunes(pokes)
-    return _simulate(args, server, clock, pokes, auto_tune)
+    auto_feed = not _pokes_decide_feed(pokes)
+    return _simulate(args, server, clock, pokes, auto_feed)
 
 
 def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock,
-              pokes: list[tuple[float, str]], auto_tune: bool) -> int:
+              pokes: list[tuple[float, str]], auto_feed: bool) -> int:
     # Refusals are reported below with their time; keep the core's own warning out of the way
     # (restored on the way out: the logger is shared with anything else in this process).
     core_log = logging.getLogger("nfwserver.core.station_core")
@@ -164,7 +164,7 @@ def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock
                                                                         for d in DIALECTS.values())
         args.usage_error(f"--link {link}: nothing serves that service and topic here (served: {served})")
     client = SimulatedClient(args.client, conversation, link.item, emit, args.poll)
-    pending = [(0.0, "TUNE ON", False)] if auto_tune else []  # the automatic TUNE ON is not reported
+    pending = [(0.0, "TUNE ON", False)] if auto_feed else []  # the automatic TUNE ON is not reported
     pending += [(offset, command, True) for offset, command in pokes]
     started = False
     previous: list[float] = []  # the offset of the tick published last

@@ -77,8 +77,8 @@ def _satellite(snap: StateSnapshot) -> str:
 def state_changes(before: StateSnapshot, after: StateSnapshot) -> tuple[str, ...]:
     """The differences a command can make, in words (feed, tracking, satellite, antenna degrees)."""
     out: list[str] = []
-    if before.dde_output != after.dde_output:
-        out.append(f"feed {'on' if after.dde_output else 'off'}")
+    if before.feed_on != after.feed_on:
+        out.append(f"feed {'on' if after.feed_on else 'off'}")
     if before.tracking != after.tracking:
         out.append(f"tracking {'on' if after.tracking else 'off'}")
     if before.catalog_number != after.catalog_number:

@@ -73,7 +73,7 @@ def status_line(station: Station) -> str:
         where = "no position"
     conversations, loops = station.nova.client_count()
     parts = [f"status: {_satellite(station)} {where}",
-             f"TUNE {'ON' if snap.state.dde_output else 'OFF'} TRACK {'ON' if snap.state.tracking else 'OFF'}",
+             f"TUNE {'ON' if snap.state.feed_on else 'OFF'} TRACK {'ON' if snap.state.tracking else 'OFF'}",
              f"DDE clients {conversations} ({loops} advise)"]
     if station.tcp is not None:
         parts.append(f"TCP clients {station.tcp.client_count()}")

@@ -44,7 +44,7 @@ class StationPort(Protocol):
     #: whether the station drives a rotor itself (None: not known, then no warning)
     rotor_configured: bool | None
 
-    def set_tune(self, on: bool, source: str = ...) -> None: ...
+    def set_feed(self, on: bool, source: str = ...) -> None: ...
 
     def set_track(self, on: bool, source: str = ...) -> str | None: ...
 
@@ -112,8 +112,9 @@ def _degrees(value: object) -> float:
     return float(value)
 
 
-def tune(targets: Targets, value: object, source: str) -> Outcome:
-    targets.station.set_tune(value is True, source)
+def feed(targets: Targets, value: object, source: str) -> Outcome:
+    """TUNE ON/OFF: the feed (the published Nova string), not the radio's Doppler tuning."""
+    targets.station.set_feed(value is True, source)
     return DONE
 
 

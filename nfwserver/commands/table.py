@@ -162,7 +162,7 @@ _STATION_REPLY = ("DDE: acknowledged, or refused (DDE_FNOTPROCESSED) with the re
 COMMANDS: tuple[Command, ...] = (
     Command("TUNE", r"TUNE\s+(ON|OFF)", "TUNE ON|OFF", "TUNE ON|OFF", "ON or OFF",
             "switch the Nova string feed on or off (DDE advise loops, requests, TCP WATCH and SUMMARY)",
-            _STATION_REPLY, Face.ALL, Target.STATION, _on, action=actions.tune),
+            _STATION_REPLY, Face.ALL, Target.STATION, _on, action=actions.feed),
     Command("TRACK", r"TRACK\s+(ON|OFF)", "TRACK ON|OFF", "TRACK ON|OFF", "ON or OFF",
             "switch rotor tracking on or off (TRACK ON needs a station and a satellite; without a rotor it is "
             "accepted with a warning)",

@@ -89,7 +89,7 @@ class NfwConsole(App[None]):
         Binding("f2", "pick_satellite", "Sats", priority=True),
         Binding("f3", "show_incoming", "In", priority=True),
         Binding("f4", "toggle_zone", "Zone", priority=True),
-        Binding("ctrl+t", "toggle_tune", "Tune", priority=True),
+        Binding("ctrl+t", "toggle_feed", "Tune", priority=True),
         Binding("ctrl+d", "toggle_doppler", "Doppler", priority=True),
         Binding("ctrl+f", "cycle_flip", "Flip", priority=True),
         Binding("ctrl+q", "quit", "Quit", priority=True),
@@ -237,7 +237,7 @@ class NfwConsole(App[None]):
         lines.extend(realtime_lines(values, why, self.core, catnr, above, width))
         lines.append(Text(next_pass_text(search, self.times, now)))
         lines.append(elements_line(self.core, catnr, now, self.stale_days))
-        radio = guarded("Radio", lambda: radio_line(self.radio, snap.state.radio_tuning))
+        radio = guarded("Radio", lambda: radio_line(self.radio, snap.state.doppler_on))
         lines.extend(antenna_lines(snap, radio or Text(), width))
         if self.rotor is not None:
             lines.append(guarded("Rotor", partial(rotor_line, self.rotor)))
@@ -351,8 +351,8 @@ class NfwConsole(App[None]):
         self._refresh_state()
 
     def action_toggle_doppler(self) -> None:
-        on = not self.core.state.radio_tuning
-        self.core.set_radio_tuning(on, source="console")
+        on = not self.core.state.doppler_on
+        self.core.set_doppler(on, source="console")
         if self.radio is None:
             where = self.config_file or "the configuration file"
             text = (f"Doppler tuning {'on' if on else 'off'}, but no radio is configured, so nothing is tuned: "
@@ -363,8 +363,8 @@ class NfwConsole(App[None]):
         self._drain()
         self._refresh_state()
 
-    def action_toggle_tune(self) -> None:
-        self._run("TUNE OFF" if self.core.snapshot().state.dde_output else "TUNE ON")
+    def action_toggle_feed(self) -> None:
+        self._run("TUNE OFF" if self.core.snapshot().state.feed_on else "TUNE ON")
 
     def action_cycle_flip(self) -> None:
         """The next flip mode (auto, on, off), as the command ``FLIP <mode>`` typed on the input line."""

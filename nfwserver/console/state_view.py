@@ -61,7 +61,7 @@ def satellite_line(snap: CoreSnapshot, core: StationCore, clients: tuple[int, in
     """``Satellite ISS (25544) ISS (ZARYA)  TUNE ON  TRACK OFF  clients 1 (1 advise)`` (DDE clients); the
     satellite's long name is shortened to keep the line within ``width`` (0: no limit)."""
     state = snap.state
-    tail = (f"  TUNE {'ON' if state.dde_output else 'OFF'}  TRACK {'ON' if state.tracking else 'OFF'}"
+    tail = (f"  TUNE {'ON' if state.feed_on else 'OFF'}  TRACK {'ON' if state.tracking else 'OFF'}"
             f"  clients {clients[0]} ({clients[1]} advise)")
     line = Text("Satellite ")
     sat = core.state.catalog.get(snap.catalog_number) if snap.catalog_number is not None else None
@@ -181,8 +181,8 @@ def rotor_line(rotor: RotorCoupling) -> Text:
     return line
 
 
-def radio_line(radio: RadioCoupling | None, tuning_on: bool) -> Text:
-    state = "ON" if tuning_on else "OFF"
+def radio_line(radio: RadioCoupling | None, doppler_on: bool) -> Text:
+    state = "ON" if doppler_on else "OFF"
     if radio is None:
         return Text(f"Radio: none configured (tuning {state}; Ctrl+D explains)", style="dim")
     r = radio.current_result()

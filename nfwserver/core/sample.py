@@ -35,10 +35,10 @@ class TickSample:
     dde_name: str | None
     look_angles: LookAngles | None  #: None without a satellite, station, or when computation failed
     above_horizon: bool  #: above the horizon table at the satellite's azimuth
-    dde_output: bool  #: Nova's TUNE ON (the DDE string is published)
+    feed_on: bool  #: the feed: Nova's TUNE ON (the Nova string is published)
     tracking: bool  #: autotracking enabled (Nova's TRACK ON; OrbitDRV "tracking enabled")
     text: str  #: the Nova string published this tick ("" when nothing was published)
     status: int  #: OrbitDRV-style status word (:class:`nfwserver.core.status.StatusBit`)
-    radio_tuning: bool = False  #: Doppler tuning enabled (OrbitDRV "tuning enabled")
+    doppler_on: bool = False  #: Doppler updates to the radio (OrbitDRV "tuning enabled"; not Nova's TUNE)
     error: ArithmeticErrorCode = ArithmeticErrorCode.NONE  #: code reported with the arithmetic-error bit
     interface_version: int = INTERFACE_VERSION  #: reported with every status word, as OrbitDRV did

@@ -2,8 +2,9 @@
 
 :class:`StationState` holds what the station *is* at this moment: the catalog, the observer, the
 horizon table, UT1-UTC, the radio channels, the publish rate, and the session switches that
-clients and the operator change (the AutoTracking satellite, Nova's ``TUNE`` (DDE output), OrbitDRV's
-tracking and tuning enables, the antenna position last reported).
+clients and the operator change (the AutoTracking satellite, the feed that Nova's ``TUNE`` switches
+(``feed_on``: the Nova string is published), OrbitDRV's tracking and tuning enables (``tracking``, and
+``doppler_on``: Doppler updates to the radio), the antenna position last reported).
 
 Nothing else in the server keeps a copy of these values: the tracker, the DDE services, the
 dialects, PREDICT, the rotor and radio couplings and the console read them from here each time they
@@ -52,9 +53,9 @@ class StateSnapshot:
     rate_hz: float
     catalog_number: int | None
     satellite: Satellite | None  #: the AutoTracking satellite's record, None when unknown/none
-    dde_output: bool  #: Nova's TUNE ON: the DDE string is published
+    feed_on: bool  #: the feed: Nova's TUNE ON, the Nova string is published
     tracking: bool  #: OrbitDRV "tracking enabled": the rotor follows the satellite (Nova's TRACK ON)
-    radio_tuning: bool  #: OrbitDRV "tuning enabled": the radio receives Doppler updates
+    doppler_on: bool  #: OrbitDRV "tuning enabled": the radio receives Doppler updates
     antenna: AntennaPosition
     channels: Mapping[int, Channel] = field(default_factory=dict)
     #: who chose the selected satellite ("config", "saved-state", or the source of the command), read with it
@@ -76,9 +77,9 @@ class StationState:
         self._channels: Mapping[int, Channel] = MappingProxyType(dict(channels or {}))
         self._selected_by = ""
         self._catalog_number: int | None = None
-        self._dde_output = False
+        self._feed_on = False
         self._tracking = False
-        self._radio_tuning = False
+        self._doppler_on = False
         self._antenna = AntennaPosition(None, None, "", None)
         self.generation = 0
 
@@ -112,12 +113,12 @@ class StationState:
         return self._catalog_number
 
     @property
-    def radio_tuning(self) -> bool:
-        return self._radio_tuning
+    def doppler_on(self) -> bool:
+        return self._doppler_on
 
     @property
-    def dde_output(self) -> bool:
-        return self._dde_output
+    def feed_on(self) -> bool:
+        return self._feed_on
 
     def selected(self) -> Satellite | None:
         """The AutoTracking satellite's catalog record (None when none is selected or it is unknown)."""
@@ -128,8 +129,8 @@ class StationState:
     def snapshot(self) -> StateSnapshot:
         with self._lock:
             return StateSnapshot(self.generation, self._catalog, self._observer, self._horizon, self._ut1_utc_s,
-                                 self._rate_hz, self._catalog_number, self.selected(), self._dde_output,
-                                 self._tracking, self._radio_tuning, self._antenna, self._channels,
+                                 self._rate_hz, self._catalog_number, self.selected(), self._feed_on,
+                                 self._tracking, self._doppler_on, self._antenna, self._channels,
                                  self._selected_by)
 
     # -- changing ----------------------------------------------------------------------------
@@ -167,14 +168,16 @@ class StationState:
         with self._lock:
             self._selected_by = by
 
-    def set_dde_output(self, on: bool) -> bool:
-        return self._set("_dde_output", bool(on))
+    def set_feed(self, on: bool) -> bool:
+        """Nova's TUNE ON/OFF; True when it changed."""
+        return self._set("_feed_on", bool(on))
 
     def set_tracking(self, on: bool) -> bool:
         return self._set("_tracking", bool(on))
 
-    def set_radio_tuning(self, on: bool) -> bool:
-        return self._set("_radio_tuning", bool(on))
+    def set_doppler(self, on: bool) -> bool:
+        """Doppler updates to the radio on or off (OrbitDRV's tuning enable); True when it changed."""
+        return self._set("_doppler_on", bool(on))
 
     def catalog_changed(self) -> None:
         """Tell readers the catalog's contents changed (an element refresh updated it in place)."""

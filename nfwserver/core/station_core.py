@@ -4,7 +4,7 @@
 (:attr:`StationCore.state`), subscribe to ticks (:meth:`StationCore.subscribe`) and talk back
 through narrow ports: :meth:`execute` (every command, as a face parsed it:
 :func:`nfwserver.commands.parsing.parse_request`; :meth:`command` parses text for a caller that has
-only text), :meth:`select_satellite`, :meth:`report_antenna_position`, :meth:`set_radio_tuning`.  No
+only text), :meth:`select_satellite`, :meth:`report_antenna_position`, :meth:`set_doppler`.  No
 adapter keeps its own copy of the station.
 
 Every command is run through its entry's action in the command table (:mod:`nfwserver.commands`):
@@ -131,11 +131,11 @@ class StationCore:
     def _note(self, text: str, source: str, accepted: bool | None = None) -> None:
         self.events.add(self.clock.now(), Direction.INFO, "note", text, client=source, accepted=accepted)
 
-    def set_tune(self, on: bool, source: str = "console") -> None:
-        """Nova's TUNE ON/OFF: switch the DDE output."""
+    def set_feed(self, on: bool, source: str = "console") -> None:
+        """Nova's TUNE ON/OFF: switch the feed (the Nova string published to every output) on or off."""
         if not on:
-            self.tracker.dde_output_off()
-        if self.state.set_dde_output(on):
+            self.tracker.feed_off()
+        if self.state.set_feed(on):
             self.tracker.refresh_text()  # a request right after TUNE ON gets the string, not ""
             self._note(f"TUNE {'ON' if on else 'OFF'}", source)
 
@@ -154,9 +154,10 @@ class StationCore:
             self._note(f"TRACK {'ON' if on else 'OFF'}", source)
         return None
 
-    def set_radio_tuning(self, on: bool, source: str = "console") -> None:
-        """OrbitDRV's Enable/Disable Tuning: Doppler updates to the radio."""
-        if self.state.set_radio_tuning(on):
+    def set_doppler(self, on: bool, source: str = "console") -> None:
+        """Doppler on or off: frequency updates to the radio (OrbitDRV's Enable/Disable Tuning; not Nova's TUNE,
+        which is :meth:`set_feed`)."""
+        if self.state.set_doppler(on):
             self._note(f"radio Doppler tuning {'on' if on else 'off'}", source)
 
     def select_satellite(self, catalog_number: int, source: str = "console") -> bool:

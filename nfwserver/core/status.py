@@ -18,7 +18,7 @@ class StatusBit(enum.IntFlag):
     STATION_MISSING = 0x0001  #: station (observer) elements missing or bad
     SATELLITE_MISSING = 0x0002  #: satellite elements missing or bad (no satellite selected)
     TRACKING_DISABLED = 0x0004  #: TRACK OFF (the default)
-    TUNING_DISABLED = 0x0008  #: TUNE OFF (the default)
+    TUNING_DISABLED = 0x0008  #: OrbitDRV's "tuning disabled": no Doppler updates to the radio (not Nova's TUNE OFF)
     ARITHMETIC_ERROR = 0x0010  #: the last computation failed; the code is in ``error_code``
     NOT_IN_VIEW = 0x0020  #: the satellite is below the horizon table (valid while tracking)
     NOT_RECOMPUTED = 0x0040  #: no position computed since the last parameter change

@@ -9,8 +9,8 @@ Status word (seed: OrbitDRV interrupt interface), as this tracker reads it:
 
 - 0x0001 / 0x0002: no station / no (known) satellite selected.
 - 0x0004: tracking disabled (Nova's ``TRACK OFF``); 0x0008: *tuning* disabled in OrbitDRV's sense,
-  i.e. the radio gets no Doppler updates.  Nova's ``TUNE`` (DDE output) is reported separately
-  (:attr:`TickSample.dde_output`), because OrbitDRV's tuning is the radio's, not the feed's.
+  i.e. the radio gets no Doppler updates (:attr:`TickSample.doppler_on` off).  Nova's ``TUNE`` (the feed)
+  is reported separately (:attr:`TickSample.feed_on`), because OrbitDRV's tuning is the radio's, not the feed's.
 - 0x0010: an arithmetic error, with its code.  OrbitDRV's words are "No computations will be done
   until a new Enable call is made"; a server left unattended must not go silent for good on one bad
   instant (a clock step, a set past decay), so here the error **belongs to the tick** in which the
@@ -116,7 +116,7 @@ class Tracker:
         snap = self.state.snapshot()
         text = ""
         calc = self._calculator_for(snap)
-        if snap.dde_output and snap.satellite is not None and calc is not None:
+        if snap.feed_on and snap.satellite is not None and calc is not None:
             try:
                 angles = calc.compute(snap.satellite.satrec, self.clock.now())
             except (PropagationError, ArithmeticError, ValueError):
@@ -131,7 +131,7 @@ class Tracker:
 
     def _still_current(self, snap: StateSnapshot) -> bool:
         """The string computed from ``snap`` is still the one to serve: the same satellite, the output the same."""
-        return self.state.catalog_number == snap.catalog_number and self.state.dde_output == snap.dde_output
+        return self.state.catalog_number == snap.catalog_number and self.state.feed_on == snap.feed_on
 
     def why_not_computable(self, satellite: Satellite, when: datetime | None = None) -> str | None:
         """Why ``satellite`` cannot be computed at ``when`` (default now) for this station, or None if it can.
@@ -147,7 +147,7 @@ class Tracker:
             return str(exc) or type(exc).__name__
         return None
 
-    def dde_output_off(self) -> None:
+    def feed_off(self) -> None:
         with self._lock:
             self._text = ""
 
@@ -165,7 +165,7 @@ class Tracker:
             word |= StatusBit.SATELLITE_MISSING
         if not snap.tracking:
             word |= StatusBit.TRACKING_DISABLED
-        if not snap.radio_tuning:
+        if not snap.doppler_on:
             word |= StatusBit.TUNING_DISABLED
         if self._error:
             word |= StatusBit.ARITHMETIC_ERROR
@@ -221,7 +221,7 @@ class Tracker:
             self.health.succeeded()
         above = angles is not None and snap.horizon.is_above(angles.azimuth_deg, angles.elevation_deg)
         text = ""
-        if angles is not None and sat is not None and snap.dde_output:
+        if angles is not None and sat is not None and snap.feed_on:
             text = format_nova(sat.dde_name, angles.azimuth_deg, angles.elevation_deg, angles.range_rate_km_s, above)
         with self._lock:
             if self.state.generation == snap.generation:
@@ -229,7 +229,7 @@ class Tracker:
             if self._still_current(snap):  # else a command changed the satellite or the output meanwhile
                 self._text = text
             sample = TickSample(when, snap.catalog_number, sat.dde_name if sat else None, angles, above,
-                                snap.dde_output, snap.tracking, text, 0, snap.radio_tuning, self._error)
+                                snap.feed_on, snap.tracking, text, 0, snap.doppler_on, self._error)
             sample = replace(sample, status=self._status(snap, sample))
             self._last = sample
             listeners = list(self._listeners)

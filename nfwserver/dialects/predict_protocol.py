@@ -236,7 +236,7 @@ class PredictProtocol:
 
     def _tracking_now(self) -> Satellite | None:
         snap = self.ctx.state.snapshot()
-        return snap.satellite if snap.satellite is not None and (snap.dde_output or snap.tracking) else None
+        return snap.satellite if snap.satellite is not None and (snap.feed_on or snap.tracking) else None
 
     def _note_tracking(self) -> None:
         if not self._tracked_once and self._tracking_now() is not None:

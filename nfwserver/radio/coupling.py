@@ -38,7 +38,7 @@ class RadioCoupling(TickWorker):
 
     def process(self, sample: TickSample) -> TuneResult | None:
         """Tune for one sample now (the worker's step; tests call it directly)."""
-        if not sample.radio_tuning or sample.look_angles is None or sample.catalog_number is None:
+        if not sample.doppler_on or sample.look_angles is None or sample.catalog_number is None:
             return None
         channel = self.state.channels.get(sample.catalog_number)
         if channel is None:
@@ -68,7 +68,7 @@ class RadioCoupling(TickWorker):
     def without_channel(self) -> bool:
         """Doppler tuning is on and the selected satellite has no radio channel (so nothing is tuned)."""
         number = self.state.catalog_number
-        return self.state.radio_tuning and number is not None and number not in self.state.channels
+        return self.state.doppler_on and number is not None and number not in self.state.channels
 
     def current_result(self) -> TuneResult | None:
         """The last tuning, unless the selected satellite has no channel (then its frequencies are stale)."""

@@ -150,8 +150,8 @@ class NovaTcpProtocol:
         state = snap.state
         fields: dict[str, object] = {
             "satellite": state.catalog_number, "name": snap.dde_name, "satellite_from": state.selected_by,
-            "tune": state.dde_output,
-            "track": state.tracking, "radio_tuning": state.radio_tuning, "status": f"0x{snap.status:04X}",
+            "tune": state.feed_on,
+            "track": state.tracking, "radio_tuning": state.doppler_on, "status": f"0x{snap.status:04X}",
             "interface": snap.interface_version,
         }
         sample = snap.last_sample

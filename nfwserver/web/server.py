@@ -255,7 +255,7 @@ class WebServer:
             "now": now_tracking(self.core, sample, now),
             "next_event": self.board.next_event(sample.time if sample is not None else now),
             "rotor": rotor_part(self.parts.rotor),
-            "radio": radio_part(self.parts.radio, self.core.state.radio_tuning),
+            "radio": radio_part(self.parts.radio, self.core.state.doppler_on),
             "links": links_part(self.core.health),
             "clients": clients_part(self._follower, self._counts),
             "log": [event_json(e) for e in events], "log_skipped": skipped,

@@ -90,7 +90,7 @@ def now_tracking(core: StationCore, sample: TickSample | None, now: datetime) ->
     return {
         "time": iso(sample.time if sample is not None else now),
         "satellite": satellite_part(core, now),
-        "tune": state.dde_output, "track": state.tracking, "radio_tuning": state.radio_tuning,
+        "tune": state.feed_on, "track": state.tracking, "radio_tuning": state.doppler_on,
         "nova": sample.text if sample is not None else "",
         "position": position_part(sample), "subpoint": sub, "doppler": doppler,
         "status": status_part(sample, core),

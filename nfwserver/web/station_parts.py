@@ -57,12 +57,12 @@ def rotor_part(rotor: RotorCoupling | None) -> dict[str, object] | None:
     return out
 
 
-def radio_part(radio: RadioCoupling | None, tuning_on: bool) -> dict[str, object] | None:
+def radio_part(radio: RadioCoupling | None, doppler_on: bool) -> dict[str, object] | None:
     if radio is None:
         return None
     result = radio.current_result()  # none while the satellite has no channel: no other satellite's frequency
     state = radio.link_state()
-    return {"state": state, "tuning": tuning_on, "error": None if state == "ok" else str(radio.tuner.last_error or ""),
+    return {"state": state, "tuning": doppler_on, "error": None if state == "ok" else str(radio.tuner.last_error or ""),
             "rx_hz": result.rx_hz if result is not None else None,
             "tx_hz": result.tx_hz if result is not None and result.tx_hz else None}
 

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import asyncio
 import time
+from collections.abc import Callable
 
 from textual.app import App
 from textual.widgets import RichLog, Static
@@ -32,17 +34,32 @@ def static_text(app: App, widget_id: str) -> str:
     return str(app.query_one(f"#{widget_id}", Static).render())
 
 
-async def settle(app: App, pilot, until=None, limit_s: float = 5.0, what: str = "", workers: bool = True) -> None:
-    """Let worker threads (pass searches) finish and the screen catch up.  With ``until``, pause 0.05 s at a
-    time until it holds, and fail (:class:`tests.waiting.WaitTimeout`) after ``limit_s`` seconds: a loaded
-    machine cannot make the screen be read before its refresh, and a screen that never shows it cannot pass.
-    Without ``until`` (nothing to wait for), pause 0.3 s.  ``workers=False``: do not wait for the workers
-    (a test that holds one back)."""
+async def spin_until(until: Callable[[], object], limit_s: float, what: str) -> None:
+    """Yield to the event loop 0.01 s at a time until ``until`` holds, without waiting for the screen to go idle
+    (as :func:`settle` does, which a busy worker thread can hold up); fail after ``limit_s`` seconds."""
+    deadline = time.monotonic() + limit_s
+    while not until():
+        if time.monotonic() >= deadline:
+            raise WaitTimeout(f"the console did not reach {what} within {limit_s:g} s")
+        await asyncio.sleep(0.01)
+
+
+def searched(app: App) -> bool:
+    """The first pass search has been drawn: the pass list and the state pane's next pass are no longer
+    "searching..." (a console without an observer never searches, and never gets here)."""
+    return ("searching..." not in static_text(app, "passes") and "Next pass: searching" not in static_text(app, "state")
+            and static_text(app, "passes").strip() != "")
+
+
+async def settle(app: App, pilot, until: Callable[[], object], limit_s: float = 5.0, what: str = "",
+                 workers: bool = True) -> None:
+    """Let worker threads (pass searches) finish, then let the screen catch up until ``until`` holds, pausing
+    0.05 s at a time; fail (:class:`tests.waiting.WaitTimeout`) after ``limit_s`` seconds.  A loaded machine
+    cannot make the screen be read before its refresh, and a screen that never shows it cannot pass; there is
+    no "pause a while" form, since every test waits for something it can name.  ``workers=False``: do not wait
+    for the workers (a test that holds one back)."""
     if workers:
         await app.workers.wait_for_complete()
-    if until is None:
-        await pilot.pause(0.3)
-        return
     await pilot.pause()
     deadline = time.monotonic() + limit_s
     while not until():

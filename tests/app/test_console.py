@@ -6,7 +6,7 @@ import asyncio
 from datetime import timedelta
 
 from nfwserver.console.app import NfwConsole
-from tests.app.console_helpers import log_text, settle, static_text
+from tests.app.console_helpers import log_text, searched, settle, static_text
 from tests.dde.conftest import ISS_PASS, make_station
 
 
@@ -39,7 +39,9 @@ def test_pokes_outgoing_strings_and_state_changes_show() -> None:
             assert sum(" ISS AZ:" in line for line in log_text(app, "outgoing").splitlines()) == 11  # none new
             client = station.system.connect("NFW32", "NFW_DATA")
             client.poke("NFW_SERVER", "TRACK ON")
-            await settle(app, pilot)
+            await settle(app, pilot, until=lambda: "TRACK ON ok" in log_text(app, "incoming")
+                         and "clients 1" in static_text(app, "state") and "TRACK ON" in static_text(app, "state")
+                         and searched(app), what="the DDE client's TRACK ON")
             assert "[conv 1 NFW32/NFW_DATA] TRACK ON ok" in log_text(app, "incoming")
             state = static_text(app, "state")
             assert "TRACK ON" in state and "clients 1 (0 advise)" in state

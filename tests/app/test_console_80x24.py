@@ -43,13 +43,13 @@ def _words(text: str) -> str:
 
 def _run(rigctld, scenario, stale_days: float = 10_000.0) -> None:
     station = make_station(start=ISS_PASS.tca - timedelta(seconds=30), channels=DEFAULT_CHANNELS)
-    station.core.set_tune(True)
+    station.core.set_feed(True)
     rotor = make_rotor(RotorConfig(backend="sim"), station.core, station.clock)
     station.core.rotor = rotor
     tuner = DopplerTuner(DEFAULT_CHANNELS[ISS], RigctldBackend(station.clock, port=rigctld.port))
     radio = RadioCoupling(tuner, station.core.state, station.clock)
     station.core.subscribe(radio.process)
-    station.core.set_radio_tuning(True)
+    station.core.set_doppler(True)
     station.core.command("TRACK ON")
     station.run(1.0)
     assert radio.last_result is not None  # the radio is tuned: the Radio line shows RX and TX
@@ -110,7 +110,7 @@ def test_help_is_readable_in_full_at_80x24_and_escape_closes_it(rigctld) -> None
         await pilot.press("escape")
         await settle(app, pilot, until=lambda: "ANTEL=" not in screen_text(app))
         await pilot.press(*"TUNE OFF", "enter")  # the command line has the focus again
-        await settle(app, pilot, until=lambda: not station.core.state.snapshot().dde_output)
+        await settle(app, pilot, until=lambda: not station.core.state.snapshot().feed_on)
 
     _run(rigctld, scenario)
 

@@ -16,7 +16,7 @@ from textual.worker import WorkerState
 from nfwserver.console.app import NfwConsole
 from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.elements import load_element_file
-from tests.app.console_helpers import settle, static_text
+from tests.app.console_helpers import settle, spin_until, static_text
 from tests.conftest import DATA
 from tests.dde.conftest import ISS_PASS, make_station
 
@@ -33,10 +33,7 @@ def test_a_whole_catalog_pass_list_leaves_the_keys_working() -> None:
         app = NfwConsole(station.core, favourites=everything)
         async with app.run_test(size=(140, 40)) as pilot:
             typed = app.query_one(Input)
-            for _ in range(100):  # until the first refresh has started the search
-                if searching(app):
-                    break
-                await asyncio.sleep(0.01)
+            await spin_until(lambda: searching(app), 5.0, "the whole catalog's pass search")
             handled_while_searching = 0
             for key in "TUNE ON":
                 before = typed.value

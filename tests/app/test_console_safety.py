@@ -27,7 +27,7 @@ from nfwserver.rotor.kct_driver import KctDriver
 from nfwserver.rotor.rotctld_backend import RotctldBackend
 from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.elements import load_element_file
-from tests.app.console_helpers import log_text, screen_text, settle, static_text
+from tests.app.console_helpers import log_text, screen_text, searched, settle, static_text
 from tests.conftest import DATA
 from tests.dde.conftest import CATALOG, ISS, ISS_PASS, make_station
 
@@ -48,7 +48,8 @@ def test_markup_in_names_is_shown_literally_everywhere() -> None:
     async def scenario() -> None:
         app = NfwConsole(station.core, favourites=(ISS,))
         async with app.run_test(size=(120, 36)) as pilot:
-            await settle(app, pilot)
+            await settle(app, pilot, until=lambda: searched(app) and "PWNED" in static_text(app, "state"),
+                         what="the hostile names and the pass search")
             state = static_text(app, "state")
             assert "Satellite [/b] (25544) [bold red]PWNED[/]" in state
             assert "[/b]" in static_text(app, "passes")
@@ -225,8 +226,8 @@ def test_pass_searches_run_off_the_ui_thread(monkeypatch) -> None:
             await pilot.pause()
             assert "TUNE ON ok" in log_text(app, "incoming") and not release.is_set()
             release.set()
-            await settle(app, pilot)
-            assert "ISS" in static_text(app, "passes") and "Next pass" in static_text(app, "state")
+            await settle(app, pilot, until=lambda: searched(app), what="the released pass search")
+            assert "ISS" in static_text(app, "passes") and "Next pass " in static_text(app, "state")
 
     asyncio.run(scenario())
 

@@ -17,7 +17,7 @@ from skyfield.api import EarthSatellite, load, wgs84
 
 from nfwserver.channels.channel import Channel
 from nfwserver.console.app import NfwConsole
-from tests.app.console_helpers import log_text, off_screen, screen_text, settle, static_text
+from tests.app.console_helpers import log_text, off_screen, screen_text, searched, settle, static_text
 from tests.dde.conftest import CATALOG, ISS, ISS_PASS, OBSERVER, dead_iss_text, make_station
 
 LONG_HINT = ("no observer configured: using 0.000000,0.000000 (Greenwich). Set [observer] location in "
@@ -64,7 +64,7 @@ def test_ctrl_d_without_a_radio_explains_itself() -> None:
             assert "Ctrl+D explains" in static_text(app, "state")
             await pilot.press("ctrl+d")
             await pilot.pause()
-            assert station.core.state.radio_tuning
+            assert station.core.state.doppler_on
             note = " ".join(log_text(app, "incoming").split())
             assert "no radio is configured, so nothing is tuned" in note
             assert 'backend = "rigctld"' in note and "/etc/nfw/station.toml" in note
@@ -80,7 +80,7 @@ def test_z_toggles_utc_and_local_time_with_the_zone_always_named() -> None:
     async def scenario() -> None:
         app = NfwConsole(station.core, favourites=(ISS,), local_zone=sydney)
         async with app.run_test(size=(120, 36)) as pilot:
-            await settle(app, pilot)
+            await settle(app, pilot, until=lambda: searched(app), what="the pass search")
             now = station.clock.now()
             utc_aos = ISS_PASS.aos.strftime("%m-%d %H:%M")
             assert f"{now:%m-%d %H:%M:%S} UTC" in static_text(app, "state")
@@ -111,7 +111,7 @@ def test_pass_table_has_headers_dates_and_marks_a_pass_in_progress() -> None:
     async def scenario() -> None:
         app = NfwConsole(station.core, favourites=(ISS, 27607))
         async with app.run_test(size=(120, 36)) as pilot:
-            await settle(app, pilot)
+            await settle(app, pilot, until=lambda: searched(app), what="the pass search")
             table = static_text(app, "passes").splitlines()
             assert table[0].split() == ["Satellite", "Date", "AOS", "Max", "LOS"]
             first = table[1].split()
@@ -182,7 +182,7 @@ def test_the_pass_list_names_a_favourite_whose_position_cannot_be_computed() -> 
     async def scenario() -> None:
         app = NfwConsole(station.core, favourites=(ISS, 99901))
         async with app.run_test(size=(120, 36)) as pilot:
-            await settle(app, pilot)
+            await settle(app, pilot, until=lambda: searched(app), what="the pass search")
             table = static_text(app, "passes").splitlines()
             assert table[1].split()[0] == "ISS"
             assert table[-1] == "! left out, position cannot be computed now: DEAD"

@@ -7,19 +7,19 @@ import asyncio
 from textual.widgets import Input
 
 from nfwserver.console.app import NfwConsole
-from tests.app.console_helpers import log_text, off_screen, screen_text, settle, static_text
+from tests.app.console_helpers import log_text, off_screen, screen_text, searched, settle, static_text
 from tests.dde.conftest import ISS, make_station
 
 
 def _run(scenario) -> None:
     station = make_station()
-    station.core.set_tune(True)
+    station.core.set_feed(True)
     station.run(1.0)
 
     async def body() -> None:
         app = NfwConsole(station.core, favourites=(ISS,))
         async with app.run_test(size=(80, 24)) as pilot:
-            await settle(app, pilot)
+            await settle(app, pilot, until=lambda: searched(app), what="the first pass search")
             await scenario(app, pilot, station)
 
     asyncio.run(body())
@@ -29,12 +29,12 @@ def test_typed_commands_still_reach_the_station_after_f1_and_f3() -> None:
     async def scenario(app, pilot, station) -> None:
         await pilot.press("f1")
         await pilot.press(*"TUNE OFF", "enter")
-        await settle(app, pilot, until=lambda: not station.core.state.snapshot().dde_output)
-        assert not station.core.state.snapshot().dde_output
+        await settle(app, pilot, until=lambda: not station.core.state.snapshot().feed_on)
+        assert not station.core.state.snapshot().feed_on
         await pilot.press("f3")
         await pilot.press(*"TUNE ON", "enter")
-        await settle(app, pilot, until=lambda: station.core.state.snapshot().dde_output)
-        assert station.core.state.snapshot().dde_output
+        await settle(app, pilot, until=lambda: station.core.state.snapshot().feed_on)
+        assert station.core.state.snapshot().feed_on
         assert isinstance(app.focused, Input)
 
     _run(scenario)
@@ -62,8 +62,9 @@ def test_page_keys_scroll_the_shown_log_while_typing_stays_possible() -> None:
         for k in range(60):
             station.core.command(f"ANTAZ={k}", source="test")
         await pilot.press("f3")
-        await settle(app, pilot)
         incoming = app.query_one("#incoming")
+        await settle(app, pilot, until=lambda: "ANTAZ=59" in log_text(app, "incoming") and incoming.max_scroll_y > 0
+                     and incoming.scroll_y == incoming.max_scroll_y, what="the 60th command, scrolled to")
         bottom = incoming.scroll_y
         assert bottom > 0
         await pilot.press("pageup")
@@ -88,11 +89,19 @@ def test_the_footer_shows_every_key_at_80_columns() -> None:
     _run(scenario)
 
 
+def _fitted(app) -> bool:
+    """The state pane has been redrawn for its present width: one row per line, as wide as the pane at most."""
+    state = app.query_one("#state")
+    lines = static_text(app, "state").splitlines()
+    return (bool(lines) and max(len(line) for line in lines) <= state.content_region.width
+            and state.content_region.height == len(lines))
+
+
 def test_the_header_fits_again_when_the_terminal_is_resized() -> None:
     async def scenario(app, pilot, station) -> None:
         await pilot.resize_terminal(140, 40)
-        await settle(app, pilot, until=lambda: app.query_one("#state").size.width > 100)
-        await settle(app, pilot)
+        await settle(app, pilot, until=lambda: app.query_one("#state").size.width > 100 and _fitted(app),
+                     what="the header refitted to 140 columns")
         assert not off_screen(app), off_screen(app)
         state = app.query_one("#state")
         # Fitted to the new width: one row per line, none longer than the pane.
@@ -100,8 +109,8 @@ def test_the_header_fits_again_when_the_terminal_is_resized() -> None:
         assert max(len(line) for line in lines) <= state.content_region.width
         assert state.content_region.height == len(lines), (state.content_region, lines)
         await pilot.resize_terminal(80, 24)
-        await settle(app, pilot, until=lambda: app.query_one("#state").size.width < 100)
-        await settle(app, pilot)
+        await settle(app, pilot, until=lambda: app.query_one("#state").size.width < 100 and _fitted(app),
+                     what="the header refitted to 80 columns")
         lines = static_text(app, "state").splitlines()
         assert max(len(line) for line in lines) <= state.content_region.width, lines
         assert state.content_region.height == len(lines), (state.content_region, lines)

@@ -51,24 +51,24 @@ def test_a_headless_station_follows_a_pass_with_rotctld_and_answers_status_and_p
         station = Station(load_config(str(path)), clock, transport=FakeDdeSystem().server_transport())
         station.start()  # the dummy rotor starts at 0/0, about 95 degrees away
         try:
-            assert station.core.state.snapshot().tracking and station.core.state.snapshot().dde_output
+            assert station.core.state.snapshot().tracking and station.core.state.snapshot().feed_on
 
             def distance() -> float:
                 az, el = (float(v) for v in rotctld.query("p", 2))
                 la = station.core.tracker.last_sample.look_angles
                 return angular_distance(az, el, la.azimuth_deg, la.elevation_deg)
 
-            first = None
-            deadline = time.monotonic() + 40.0
-            while time.monotonic() < deadline:  # the dummy rotor turns in real time: keep the clock with it
+            distances: list[float] = []
+
+            def pointed() -> bool:  # the dummy rotor turns in real time: keep the clock with it
                 for _ in range(5):
                     clock.advance(0.1)
                     time.sleep(0.1)
-                now = distance()
-                first = now if first is None else first
-                if now < 4.0:
-                    break
-            assert first > 60.0 and now < 4.0, (first, now)
+                distances.append(distance())
+                return distances[-1] < 4.0
+
+            wait_for(pointed, 40.0, lambda: f"the rotor to point at the satellite (off by {distances[-1]:.1f} deg)")
+            assert distances[0] > 60.0, distances
 
             assert main(["status", "--config", str(path)]) == 0
             fields = _fields(capsys.readouterr().out.strip())

@@ -14,6 +14,7 @@ from nfwserver.config import parse_config
 from nfwserver.config.schema import Config
 from nfwserver.fake_dde import FakeDdeSystem
 from tests.conftest import DATA
+from tests.waiting import wait_for
 
 
 def test_bundled_elements_hold_the_popular_satellites() -> None:
@@ -79,7 +80,6 @@ def test_run_refuses_a_bad_config(tmp_path, capsys) -> None:
 
 @pytest.mark.hamlib
 def test_station_tunes_a_real_rigctld_when_configured(rigctld, tmp_path) -> None:
-    import time
 
     config = parse_config(
         f'[radio]\nbackend = "rigctld"\nport = {rigctld.port}\nenabled = true\n'
@@ -89,10 +89,8 @@ def test_station_tunes_a_real_rigctld_when_configured(rigctld, tmp_path) -> None
     station = Station(config, SystemClock(), transport=FakeDdeSystem().server_transport())
     station.start()
     try:
-        for _ in range(300):  # bounded: the publisher ticks at 5 Hz and the radio worker follows
-            if station.radio.last_result is not None:
-                break
-            time.sleep(0.01)
+        # the publisher ticks at 5 Hz and the radio worker follows
+        wait_for(lambda: station.radio.last_result is not None, 10.0, "the radio's first Doppler tuning")
     finally:
         station.stop()
     result = station.radio.last_result

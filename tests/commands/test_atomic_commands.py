@@ -22,7 +22,7 @@ def test_a_refused_multi_line_poke_changes_nothing(poke: str) -> None:
         conv.poke("NFW_SERVER", poke)
     station.run(1.0)
     state = station.core.state.snapshot()
-    assert (state.dde_output, state.tracking, state.catalog_number) == (False, False, ISS)
+    assert (state.feed_on, state.tracking, state.catalog_number) == (False, False, ISS)
     assert conv.request_text("NFW_SERVER") == ""
     refused = [e for e in station.core.events.recent() if e.kind == "poke" and e.accepted is False]
     assert len(refused) == 1
@@ -34,5 +34,5 @@ def test_an_accepted_multi_line_poke_applies_every_line_in_order() -> None:
     conv.poke("NFW_SERVER", "TUNE ON\nTRACK ON\nANTAZ=12.5")
     station.run(1.0)
     state = station.core.state.snapshot()
-    assert (state.dde_output, state.tracking) == (True, True)
+    assert (state.feed_on, state.tracking) == (True, True)
     assert conv.request_text("NFW_SERVER").startswith("ISS AZ:")

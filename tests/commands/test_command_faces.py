@@ -110,14 +110,14 @@ def test_a_dde_poke_takes_catalog_numbers_only(tcp_station) -> None:
 
 def test_the_line_that_ends_watch_is_not_executed(tcp_station, client) -> None:
     station, server = tcp_station
-    station.core.set_tune(True)
+    station.core.set_feed(True)
     assert client.ask("WATCH") == "OK"
     assert wait_for(lambda: server.watcher_count() == 1)
     client.send(b"TUNE OFF\r\n")
     assert wait_for(lambda: server.watcher_count() == 0)
     while (line := client.text()) != "OK":
         assert line.startswith("ISS ")  # strings published before the stop line
-    assert station.core.state.snapshot().dde_output  # TUNE OFF ended the stream; it was not executed
+    assert station.core.state.snapshot().feed_on  # TUNE OFF ended the stream; it was not executed
     assert client.ask("STATUS").startswith("satellite=")
 
 

@@ -10,7 +10,7 @@ from nfwserver.commands.help_text import help_lines
 from nfwserver.commands.table import Face
 from nfwserver.console.app import NfwConsole
 from nfwserver.console.help_screen import HelpScreen
-from tests.app.console_helpers import log_text, screen_text, settle
+from tests.app.console_helpers import log_text, screen_text, searched, settle
 from tests.dde.conftest import ISS, make_station
 
 
@@ -21,7 +21,7 @@ def test_console_help_flip_name_and_track_warning() -> None:
     async def scenario() -> None:
         app = NfwConsole(station.core, favourites=(ISS,))
         async with app.run_test(size=(120, 40)) as pilot:
-            await settle(app, pilot)
+            await settle(app, pilot, until=lambda: searched(app), what="the first pass search")
             await pilot.press(*"help", "enter")
             await settle(app, pilot, until=lambda: isinstance(app.screen, HelpScreen) and "PARK" in screen_text(app))
             on_screen = " ".join(screen_text(app).replace("│", " ").split())

@@ -13,7 +13,7 @@ from nfwserver.commands.parsing import Request
 from nfwserver.commands.table import Command, Face
 from nfwserver.console.app import NfwConsole
 from nfwserver.tcp.protocol import NovaTcpProtocol
-from tests.app.console_helpers import settle
+from tests.app.console_helpers import searched, settle
 from tests.dde.conftest import make_station
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -91,7 +91,7 @@ def test_the_console_sends_every_command_as_the_console_through_the_core(monkeyp
     async def scenario() -> None:
         app = NfwConsole(core)
         async with app.run_test(size=(120, 40)) as pilot:
-            await settle(app, pilot)
+            await settle(app, pilot, until=lambda: searched(app), what="the first pass search")
             await pilot.press("ctrl+t")
             await pilot.press("ctrl+f")
             await pilot.press(*"TUNE OFF", "enter")

@@ -61,5 +61,5 @@ def test_each_live_part_reaches_the_running_core_and_only_when_it_changed() -> N
     assert state.observer == new.observer and state.rate_hz == 2 and state.ut1_utc_s == 0.25
     iss = state.catalog.get(ISS)
     assert iss is not None and iss.dde_name == "ARISS"
-    assert core.snapshot().state.radio_tuning
+    assert core.snapshot().state.doppler_on
     assert not any(part.differs(new, new) for part in CONFIG_PARTS)

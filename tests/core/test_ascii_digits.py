@@ -19,7 +19,7 @@ from nfwserver.console.app import NfwConsole
 from nfwserver.dialects.predict_listing import atol
 from nfwserver.fake_dde import DdeError
 from nfwserver.tracking.elements import load_elements
-from tests.app.console_helpers import log_text, settle
+from tests.app.console_helpers import log_text, searched, settle
 from tests.dde.conftest import ISS, make_station
 from tests.tcp.conftest import LOOPBACK_ONLY, LineClient
 
@@ -78,7 +78,7 @@ def test_the_console_refuses_the_poke_and_its_picker_searches_without_crashing()
     async def scenario() -> None:
         app = NfwConsole(station.core, favourites=(ISS,))
         async with app.run_test(size=(100, 30)) as pilot:
-            await settle(app, pilot)
+            await settle(app, pilot, until=lambda: searched(app), what="the first pass search")
             await pilot.press(*"SAT=²", "enter")
             await settle(app, pilot, until=lambda: "REFUSED" in log_text(app, "incoming"))
             assert "REFUSED (SAT needs a catalog number, got '\\xb2')" in " ".join(log_text(app, "incoming").split())

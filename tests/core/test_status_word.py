@@ -46,11 +46,11 @@ def test_tuning_bit_is_the_radios_not_the_dde_feed() -> None:
     core = station.core
     core.command("TUNE ON")  # Nova's DDE output, not OrbitDRV tuning
     sample = core.tick()
-    assert sample.text and sample.dde_output
+    assert sample.text and sample.feed_on
     assert sample.status & StatusBit.TUNING_DISABLED
-    core.set_radio_tuning(True)
+    core.set_doppler(True)
     sample = core.tick()
-    assert not sample.status & StatusBit.TUNING_DISABLED and sample.radio_tuning
+    assert not sample.status & StatusBit.TUNING_DISABLED and sample.doppler_on
 
 
 def test_track_on_is_ignored_without_station_or_satellite() -> None:

@@ -167,8 +167,8 @@ def test_fuzzed_pokes_never_disturb_another_conversation(junk) -> None:
     station.run(0.4)
     after = station.core.snapshot()
     if isinstance(junk, str):
-        assert (after.state.dde_output, after.catalog_number) == (before.state.dde_output, before.catalog_number)
-    assert len(victim.texts()) >= 3 or not after.state.dde_output
+        assert (after.state.feed_on, after.catalog_number) == (before.state.feed_on, before.catalog_number)
+    assert len(victim.texts()) >= 3 or not after.state.feed_on
 
 
 def test_tick_listeners_and_a_broken_listener(station) -> None:

@@ -213,7 +213,7 @@ def test_station_serves_the_configured_dialects_next_to_nova() -> None:
             client.settimeout(5)
             client.sendto(b"GET_MODE", station.predict.address)
             assert client.recvfrom(100)[0] == b""  # PREDICT: empty until something is tracked
-            station.core.set_tune(True, source="test")
+            station.core.set_feed(True, source="test")
             client.sendto(b"GET_MODE", station.predict.address)
             assert client.recvfrom(100)[0] == b"ISS (ZARYA)\n"
     finally:

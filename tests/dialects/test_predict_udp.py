@@ -118,9 +118,9 @@ def test_get_mode_is_empty_before_any_tracking_then_the_name_then_none() -> None
         assert peer.ask("GET_MODE") == ""
         state.select(ISS)
         assert peer.ask("GET_MODE") == ""  # selected but neither published nor followed
-        state.set_dde_output(True)
+        state.set_feed(True)
         assert peer.ask("GET_MODE") == "ISS (ZARYA)\n"
-        state.set_dde_output(False)
+        state.set_feed(False)
         state.set_tracking(True)
         assert peer.ask("GET_MODE") == "ISS (ZARYA)\n"
         state.set_tracking(False)
@@ -140,7 +140,7 @@ def test_names_with_control_characters_never_shift_fields() -> None:
         assert peer.ask("GET_TLE 25544").split("\n")[0] == "EVIL?NAME?[31m??X?"
         assert peer.ask("GET_LIST").split("\n")[0] == "EVIL?NAME?[31m??X?"
         peer.state.select(ISS)
-        peer.state.set_dde_output(True)
+        peer.state.set_feed(True)
         assert peer.ask("GET_MODE") == "EVIL?NAME?[31m??X?\n"
 
 

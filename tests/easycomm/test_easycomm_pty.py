@@ -90,7 +90,7 @@ def test_lines_during_a_pass_match_the_spec_and_skyfield(tmp_path) -> None:
     pty = Pty(tmp_path / "ttyUSB0")
     output = _output(station, pty.path)
     station.core.set_track(True)
-    station.core.set_tune(True)
+    station.core.set_feed(True)
     _start(output)
     try:
         for _ in range(8):

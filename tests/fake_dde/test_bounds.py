@@ -62,7 +62,7 @@ def test_conversations_per_service_are_capped_with_a_clear_refusal() -> None:
 
 def test_tick_cost_is_bounded_with_twenty_thousand_abandoned_hot_clients() -> None:
     station = make_station()
-    station.core.set_tune(True)
+    station.core.set_feed(True)
     system = station.system
     opened = 0
     for _ in range(20_000):
@@ -84,7 +84,7 @@ def test_a_clients_record_is_bounded() -> None:
     station = make_station()
     conv = station.system.connect("NFW32", "NFW_DATA")
     conv.start_advise("NFW_SERVER")
-    station.core.set_tune(True)
+    station.core.set_feed(True)
     station.run(3000.0)  # 15,000 ticks at 5 Hz, never read
     assert len(conv.received) == station.system.received_capacity == 10_000
 
@@ -95,7 +95,7 @@ def test_advise_loops_are_served_only_to_their_item_and_forgotten_on_stop_and_di
     a, b = system.connect("NFW32", "NFW_DATA"), system.connect("NFW32", "NFW_DATA")
     a.start_advise("NFW_SERVER")
     b.start_advise("NFW_SERVER")
-    station.core.set_tune(True)
+    station.core.set_feed(True)
     station.run(1.0)
     b.stop_advise("NFW_SERVER")
     station.run(1.0)

@@ -31,7 +31,7 @@ def test_a_satellite_without_a_channel_is_no_channel_with_no_stale_frequency(rig
     tuner = DopplerTuner(DEFAULT_CHANNELS[ISS], RigctldBackend(clock, port=rigctld.port))
     radio = RadioCoupling(tuner, core.state, clock)
     core.subscribe(radio.process)
-    core.set_radio_tuning(True)
+    core.set_doppler(True)
     status = device_status(None, radio, None)
     run_virtual(core, clock, 1.0)
     assert status()["radio"] == "ok" and 437_790_000 < int(status()["radio_rx"]) < 437_810_000
@@ -43,9 +43,9 @@ def test_a_satellite_without_a_channel_is_no_channel_with_no_stale_frequency(rig
     assert part is not None and part["state"] == "no-channel" and part["rx_hz"] is None and part["tx_hz"] is None
     run_virtual(core, clock, 1.0)
     assert status() == {"radio": "no-channel"} and radio.last_result is None
-    core.set_radio_tuning(False)  # tuning off: nothing is expected of the radio
+    core.set_doppler(False)  # tuning off: nothing is expected of the radio
     assert status()["radio"] == "ok"
-    core.set_radio_tuning(True)
+    core.set_doppler(True)
     assert core.command(f"SAT={ISS}").ok
     run_virtual(core, clock, 1.0)
     assert status()["radio"] == "ok" and 437_790_000 < int(status()["radio_rx"]) < 437_810_000

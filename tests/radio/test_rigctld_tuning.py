@@ -102,10 +102,10 @@ def test_daemon_killed_and_restarted_mid_pass(rigctld) -> None:
         if k == 30:
             rigctld.start()
         outcomes.append(tuner.update(calc.compute(ISS.satrec, when).range_rate_km_s))
-    # Before the kill the radio is tuned.  Under the whole suite's parallel load the real rigctld was seen to
-    # reset the connection once before the kill (twice in about ten runs on 2 cores; cause not found, the
-    # test's own daemon, checked); that one outage heals like any other, so at most one is allowed here.
-    assert sum(o is None for o in outcomes[:20]) <= 1 and outcomes[0] is not None
+    # Before the kill the radio is tuned, every time.  (The occasional 'Connection reset by peer' here was
+    # rigctld's own: the helper's start-up probe connection, closed at once, let rigctld close our socket;
+    # tests/hamlib_daemons.py HamlibDaemon.start and tests/test_hamlib_daemons.py say how.)
+    assert all(o is not None for o in outcomes[:20]), [k for k, o in enumerate(outcomes[:20]) if o is None]
     assert all(o is None for o in outcomes[20:30])
     resumed = next(k for k in range(30, 60) if outcomes[k] is not None)
     assert resumed <= 36  # back-off is short while the outage is short
@@ -129,7 +129,7 @@ def test_coupling_tunes_from_ticks_on_its_worker(rigctld) -> None:
     tuner = DopplerTuner(FM, RigctldBackend(clock, port=rigctld.port), step_hz=STEP)
     coupling = RadioCoupling(tuner, StationState(Catalog([ISS]), OBS, channels={25544: FM}))
     la = LookAngleCalculator(OBS).compute(ISS.satrec, PASS.tca)
-    sample = TickSample(PASS.tca, 25544, "ISS", la, True, True, False, "", 0, radio_tuning=True)
+    sample = TickSample(PASS.tca, 25544, "ISS", la, True, True, False, "", 0, doppler_on=True)
     coupling.start()
     try:
         for _ in range(300):  # ticks keep coming, as from the publisher; bounded wait for the worker
@@ -142,4 +142,4 @@ def test_coupling_tunes_from_ticks_on_its_worker(rigctld) -> None:
         coupling.stop()
     assert coupling.last_result is not None
     assert abs(_read(rigctld, "f") - FM.downlink_hz * (1 - la.range_rate_km_s / C)) <= STEP + 1
-    assert coupling.process(replace(sample, radio_tuning=False)) is None  # OrbitDRV tuning disabled
+    assert coupling.process(replace(sample, doppler_on=False)) is None  # OrbitDRV tuning disabled

@@ -77,7 +77,7 @@ def test_connections_that_complete_no_line_are_closed_but_watchers_stay(limited)
     silent, loris, poller, watcher = (connect(f"127.0.0.{k}") for k in (1, 2, 3, 4))
     for c in (silent, loris, poller, watcher):
         assert c.read_line() == GREETING
-    station.core.set_tune(True)
+    station.core.set_feed(True)
     assert watcher.ask("WATCH") == "OK"
     for _ in range(4):  # 4 x 10 s: the poller completes a line every 10 s; the loris sends bytes, no line
         loris.send(b"S")

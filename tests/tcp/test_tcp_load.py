@@ -72,7 +72,7 @@ def test_fifty_watchers_get_every_string_while_a_stalled_one_is_dropped(caplog) 
     server.start()
     published: list[str] = []
     station.core.subscribe(lambda s: published.append(s.text))
-    station.core.set_tune(True)
+    station.core.set_feed(True)
     try:
         watchers = _watchers(server, 50)
         stalled = LineClient(server.address, rcvbuf=2048)
@@ -138,7 +138,7 @@ def test_ten_thousand_hostile_lines_disturb_nobody() -> None:
     station = make_station()
     server = NovaTcpServer(station.core, ONE_BUSY_ADDRESS)
     server.start()
-    station.core.set_tune(True)
+    station.core.set_feed(True)
     published: list[str] = []
     station.core.subscribe(lambda s: published.append(s.text))
     try:

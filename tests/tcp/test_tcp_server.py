@@ -88,7 +88,7 @@ def test_commands_reach_the_event_stream_with_the_peer_address(tcp_station, clie
 
 def test_every_line_end_is_understood_and_replies_end_with_crlf(tcp_station, client) -> None:
     station, _ = tcp_station
-    station.core.set_tune(True)
+    station.core.set_feed(True)
     station.run(0.2)
     expected = station.core.current_text().encode() + b"\r\n"
     client.send(b"SUMMARY\rSUMMARY\nSUMMARY\r\nSUMMARY\x00summary \r")
@@ -103,7 +103,7 @@ def test_every_line_end_is_understood_and_replies_end_with_crlf(tcp_station, cli
 def test_status_is_one_line_of_key_values(tcp_station, client) -> None:
     station, server = tcp_station
     server.protocol.extra = lambda: {"rotor": "ok", "rotor_az": "12.5", "note": "two words"}
-    station.core.set_tune(True)
+    station.core.set_feed(True)
     station.run(0.4)
     fields = parse_status(client.ask("STATUS"))
     sample = station.core.tracker.last_sample
@@ -117,7 +117,7 @@ def test_status_is_one_line_of_key_values(tcp_station, client) -> None:
 
 def test_watch_streams_every_published_string_until_a_line_arrives(tcp_station, client) -> None:
     station, server = tcp_station
-    station.core.set_tune(True)
+    station.core.set_feed(True)
     published: list[str] = []
     station.core.subscribe(lambda s: published.append(s.text))
     assert client.ask("WATCH") == "OK"

@@ -34,7 +34,7 @@ class _TickDuringDrain:
 
 def test_a_tick_landing_inside_the_drain_does_not_stop_later_wake_ups(tcp_station) -> None:
     station, server = tcp_station
-    station.core.set_tune(True)
+    station.core.set_feed(True)
     watcher = LineClient(server.address)
     try:
         assert watcher.read_line() == b"Hello, this is Nova for Windows.\r\n"

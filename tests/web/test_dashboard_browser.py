@@ -84,7 +84,7 @@ def test_controls_change_the_station_with_the_token_and_are_refused_without(brow
     web_station.advance(0.4)
     wait_for(lambda: read_page(browser)["track"] == "TRACK ON", what="the page to show TRACK ON")
     _click(browser, "btn-tune-off")
-    wait_for(lambda: not core.state.snapshot().dde_output, what="TUNE OFF")
+    wait_for(lambda: not core.state.snapshot().feed_on, what="TUNE OFF")
     # a refused command: the station's own refusal is shown, nothing changes
     box = browser.find_element(By.CSS_SELECTOR, '[data-testid="sat-input"]')
     box.send_keys("99999")

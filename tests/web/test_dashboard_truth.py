@@ -49,7 +49,7 @@ def test_doppler_tuning_without_a_channel_is_not_shown_as_on(browser) -> None:
     """#34 item 8: a green "DOPPLER ON" stood beside "no radio channel for this satellite"."""
     web = start_station(config_text())  # ISS has a built-in channel; 694 (in visual.txt) has none
     try:
-        web.station.core.set_radio_tuning(True)
+        web.station.core.set_doppler(True)
         open_page(browser, web)
         radio = browser.find_element(By.CSS_SELECTOR, '[data-testid="radio-state"]')
         wait_for(lambda: radio.text == "DOPPLER ON", what="DOPPLER ON for the ISS, which has a channel")

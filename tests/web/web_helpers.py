@@ -25,7 +25,7 @@ def running_web(**options: object) -> Iterator[tuple[StationCore, WebServer]]:
                           **{k: v for k, v in options.items() if k in fields}})  # type: ignore[arg-type]
     clock = VirtualClock(ISS_PASS.aos + timedelta(seconds=200))
     core = StationCore(CATALOG, OBSERVER, clock, satellite=25544, rate_hz=5.0)
-    core.set_tune(True)
+    core.set_feed(True)
     web = WebServer(core, config, **{k: v for k, v in options.items() if k not in fields})  # type: ignore[arg-type]
     web.start()
     try:

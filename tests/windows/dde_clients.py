@@ -28,22 +28,23 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent.parent))
 
 from nfwserver.dde.ddeml_client import DdemlClient, DdeRefused  # noqa: E402
+from tests.waiting import wait_for  # noqa: E402
 
 SERVICES = ("NFW32", "NFW_SERVER")
 
 
 def connect(client: DdemlClient, service: str, timeout_s: float) -> int:
-    deadline = time.monotonic() + timeout_s
-    while True:
+    def connected() -> int | None:
         try:
             conv = client.connect(service, "NFW_DATA")
             client.poke(conv, "NFW_SERVER", "TUNE ON")
             client.start_advise(conv, "NFW_SERVER", hot=True)
             return conv
         except DdeRefused:
-            if time.monotonic() > deadline:
-                raise
-            client.pump(0.25)
+            client.pump(0.25)  # the wait between tries: DDE messages flow meanwhile
+            return None
+
+    return wait_for(connected, timeout_s, f"{service}/NFW_DATA to take an advise link", interval_s=0.0)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import subprocess
 import sys
-import time
 from pathlib import Path
+
+from tests.waiting import wait_for
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 
@@ -31,18 +32,19 @@ class StationProcess:
         from nfwserver.dde.ddeml_client import DdemlClient, DdeRefused
 
         client = DdemlClient()
+
+        def serving() -> bool:
+            if self.proc.poll() is not None:
+                raise RuntimeError(f"the station exited with {self.proc.returncode}: {self.stderr()}")
+            try:
+                client.disconnect(client.connect(service, topic))
+                return True
+            except DdeRefused:
+                client.pump(0.2)  # the wait between tries: DDE messages flow meanwhile
+                return False
+
         try:
-            deadline = time.monotonic() + timeout_s
-            while True:
-                if self.proc.poll() is not None:
-                    raise RuntimeError(f"the station exited with {self.proc.returncode}: {self.stderr()}")
-                try:
-                    client.disconnect(client.connect(service, topic))
-                    return
-                except DdeRefused:
-                    if time.monotonic() > deadline:
-                        raise
-                    client.pump(0.2)
+            wait_for(serving, timeout_s, f"the station to serve {service}/{topic}", interval_s=0.0)
         finally:
             client.close()
 

@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import subprocess
 import sys
-import time
 from collections.abc import Iterable
 from pathlib import Path
 
 import pytest
 
+from tests.waiting import wait_for
 from tests.windows.conftest import NOVA, wine_version
 
 pytestmark = [
@@ -36,10 +36,11 @@ def minimal_server(tmp_path_factory):
                              "--ready", str(ready), "--services", ",".join(MINIMAL)],
                             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        deadline = time.monotonic() + 60
-        while not ready.exists():
-            assert proc.poll() is None and time.monotonic() < deadline, proc.poll()
-            time.sleep(0.1)
+        def up() -> bool:
+            assert proc.poll() is None, proc.poll()
+            return ready.exists()
+
+        wait_for(up, 60.0, "the minimal DDEML server to register its services", interval_s=0.1)
         yield proc
     finally:
         proc.kill()

@@ -14,10 +14,12 @@ import logging
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
+from tests.waiting import wait_for
 from tests.windows.conftest import serving_station
 from tests.windows.test_wine_advise_copies import pump_messages
 
@@ -36,13 +38,15 @@ def clients_program(service: str, seconds: float, out: Path, start_at: float = 0
                             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
 
-def pump_until(condition, timeout_s: float) -> bool:
-    deadline = time.monotonic() + timeout_s
-    while not condition():
-        if time.monotonic() > deadline:
-            return False
+def pump_until(condition, timeout_s: float, what: str | Callable[[], str]) -> None:
+    """Pump this thread's DDE messages 0.1 s at a time until ``condition`` holds; fail after ``timeout_s``."""
+    def pumped() -> bool:
+        if condition():
+            return True
         pump_messages(0.1)
-    return True
+        return False
+
+    wait_for(pumped, timeout_s, what, interval_s=0.0)
 
 
 def test_a_client_killed_while_it_holds_a_hot_link_is_dropped_in_one_line(tmp_path, caplog) -> None:
@@ -54,15 +58,18 @@ def test_a_client_killed_while_it_holds_a_hot_link_is_dropped_in_one_line(tmp_pa
         survivor = clients_program(SERVICES[0], 3.0, tmp_path / "survivor.json", start_at=window_at)
         victim = None
         try:
-            assert pump_until(lambda: station.client_count()[1] == 1, 20.0), station.client_count()
+            pump_until(lambda: station.client_count()[1] == 1, 20.0,
+                       lambda: f"one advise link ({station.client_count()})")
             victim = clients_program(SERVICES[1], 120.0, tmp_path / "victim.json")
-            assert pump_until(lambda: station.client_count()[1] == 2, 20.0), station.client_count()
+            pump_until(lambda: station.client_count()[1] == 2, 20.0,
+                       lambda: f"two advise links ({station.client_count()})")
             pump_messages(0.5)  # both links served for a few ticks
             victim.kill()  # TerminateProcess: no DdeDisconnect, no XTYP_DISCONNECT
             victim.wait(10)
-            assert pump_until(lambda: station.client_count() == (1, 1), 5.0), station.client_count()
+            pump_until(lambda: station.client_count() == (1, 1), 5.0,
+                       lambda: f"the victim dropped ({station.client_count()})")
             assert time.time() < window_at, "the survivor's window started before the victim was gone"
-            assert pump_until(lambda: survivor.poll() is not None, 60.0)
+            pump_until(lambda: survivor.poll() is not None, 60.0, "the survivor to finish")
         finally:
             for program in (survivor, victim):
                 if program is not None and program.poll() is None:

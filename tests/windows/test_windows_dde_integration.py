@@ -10,6 +10,7 @@ import time
 
 import pytest
 
+from tests.waiting import wait_for
 from tests.windows.conftest import NOVA, request_after_refusal
 
 pytestmark = [
@@ -81,10 +82,8 @@ def test_pywin32_dde_conversation(live_server) -> None:
         conv.Exec("TRACK ON")
         # pywin32's Exec can return before the server's DDE thread has handled the execute under Wine
         # (seen once in CI): allow the station up to 3 s of real DDE time to apply it.
-        deadline = time.monotonic() + 3.0
-        while not live_server.snapshot().state.tracking and time.monotonic() < deadline:
-            time.sleep(0.02)
-        assert live_server.snapshot().state.tracking
+        wait_for(lambda: live_server.snapshot().state.tracking, 3.0, "the station to apply TRACK ON",
+                 interval_s=0.02)
     finally:
         server.Destroy()
 

@@ -25,6 +25,7 @@ from pathlib import Path
 import pytest
 
 from nfwserver.dde.post_advise_stats import parse_summary
+from tests.waiting import wait_for
 from tests.windows.station_config import write_station_config
 from tests.windows.wine_session import kill_session
 
@@ -154,15 +155,13 @@ def test_wine_md_windows_rotor_client_and_station_radio_reach_linux_hamlib(tmp_p
     assert abs(el - alt.degrees) < 0.3 and abs(az - azimuth.degrees) < 0.3, (az, el, azimuth.degrees, alt.degrees)
     # The Linux rotor points where DDE said.  rotctld's dummy rotor slews at 6 deg/s from 0/0 (Hamlib's
     # rot_dummy.c), so reaching AZ 180 takes 30 s after the client's P: wait for it (up to 60 s).
-    import time
+    pos: list[float] = []
 
-    deadline = time.monotonic() + 60
-    while True:
-        pos = [float(v) for v in rotctld.query("p", lines=2)]
-        if (abs(pos[0] - az) < 0.11 and abs(pos[1] - el) < 0.11) or time.monotonic() > deadline:
-            break
-        time.sleep(0.5)
-    assert abs(pos[0] - az) < 0.11 and abs(pos[1] - el) < 0.11, (pos, az, el)
+    def pointed() -> bool:
+        pos[:] = [float(v) for v in rotctld.query("p", lines=2)]
+        return abs(pos[0] - az) < 0.11 and abs(pos[1] - el) < 0.11
+
+    wait_for(pointed, 60.0, lambda: f"the rotor at {az}/{el} (it is at {pos})", interval_s=0.5)
     assert abs(radio_hz - 1_537_700_000) < 1_537_700_000 * 1 / 299792.458  # tuned: within 1 km/s of Doppler
 
 
@@ -204,11 +203,11 @@ def test_a_signal_to_the_launcher_stops_the_windows_station_cleanly_within_5_s(t
         cwd=ROOT, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         env={**os.environ, "NFW_WINE_TIMEOUT": "120"}, start_new_session=True)
     try:
-        deadline = time.monotonic() + 90
-        while not ready.exists():
-            assert client.poll() is None and station.poll() is None and time.monotonic() < deadline, \
-                (client.poll(), station.poll())
-            time.sleep(0.1)
+        def clients_ready() -> bool:
+            assert client.poll() is None and station.poll() is None, (client.poll(), station.poll())
+            return ready.exists()
+
+        wait_for(clients_ready, 90.0, "the DDE clients to be connected", interval_s=0.1)
         if how.endswith("process group"):
             os.killpg(station.pid, sig)
         else:

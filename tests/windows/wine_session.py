@@ -13,8 +13,9 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
-import time
 from pathlib import Path
+
+from tests.waiting import wait_for
 
 
 def session_members(sid: int) -> list[int]:
@@ -37,15 +38,16 @@ def kill_session(proc: subprocess.Popen, timeout_s: float = 30.0) -> None:
     starting the program, a launcher starting ``wine``), which a single pass would leave running.  So the
     session is read and killed again until no live member is left (or ``timeout_s`` passes: RuntimeError).
     """
-    deadline = time.monotonic() + timeout_s
-    while members := session_members(proc.pid):
-        if time.monotonic() > deadline:
-            raise RuntimeError(f"session {proc.pid} still has processes {members} after {timeout_s:g} s of SIGKILL")
+    def emptied() -> bool:
+        members = session_members(proc.pid)
         for pid in members:
             try:
                 os.kill(pid, signal.SIGKILL)
             except ProcessLookupError:
                 pass
-        time.sleep(0.01)  # let the signalled ones die before the session is read again
+        return not members  # else let the signalled ones die before the session is read again
+
+    wait_for(emptied, timeout_s, lambda: f"session {proc.pid} to be empty after SIGKILL (left: "
+             f"{session_members(proc.pid)})")
     if proc.poll() is None:
         proc.wait(timeout_s)
