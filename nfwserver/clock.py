@@ -74,10 +74,18 @@ class VirtualClock:
         self._elapsed = 0.0
         self._lock = threading.Lock()
         self._advanced = threading.Condition(self._lock)
+        self._deadlines: list[float] = []  #: those of the threads in wait() (s of virtual time)
 
     def now(self) -> datetime:
         with self._lock:
             return self._start + timedelta(seconds=self._elapsed)
+
+    @property
+    def waiting(self) -> int:
+        """How many threads are in :meth:`wait` for a moment still ahead of the clock: settled until the clock is
+        advanced again.  A test that advances the clock waits for a loop to get there instead of pausing for it."""
+        with self._lock:
+            return sum(deadline > self._elapsed for deadline in self._deadlines)
 
     def monotonic(self) -> float:
         with self._lock:
@@ -104,6 +112,10 @@ class VirtualClock:
     def wait(self, event: threading.Event, seconds: float) -> bool:
         with self._lock:
             deadline = self._elapsed + max(0.0, seconds)
-            while not event.is_set() and self._elapsed < deadline:
-                self._advanced.wait(self.POLL_S)
+            self._deadlines.append(deadline)
+            try:
+                while not event.is_set() and self._elapsed < deadline:
+                    self._advanced.wait(self.POLL_S)
+            finally:
+                self._deadlines.remove(deadline)
         return event.is_set()

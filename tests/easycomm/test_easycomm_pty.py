@@ -5,7 +5,6 @@ from __future__ import annotations
 import os
 import re
 import select
-import time
 from datetime import timedelta
 from pathlib import Path
 
@@ -62,10 +61,11 @@ def _output(station, path: Path, uplink: str = "range-rate", **kw) -> EasyCommOu
 
 
 def _start(output: EasyCommOutput) -> None:
-    """Start the worker and let it open the port and settle into its wait (it opens at once)."""
+    """Start the worker and let it open the port and settle into its wait on the virtual clock (it opens at
+    once)."""
     output.start()
-    wait_for(lambda: output.connected, 5.0, "the port to open", interval_s=0.001)
-    time.sleep(0.05)
+    wait_for(lambda: output.connected and output.clock.waiting, 5.0, "the port to open and the worker to wait for "
+             "its next line", interval_s=0.001)
 
 
 def _step(station, output: EasyCommOutput) -> None:
@@ -119,11 +119,14 @@ def test_lines_come_at_the_configured_rate_on_the_clock(tmp_path) -> None:
     try:
         assert advance_until(station.clock, lambda: output.lines_written >= 1, step_s=0.1)
         first = output.lines_written
-        for _ in range(100):  # 10 s of virtual time in small steps the worker can follow
-            station.clock.advance(0.1)
+        # 10.05 s of virtual time in steps the worker follows: its lines fall due 0.5, 1.0, ... 10.0 s after the
+        # first (the first came at most one 0.1 s step before this loop; the 0.05 s keeps the line due at 10.0 s
+        # on this side of the sum of a hundred 0.1 s steps, which floating point makes 9.99999...).
+        for step in [0.1] * 100 + [0.05]:
             station.core.tick()  # as the publisher does
-            time.sleep(0.01)
-        assert output.lines_written - first in (19, 20, 21)  # 2 Hz
+            station.clock.advance(step)
+            wait_for(lambda: station.clock.waiting, 5.0, "the worker to wait for its next line", interval_s=0.001)
+        assert output.lines_written - first == 20  # 2 Hz
     finally:
         output.stop()
     assert len([line for line in pty.lines() if line.startswith("AZ")]) == output.lines_written - 1  # + SA SE
@@ -145,7 +148,7 @@ def test_stop_lines_when_tracking_stops_and_at_los(tmp_path) -> None:
         for _ in range(10):  # 5 s across LOS: positions while up, one SA SE at LOS, then silence
             station.core.tick()
             station.clock.advance(0.5)
-            time.sleep(0.01)
+            wait_for(lambda: station.clock.waiting, 5.0, "the worker to wait for its next line", interval_s=0.001)
             station.core.tick()
         assert advance_until(station.clock, lambda: output.last_line == "SA SE", step_s=0.5, limit_s=2.0)
         lines = pty.lines()

@@ -6,7 +6,6 @@ Runs where DDEML exists: under Wine via ``tools/wine/test`` (CI), or on Windows.
 from __future__ import annotations
 
 import sys
-import time
 
 import pytest
 
@@ -77,7 +76,7 @@ def test_pywin32_dde_conversation(live_server) -> None:
         conv = dde.CreateConversation(server)
         conv.ConnectTo("NFW32", "NFW_DATA")
         conv.Poke("NFW_SERVER", "TUNE ON")
-        time.sleep(0.3)
+        wait_for(lambda: live_server.snapshot().state.feed_on, 3.0, "the station to apply TUNE ON", interval_s=0.02)
         assert NOVA.match(conv.Request("NFW_SERVER").rstrip("\x00"))
         conv.Exec("TRACK ON")
         # pywin32's Exec can return before the server's DDE thread has handled the execute under Wine
