@@ -41,6 +41,7 @@ _WORD_END = re.compile(r"[\s&/]+")
 #: Text that the substitutions of :func:`sanitize` would only turn blanks into dashes in: words of allowed
 #: characters other than ``-``, each separated by one blank or one ``-``.
 _PLAIN = re.compile(r"[A-Za-z0-9_.+/]+(?:[ -][A-Za-z0-9_.+/]+)*")
+_DIGITS = frozenset("0123456789")
 
 
 def sanitize(text: str) -> str:
@@ -58,7 +59,7 @@ def sanitize(text: str) -> str:
         text = _DASHES.sub("-", text).strip("-")
     if len(text) > MAX_LENGTH:
         head, sep, tail = text.rpartition("-")
-        if sep and head and any(c.isdigit() for c in tail) and len(tail) <= MAX_LENGTH - 4:
+        if sep and head and not _DIGITS.isdisjoint(tail) and len(tail) <= MAX_LENGTH - 4:  # text is ASCII here
             return head[: MAX_LENGTH - len(tail) - 1].rstrip("-") + "-" + tail
     return text[:MAX_LENGTH].rstrip("-")
 
@@ -126,6 +127,18 @@ def _candidates(element_name: str, catalog_number: int) -> Iterator[str]:
         yield cand
 
 
+def _plain_first(element_name: str) -> str:
+    """The first of :func:`_candidates` for a name without parentheses whose first word is no amateur designator
+    (the name itself, sanitised), else "" (the caller then asks :func:`_candidates`)."""
+    name = element_name.strip()
+    if "(" in name or name.startswith("0 ") or not name:
+        return ""
+    first_word = _WORD_END.split(name, maxsplit=1)[0]
+    if first_word != name and _AMATEUR.match(first_word.upper()):
+        return ""
+    return sanitize(name)
+
+
 def dde_name_for(element_name: str, catalog_number: int) -> str:
     """The preferred DDE name of one satellite, ignoring other satellites."""
     return name_candidates(element_name, catalog_number)[0]
@@ -144,6 +157,11 @@ def assign_dde_names(names: dict[int, str], overrides: dict[int, str] | None = N
             result[catnr] = known
     for catnr in sorted(names):
         if catnr in result:
+            continue
+        cand = _plain_first(names[catnr])  # most names: their first candidate, without the generator
+        if cand and cand.upper() not in taken:
+            taken.add(cand.upper())
+            result[catnr] = cand
             continue
         for cand in _candidates(names[catnr], catnr):
             if cand.upper() not in taken:

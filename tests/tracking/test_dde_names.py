@@ -73,3 +73,39 @@ def test_sanitize_follows_its_rule_for_every_name_of_a_catalog() -> None:
     assert len(names) > 15000
     for name in names:
         assert sanitize(name) == _sanitize_by_the_rule(name)
+
+
+def _assign_by_the_rule(names: dict[int, str]) -> dict[int, str]:
+    """The module docstring's rule spelt out: the well-known names first, then, in ascending catalog number, each
+    satellite's first candidate (``name_candidates``, best first) that no satellite holds yet (case ignored)."""
+    from nfwserver.tracking.dde_names import WELL_KNOWN_NAMES, name_candidates
+
+    taken: set[str] = set()
+    result: dict[int, str] = {}
+    for catnr in sorted(names):
+        known = WELL_KNOWN_NAMES.get(catnr)
+        if known is not None and known.upper() not in taken:
+            taken.add(known.upper())
+            result[catnr] = known
+    for catnr in sorted(names):
+        if catnr not in result:
+            result[catnr] = next(c for c in name_candidates(names[catnr], catnr) if c.upper() not in taken)
+            taken.add(result[catnr].upper())
+    return result
+
+
+def test_a_whole_catalog_is_named_by_the_rule() -> None:
+    """Every name of two catalogs, with names made to collide and the awkward shapes (amateur first words, a
+    leading "0 ", blanks only, parentheses) added: the fast path for plain names gives what the rule gives."""
+    from tests.conftest import DATA
+
+    names: dict[int, str] = {}
+    for file in ("active.txt", "visual.txt"):
+        lines = (DATA / file).read_text().splitlines()
+        names.update((int(lines[k + 1][2:7]), lines[k].strip()) for k in range(0, len(lines) - 2, 3))
+    assert len(names) > 15000
+    awkward = ["0 ISS", "   ", "RS-44 & BREEZE-KM R/B", "AO-7", "ISS", "STARLINK-1008", "starlink-1008", "A*B C",
+               "NOAA 19", "noaa-19", "SO-50 (X)", "ISS (ZARYA)", "STARLIN-1008", "X -- Y", "FO 29 PLUS"]
+    names.update((900000 + k, name) for k, name in enumerate(awkward))
+    names.update((1 + k, name) for k, name in enumerate(awkward))  # the same names, before the catalog's
+    assert assign_dde_names(names) == _assign_by_the_rule(names)
