@@ -67,9 +67,10 @@ class EventLog:
         detail = fields.get("detail")
         if isinstance(detail, str):
             fields["detail"] = truncate_text(detail)
-        # the keyword fields of Event (conversation, client, accepted, detail): Event checks them when called
-        event = Event(next(self._seq), time, direction, kind, truncate_text(text), **fields)  # type: ignore[arg-type]
-        with self._lock:
+        text = truncate_text(text)
+        with self._lock:  # numbered and stored in one step: the ring is always in seq order, without gaps
+            # the keyword fields of Event (conversation, client, accepted, detail): Event checks them when called
+            event = Event(next(self._seq), time, direction, kind, text, **fields)  # type: ignore[arg-type]
             self._events.append(event)
             subscribers = list(self._subscribers)
         for callback in subscribers:
@@ -98,6 +99,20 @@ class EventLog:
         if direction is not None:
             events = [e for e in events if e.direction is direction]
         return events if count is None else events[-count:]
+
+    def since(self, after: int, limit: int) -> tuple[list[Event], int]:
+        """The oldest ``limit`` events whose seq is above ``after``, oldest first, and how many events
+        above ``after`` the ring no longer holds (pushed out by ``capacity`` newer ones).
+
+        A reader that passes the seq of the last event it took each time takes every event once, however
+        slowly it reads, as long as it is less than ``capacity`` events behind.  Costs O(events above
+        ``after``), not O(capacity)."""
+        with self._lock:
+            newer = list(itertools.takewhile(lambda e: e.seq > after, reversed(self._events)))
+        if not newer:
+            return [], 0
+        newer.reverse()
+        return newer[:max(0, limit)], newer[0].seq - after - 1
 
     def __len__(self) -> int:
         return len(self._events)

@@ -217,12 +217,12 @@ class WebHandler(BaseHTTPRequestHandler):
         reason, dropped = "closed by the browser", False
         try:
             self._stream_headers()
-            history = json.dumps(web.history(), default=str).encode()
-            self.wfile.write(b"event: history\ndata: " + history + b"\n\n")
+            cursor, history = web.page_log()  # the frames are shared; the log lines are this page's own
+            self.wfile.write(b"event: history\ndata: " + json.dumps(history, default=str).encode() + b"\n\n")
             seen, frame = web.hub.newest()
             while not web.stopping:
                 if frame is not None:
-                    self.wfile.write(b"event: state\ndata: " + frame + b"\n\n")
+                    self.wfile.write(b"event: state\ndata: " + cursor.attach(frame) + b"\n\n")
                 else:
                     self.wfile.write(b": keep-alive\n\n")
                 seen, frame = web.hub.wait_newer(seen, KEEPALIVE_S)

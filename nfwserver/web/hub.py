@@ -3,7 +3,9 @@
 The frame thread publishes one encoded frame per tick (:meth:`FrameHub.publish`); each browser's
 connection thread waits for a frame newer than the one it sent last (:meth:`FrameHub.wait_newer`).
 There is one slot, not a queue: a browser that reads slowly skips to the newest frame, so nothing is
-ever buffered for it beyond the socket's own buffer, and no browser can hold the others back.
+ever buffered for it beyond the socket's own buffer, and no browser can hold the others back.  What a
+skipped frame must not lose, the log lines, is not in the slot: each connection adds the lines its page
+has not been sent to the frame it sends (:class:`~nfwserver.web.station_parts.LogCursor`).
 """
 
 from __future__ import annotations

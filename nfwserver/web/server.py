@@ -13,7 +13,8 @@ Threads and what they do:
   on a frame that no longer changes;
 - ``nfw-web-http`` accepts connections (Python's :class:`http.server.ThreadingHTTPServer`); each
   connection has a thread of its own, at most ``max_clients`` at once (others are closed at once);
-  an event-stream connection sends the hub's newest frame whenever there is one (Server-Sent Events);
+  an event-stream connection sends the hub's newest frame whenever there is one (Server-Sent Events),
+  with the log lines that page has not been sent (:class:`~nfwserver.web.station_parts.LogCursor`);
 - ``nfw-web-passes``: :class:`~nfwserver.web.pass_board.PassBoard`.
 
 Bounds: every socket has a timeout (``io_timeout_s``): a browser that stops reading blocks only its
@@ -59,6 +60,7 @@ from nfwserver.web.request_head import HEAD_DEADLINE_S, error_response
 from nfwserver.web.state_view import now_tracking
 from nfwserver.web.station_parts import (
     EventFollower,
+    LogCursor,
     clients_part,
     event_json,
     links_part,
@@ -250,7 +252,7 @@ class WebServer:
     def _build_frame_locked(self) -> datetime | None:
         now = self.core.clock.now()
         sample = self._sample or self.core.tracker.last_sample
-        events, skipped = self._follower.new_events()
+        self._follower.catch_up()  # the client list; log lines go to each page by its own cursor
         frame: dict[str, object] = {
             "now": now_tracking(self.core, sample, now),
             "next_event": self.board.next_event(sample.time if sample is not None else now),
@@ -258,7 +260,6 @@ class WebServer:
             "radio": radio_part(self.parts.radio, self.core.state.doppler_on),
             "links": links_part(self.core.health),
             "clients": clients_part(self._follower, self._counts),
-            "log": [event_json(e) for e in events], "log_skipped": skipped,
             "passes_version": self.board.version,
             "control": self.control.enabled,
         }
@@ -283,11 +284,17 @@ class WebServer:
         if self.stats.streams == 0:  # no frame thread at work: this request's own, from the live state
             self._safe_frame()
         frame = dict(self._latest)
-        frame["log"] = self.history()
+        frame["log"], frame["log_skipped"] = self.history(), 0
         return json.dumps(frame, allow_nan=False, default=str).encode()
 
     def history(self) -> list[dict[str, object]]:
         return [event_json(e) for e in self.core.events.recent(HISTORY_EVENTS)]
+
+    def page_log(self) -> tuple[LogCursor, list[dict[str, object]]]:
+        """A new page's place in the log, just past its history (the last :data:`HISTORY_EVENTS` lines):
+        its stream sends the history, then each frame with the lines that page has not been sent."""
+        cursor = LogCursor(self.core.events)
+        return cursor, cursor.history(HISTORY_EVENTS)
 
     # -- connections (nfw-web-http and connection threads) ---------------------------------------
     def configure(self, config: WebConfig) -> None:

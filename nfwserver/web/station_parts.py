@@ -4,13 +4,16 @@ Rotor and radio values are what their worker threads last recorded (plain attrib
 console and ``STATUS`` do); no device is ever asked from here.  Rotor angles are given twice: in the
 rotor's own frame (``*_rotor``: KCT, elevation above 90 when flipped) and in the sky (``az``/``el``, for
 the polar plot).  Clients and the log come from the station's event stream
-(:class:`~nfwserver.core.events.EventLog`): :class:`EventFollower` reads the events added since the last
-frame and keeps the last state of each connected client (bounded; a client that disconnects leaves the
-list, its lines stay in the log), so a page sees every string once.
+(:class:`~nfwserver.core.events.EventLog`): :class:`EventFollower` (the frame thread's) keeps the last
+state of each connected client (bounded; a client that disconnects leaves the list, its lines stay in the
+log); each page's own :class:`LogCursor` (its event stream's thread's) remembers the last log line that
+page was sent, and puts every newer line into the next frame the page is sent, so a page sees every
+string once, however many frames it skips.
 """
 
 from __future__ import annotations
 
+import json
 import logging
 import math
 from collections import OrderedDict
@@ -25,7 +28,7 @@ from nfwserver.web.state_view import iso
 
 log = logging.getLogger(__name__)
 
-#: Events sent in one frame at most (the rest are summarised as skipped); clients remembered at most.
+#: Log lines sent to a page in one frame at most (the rest go with its next frames); clients remembered at most.
 MAX_LOG_PER_FRAME = 100
 MAX_CLIENTS = 64
 
@@ -95,23 +98,20 @@ def event_json(event: Event) -> dict[str, object]:
 
 
 class EventFollower:
-    """Reads the event stream forward; owned by the frame thread."""
+    """Reads the event stream forward for the client list; owned by the frame thread."""
 
     def __init__(self, events: EventLog) -> None:
         self.events = events
         self.last_seq = 0
         self.clients: OrderedDict[str, ClientRecord] = OrderedDict()
 
-    def new_events(self) -> tuple[list[Event], int]:
-        """Events added since the last call (at most :data:`MAX_LOG_PER_FRAME`) and how many were skipped."""
-        fresh = [e for e in self.events.recent(MAX_LOG_PER_FRAME * 4) if e.seq > self.last_seq]
-        if not fresh:
-            return [], 0
-        skipped = max(0, fresh[-1].seq - self.last_seq - MAX_LOG_PER_FRAME)
-        self.last_seq = fresh[-1].seq
+    def catch_up(self) -> None:
+        """Note the clients of every event added since the last call (that the ring still holds)."""
+        fresh, _ = self.events.since(self.last_seq, len(self.events))
         for event in fresh:
             self._note_client(event)
-        return fresh[-MAX_LOG_PER_FRAME:], skipped
+        if fresh:
+            self.last_seq = fresh[-1].seq
 
     def _note_client(self, event: Event) -> None:
         if not event.client or event.kind == "note" and event.client in ("config", "health", "startup"):
@@ -142,3 +142,41 @@ def clients_part(follower: EventFollower, counts: Callable[[], dict[str, object]
         log.debug("web: client counts failed", exc_info=True)
         numbers = {}
     return {"counts": numbers, "list": follower.client_list()}
+
+
+class LogCursor:
+    """One page's place in the log: the seq of the last line it was sent; owned by its stream's thread.
+
+    Frames are shared by every page and a page that reads slowly skips to the newest, so the frames
+    themselves carry no log lines: :meth:`attach` adds to each frame a page is sent the lines that page
+    has not been sent yet (read from the station's own bounded ring, nothing stored per page but one
+    number).  Lines are sent oldest first, at most :data:`MAX_LOG_PER_FRAME` to a frame; a page more
+    lines behind gets the rest with its next frames, and only lines the ring no longer holds (more than
+    its capacity behind) are lost, counted in ``log_skipped``.
+    """
+
+    def __init__(self, events: EventLog) -> None:
+        self.events = events
+        self.last_seq = 0
+
+    def history(self, count: int) -> list[dict[str, object]]:
+        """The newest ``count`` lines, oldest first (the page's start); the cursor moves past them."""
+        lines = self.events.recent(count)
+        if lines:
+            self.last_seq = lines[-1].seq
+        return [event_json(e) for e in lines]
+
+    def attach(self, frame: bytes) -> bytes:
+        """``frame`` (a JSON object) with ``log``: the lines this page has not been sent (at most
+        :data:`MAX_LOG_PER_FRAME`), and ``log_skipped``: those no longer in the ring; the cursor moves
+        past them."""
+        body = frame.strip()
+        if not (body.startswith(b"{") and body.endswith(b"}")):
+            raise ValueError("a frame must be a JSON object")
+        lines, skipped = self.events.since(self.last_seq, MAX_LOG_PER_FRAME)
+        if lines:
+            self.last_seq = lines[-1].seq
+        tail = json.dumps({"log": [event_json(e) for e in lines], "log_skipped": skipped},
+                          allow_nan=False, default=str).encode()
+        inner = body[1:-1].strip()
+        return b"{" + inner + b", " + tail[1:] if inner else tail

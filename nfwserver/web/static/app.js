@@ -118,7 +118,7 @@ function applyFilter(li) {
   li.hidden = (dir && li.dataset.dir !== dir) || (q && !li.textContent.toLowerCase().includes(q))
     || (li.dataset.kind === "publish" && !$("logpublish").checked);  // one a tick: shown on request
 }
-let lastSeq = 0;  // the newest event shown: a frame's log repeats what the history already gave
+let lastSeq = 0;  // the newest event shown: a line is never shown twice, whatever the stream repeats
 function addLog(events) {
   const list = $("logrows");
   const atBottom = list.scrollTop + list.clientHeight >= list.scrollHeight - 4;
@@ -196,7 +196,6 @@ function onFrame(f) {
   renderDevices(f);
   Polar.update(f);
   WorldMap.update(f);
-  addLog(f.log);
   setControl(f.control);
   if (f.passes_version !== passesVersion) { passesVersion = f.passes_version; loadPasses(); }
   document.body.dataset.frames = String(Number(document.body.dataset.frames || 0) + 1);
@@ -208,6 +207,7 @@ function connect() {
   source.addEventListener("history", e => { $("logrows").textContent = ""; lastSeq = 0; addLog(JSON.parse(e.data)); });
   source.addEventListener("state", e => {
     const f = JSON.parse(e.data);
+    addLog(f.log || []);  // the lines this page was not sent yet, in every frame (a frame error's too)
     if (f.frame_error) {  // the station could not build a frame: say so, never "live" on an old one
       link.textContent = "not updating"; link.className = "badge bad"; link.title = f.frame_error;
       return;
