@@ -20,12 +20,15 @@ from __future__ import annotations
 
 import contextlib
 import json
+import logging
 import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 from nfwserver.storage import atomic_write_text
+
+log = logging.getLogger(__name__)
 
 LOCK_NAME = "station.lock"
 INFO_NAME = "station.json"
@@ -91,6 +94,7 @@ class StationChannel:
         self.lock_path = self.directory / LOCK_NAME
         self.info_path = self.directory / INFO_NAME
         self._lock = _Lock(self.lock_path)
+        self._describe_failed = False
 
     @property
     def default_control(self) -> Path:
@@ -113,14 +117,24 @@ class StationChannel:
         """Write ``station.json`` (atomically); only while this process holds the lock.  On Windows the
         replace fails while a reader has the old file open: it is tried again for up to a second."""
         record = {"pid": info.pid, "control": str(info.control), "web": info.web_url, "started": info.started}
+        problem: OSError | None = None
         for _ in range(20):
             try:
                 atomic_write_text(self.info_path, json.dumps(record) + "\n")
+                if self._describe_failed:
+                    log.info("the station's description %s is written again", self.info_path)
+                self._describe_failed = False
                 return
-            except PermissionError:
+            except PermissionError as exc:
+                problem = exc
                 time.sleep(0.05)
-            except OSError:
-                return
+            except OSError as exc:
+                problem = exc
+                break
+        if not self._describe_failed:  # once per episode: the station runs on without it
+            log.warning("cannot write the station's description %s (%s): `nfwserver stop` and `nfwserver "
+                        "dashboard` will not find this station until it can", self.info_path, problem)
+        self._describe_failed = True
 
     def release(self) -> None:
         """Remove the description, then free the lock (the order a waiting ``stop`` relies on)."""

@@ -219,3 +219,27 @@ def test_dashboard_waits_for_a_station_that_is_still_starting_and_says_so(tmp_pa
     finally:
         stuck.kill()
         stuck.wait(10)
+
+
+def test_a_description_that_cannot_be_written_is_said_once_and_again_when_it_can(tmp_path, caplog) -> None:
+    """The station runs on without its description (a `stop` then cannot find it): one warning for the episode,
+    one line when it is written again; nothing is swallowed silently."""
+    import logging
+
+    from nfwserver.cli.station_channel import StationInfo
+
+    channel = StationChannel(tmp_path)
+    assert channel.claim()
+    try:
+        channel.info_path.mkdir()  # a directory where the file should be: every replace fails
+        caplog.set_level(logging.INFO, logger="nfwserver.cli.station_channel")
+        for _ in range(3):
+            channel.describe(StationInfo(os.getpid(), tmp_path / "control"))
+        warnings = [r for r in caplog.records if r.levelno == logging.WARNING]
+        assert len(warnings) == 1 and "cannot write the station's description" in warnings[0].getMessage()
+        channel.info_path.rmdir()
+        channel.describe(StationInfo(os.getpid(), tmp_path / "control"))
+        assert json.loads(channel.info_path.read_text())["pid"] == os.getpid()
+        assert "is written again" in caplog.text
+    finally:
+        channel.release()
