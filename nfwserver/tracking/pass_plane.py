@@ -24,11 +24,12 @@ Times are seconds after the search's reference instant; angles radians.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from nfwserver.tracking.constants import SECONDS_PER_DAY
+from nfwserver.tracking.constants import SECONDS_PER_DAY, WGS72_MU_KM3_S2
 from nfwserver.tracking.timescale import gmst1982
 
 if TYPE_CHECKING:
@@ -44,14 +45,27 @@ MAX_ECCENTRICITY = 0.01
 EARTH_RATE = 7.3e-5
 #: Relative allowance on the apogee radius (short-period terms) and an absolute one (km).
 _RADIUS_SLACK, _RADIUS_SLACK_KM = 1.01, 20.0
+#: Largest relative spread of the osculating semi-major axes at the samples of an orbit judged here.
+_STEADY = 0.01
 
 
-def plane_possible(satrecs: list[Any], origin: np.ndarray, e_lo: float, jd0: float, fr0: float,
-                   grid: np.ndarray, ut1_utc: float) -> np.ndarray | None:
-    """Which coarse intervals ``[grid[k], grid[k + 1]]`` (s after the UTC Julian date ``jd0 + fr0``) of each of
-    ``satrecs`` (``sgp4`` Satrec) may hold a moment when the satellite is above elevation ``e_lo`` (rad) for an
-    observer at Earth-fixed ``origin`` (km): a (satellites, intervals) mask, True where the plane proves
-    nothing.  None when no satellite can be judged (nothing would be saved)."""
+@dataclass
+class PlaneGeometry:
+    """The observer's angle from the orbits' planes at the middle of each coarse interval, and the angle beyond which
+    an interval is proven invisible."""
+
+    rows: np.ndarray  #: the judged satellites (indices into the list given)
+    #: (judged, intervals): |sin| of the observer's angle from the interpolated plane (not renormalised, so no
+    #: larger than it is; 0 for a satellite whose samples could not be trusted)
+    sin_beta: np.ndarray
+    limit: np.ndarray  #: (judged,): reach + the motion within half an interval + the slack (rad; >= pi/2: none)
+
+
+def plane_geometry(satrecs: list[Any], origin: np.ndarray, e_lo: float, jd0: float, fr0: float, grid: np.ndarray,
+                   ut1_utc: float) -> PlaneGeometry | None:
+    """:class:`PlaneGeometry` of the judged ``satrecs`` over the coarse ``grid`` (s after the UTC Julian date
+    ``jd0 + fr0``) for an observer at Earth-fixed ``origin`` (km) and the elevation ``e_lo`` (rad); None when none
+    can be judged."""
     if not satrecs or not hasattr(satrecs[0], "_sgp4") or len(grid) < 2:
         return None  # sgp4's pure-Python model (no SatrecArray): the screen judges every interval
     judged = np.array([getattr(sr, "method", "d") == "n" and sr.ecco < MAX_ECCENTRICITY for sr in satrecs])
@@ -64,18 +78,21 @@ def plane_possible(satrecs: list[Any], origin: np.ndarray, e_lo: float, jd0: flo
     n_samples = max(2, math.ceil(grid[-1] / PLANE_STEP_S) + 1)
     sample_t = np.arange(n_samples) * PLANE_STEP_S
     err, r, v = SatrecArray(part).sgp4(np.full(n_samples, jd0), fr0 + sample_t / SECONDS_PER_DAY)
+    apogee_km, steady = _apogees(part, r, v)
     normal = np.cross(r, v)  # (satellites, samples, 3), TEME
     del r, v
     with np.errstate(invalid="ignore", divide="ignore"):
         normal /= np.sqrt(np.sum(normal * normal, axis=-1, keepdims=True))
-    sound = (err == 0).all(axis=1) & np.isfinite(normal).all(axis=(1, 2))
+    sound = (err == 0).all(axis=1) & np.isfinite(normal).all(axis=(1, 2)) & steady
     normal[~sound] = 0.0
-    # The plane's turning rate (rad/s): the largest angle between consecutive samples over the step.
+    # The plane's turning rate (rad/s): between two samples an angle alpha apart, the renormalised interpolated
+    # normal turns at most 2 tan(alpha / 2) / step.
     cosines = np.clip(np.sum(normal[:, 1:] * normal[:, :-1], axis=-1), -1.0, 1.0)
-    turn_rate = np.max(np.arccos(cosines), axis=1) / PLANE_STEP_S
+    turn_rate = np.max(2.0 * np.tan(0.5 * np.arccos(cosines)), axis=1) / PLANE_STEP_S
     # sin(beta) at each interval's middle: the normal interpolated linearly between the samples (not
-    # renormalised: shorter than a unit vector, so |sin(beta)| comes out no larger than it is), turned into the
-    # Earth-fixed frame and dotted with the observer's direction; one matrix product for all of it.
+    # renormalised: shorter than a unit vector, so |sin(beta)| comes out no larger than it is for the
+    # interpolated plane, which the slack relates to the osculating one), turned into the Earth-fixed frame and
+    # dotted with the observer's direction; one matrix product for all of it.
     mid = 0.5 * (grid[:-1] + grid[1:])
     k = np.minimum((mid // PLANE_STEP_S).astype(np.intp), n_samples - 2)
     w = (mid - sample_t[k]) / PLANE_STEP_S
@@ -89,17 +106,48 @@ def plane_possible(satrecs: list[Any], origin: np.ndarray, e_lo: float, jd0: flo
     ox, oy, oz = (origin / r_obs).tolist()
     # Earth-fixed (c nx + s ny, c ny - s nx, nz) . (ox, oy, oz) = nx (c ox - s oy) + ny (s ox + c oy) + nz oz.
     factors = np.concatenate((weights * (c * ox - s * oy), weights * (s * ox + c * oy), weights * oz))
-    sin_beta = normal.transpose(0, 2, 1).reshape(len(part), 3 * n_samples) @ factors
+    sin_beta = np.abs(normal.transpose(0, 2, 1).reshape(len(part), 3 * n_samples) @ factors)
     # The largest central angle at which the satellite can be above e_lo: at its highest (apogee, with room),
     # widened by what the observer and the plane can move in half an interval and by the slack.
-    apogee_km = np.array([(sr.alta + 1.0) * sr.radiusearthkm for sr in part]) * _RADIUS_SLACK + _RADIUS_SLACK_KM
     reach = np.arccos(np.clip(r_obs * math.cos(e_lo) / apogee_km, -1.0, 1.0)) - e_lo
     half = 0.5 * float(np.max(np.diff(grid)))
     limit = reach + half * (EARTH_RATE * math.hypot(ox, oy) + turn_rate) + PLANE_SLACK_RAD
-    sin_limit = np.where(sound & (limit < 0.5 * math.pi), np.sin(np.minimum(limit, 0.5 * math.pi)), 2.0)
-    proven = np.abs(sin_beta) > sin_limit[:, None]
-    possible = np.ones((len(satrecs), len(mid)), dtype=bool)
-    possible[rows] = ~proven
+    return PlaneGeometry(rows, sin_beta, np.where(sound, limit, np.inf))
+
+
+def _apogees(part: list[Any], r: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The radius (km) no satellite of ``part`` exceeds, with room: the larger of its mean apogee at the epoch and
+    the osculating apogees at the samples (TEME ``r`` km, ``v`` km/s, (satellites, samples, 3)); and whether its
+    orbit held steady over the samples (osculating semi-major axes within :data:`_STEADY` of each other and
+    eccentricities under 0.1).  A set long past its epoch or decayed can give SGP4 orbits that wander; those are
+    left to the screen."""
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        radius = np.sqrt(np.sum(r * r, axis=-1))
+        speed2 = np.sum(v * v, axis=-1)
+        axis = 1.0 / (2.0 / radius - speed2 / WGS72_MU_KM3_S2)  # vis-viva: negative or inf when unbound
+        ecc_vec = ((speed2 - WGS72_MU_KM3_S2 / radius)[..., None] * r
+                   - np.sum(r * v, axis=-1)[..., None] * v) / WGS72_MU_KM3_S2
+        ecc = np.sqrt(np.sum(ecc_vec * ecc_vec, axis=-1))
+        sampled = np.max(axis * (1.0 + ecc), axis=1)
+        steady = ((np.min(axis, axis=1) > 0.0) & (np.max(axis, axis=1) <= np.min(axis, axis=1) * (1.0 + _STEADY))
+                  & (np.max(ecc, axis=1) < 0.1) & np.isfinite(sampled))
+    mean = np.array([(sr.alta + 1.0) * sr.radiusearthkm for sr in part])
+    return np.fmax(mean, sampled) * _RADIUS_SLACK + _RADIUS_SLACK_KM, steady
+
+
+def plane_possible(satrecs: list[Any], origin: np.ndarray, e_lo: float, jd0: float, fr0: float,
+                   grid: np.ndarray, ut1_utc: float) -> np.ndarray | None:
+    """Which coarse intervals ``[grid[k], grid[k + 1]]`` (s after the UTC Julian date ``jd0 + fr0``) of each of
+    ``satrecs`` (``sgp4`` Satrec) may hold a moment when the satellite is above elevation ``e_lo`` (rad) for an
+    observer at Earth-fixed ``origin`` (km): a (satellites, intervals) mask, True where the plane proves
+    nothing.  None when no satellite can be judged (nothing would be saved)."""
+    geometry = plane_geometry(satrecs, origin, e_lo, jd0, fr0, grid, ut1_utc)
+    if geometry is None:
+        return None
+    limit = geometry.limit
+    sin_limit = np.where(limit < 0.5 * math.pi, np.sin(np.minimum(limit, 0.5 * math.pi)), 2.0)
+    possible = np.ones((len(satrecs), len(grid) - 1), dtype=bool)
+    possible[geometry.rows] = ~(geometry.sin_beta > sin_limit[:, None])
     return possible
 
 

@@ -26,31 +26,86 @@ SETS = load_element_file(DATA / "active.txt").sets
 JUDGED = [s for s in SETS if s.transient_satrec().method == "n" and s.eccentricity < pass_plane.MAX_ECCENTRICITY]
 
 
-def test_every_moment_a_satellite_is_up_lies_in_an_interval_the_plane_left_possible() -> None:
-    """Skyfield's elevation (its own SGP4 and frames, UT1 from its tables) every 30 s over 26 h for 120 orbits:
-    wherever a satellite is above -0.5 deg, its coarse interval is possible; and the plane proves most of the
-    other intervals invisible (so the test would notice a proof that proves nothing)."""
+@pytest.mark.parametrize(("latitude", "longitude", "horizon_deg"),
+                         [(52.2, 0.12, 0.0), (0.0, -70.0, 0.0), (85.0, 30.0, 0.0), (-45.0, 170.0, 10.0)])
+def test_every_moment_a_satellite_is_up_lies_in_an_interval_the_plane_left_possible(
+        latitude: float, longitude: float, horizon_deg: float) -> None:
+    """Skyfield's elevation (its own SGP4 and frames, UT1 from its tables) every 30 s over 26 h for 120 orbits, from
+    the equator, near the pole, the northern and southern mid-latitudes: wherever a satellite is above the
+    elevation the proof is about (a degree under the horizon's lowest point, with 0.05 deg for UT1), its coarse
+    interval is possible; and the plane proves much of the rest invisible (a proof that proves nothing fails)."""
+    observer = Observer(latitude, longitude, 20.0)
+    e_lo_deg = horizon_deg - 1.0
     sample = JUDGED[::40][:120]
     models = [s.transient_satrec() for s in sample]
     jd0, fr0 = julian_date(START)
     grid = np.arange(0.0, 26 * 3600.0 + 1.0, 1200.0)
-    possible = pass_plane.plane_possible(models, TopocentricFrame(OBSERVER).origin, math.radians(-1.0), jd0, fr0,
-                                         grid, 0.0)
+    possible = pass_plane.plane_possible(models, TopocentricFrame(observer).origin, math.radians(e_lo_deg), jd0,
+                                         fr0, grid, 0.0)
     assert possible is not None and possible.shape == (len(sample), len(grid) - 1)
     seconds = np.arange(0.0, grid[-1], 30.0)
     times = TS.utc(START.year, START.month, START.day, 0, 0, seconds)
-    topos = skyfield_topos(OBSERVER)
+    topos = skyfield_topos(observer)
     up_samples = 0
     up_and_proven = []
     for row, es in enumerate(sample):
         el = (skyfield_satellite(es) - topos).at(times).altaz()[0].degrees
-        up = el > -0.5
+        up = el > e_lo_deg + 0.05
         up_samples += int(up.sum())
         interval = (seconds[up] // 1200.0).astype(int)
         up_and_proven += [(es.catalog_number, float(t)) for t in seconds[up][~possible[row, interval]]]
-    assert up_samples > 500  # the sample holds passes to judge
+    assert up_samples > 300  # the sample holds passes to judge
     assert up_and_proven == []
-    assert possible.mean() < 0.65  # measured 0.51 for the whole catalog's near-Earth orbits
+    assert possible.mean() < 0.8  # 0.51 for the whole catalog's near-Earth orbits from 52.2 N
+
+
+def test_the_angle_from_the_plane_is_the_one_sgp4_gives_at_each_interval() -> None:
+    """At each coarse interval's middle, the observer's angle from the plane that ``plane_geometry`` interpolates
+    is within a fifth of the slack of the angle from the osculating plane computed directly: SGP4's r x v there,
+    turned into the Earth-fixed frame by Skyfield's sidereal time, against Skyfield's geocentric direction of the
+    observer."""
+    models = [s.transient_satrec() for s in JUDGED[::50][:200]]
+    jd0, fr0 = julian_date(START)
+    grid = np.arange(0.0, 50 * 3600.0 + 1.0, 1200.0)
+    geometry = pass_plane.plane_geometry(models, TopocentricFrame(OBSERVER).origin, math.radians(-1.0), jd0, fr0,
+                                         grid, 0.0)
+    assert geometry is not None and len(geometry.rows) == len(models) and np.isfinite(geometry.limit).all()
+    mid = 0.5 * (grid[:-1] + grid[1:])
+    err, r, v = SatrecArray(models).sgp4(np.full(len(mid), jd0), fr0 + mid / 86400.0)
+    assert not err.any()
+    normal = np.cross(r, v)
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    gmst = np.asarray(TS.utc(START.year, START.month, START.day, 0, 0, mid).gmst) * (np.pi / 12.0)
+    c, s = np.cos(gmst), np.sin(gmst)
+    fixed = np.stack([c * normal[..., 0] + s * normal[..., 1], -s * normal[..., 0] + c * normal[..., 1],
+                      normal[..., 2]], axis=-1)
+    site = skyfield_topos(OBSERVER).itrs_xyz.km
+    direct = np.arcsin(np.abs(fixed @ (site / np.linalg.norm(site))))
+    interpolated = np.arcsin(geometry.sin_beta)
+    # Never larger than the truth by more than a fifth of the slack (that side would hide a pass); smaller by a
+    # little more only far from the plane, where the shortened interpolated normal moves arcsin's steep end
+    # (0.15 deg at 70-90 deg from the plane, where the proof has tens of degrees to spare).
+    assert np.max(interpolated - direct) < pass_plane.PLANE_SLACK_RAD / 5.0
+    near = direct < 1.0
+    assert near.mean() > 0.5 and np.max(np.abs(interpolated - direct)[near]) < pass_plane.PLANE_SLACK_RAD / 5.0
+    assert np.ptp(direct) > 1.0  # the observer sweeps across the planes (radians)
+
+
+def test_sets_whose_orbits_wander_are_left_to_the_screen() -> None:
+    """Sets searched weeks after their epoch, among them those with a negative drag term (SGP4 raises their orbits)
+    and decayed ones that SGP4 still propagates to absurd radii: the passes are the same with the plane's proof as
+    without it (the proof once dropped 10-19 passes of sets such as 63876 and 62693 here)."""
+    by_number = {s.catalog_number: s for s in SETS}
+    picked = [by_number[63876], by_number[62693]] + [s for s in SETS if s.transient_satrec().bstar < 0.0][::3]
+    for days in (14, 28):
+        start = START + timedelta(days=days)
+        with pytest.MonkeyPatch.context() as patch:
+            with_plane = find_passes(picked, OBSERVER, start, start + timedelta(hours=24)).columns
+            patch.setattr(pass_screen, "_PLANE_WORTH", -1.0)
+            without = find_passes(picked, OBSERVER, start, start + timedelta(hours=24)).columns
+        assert len(without["tca_s"]) > 1000
+        for name, column in without.items():
+            np.testing.assert_array_equal(with_plane[name], column, err_msg=f"{name}, {days} days on")
 
 
 def test_the_slack_covers_the_osculating_plane_with_room_to_spare() -> None:
