@@ -35,6 +35,7 @@ import math
 import os
 import sys
 import threading
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
@@ -76,6 +77,8 @@ _BATCH_BRACKETS = 10000
 AUTO_WORKERS_FROM = 1000
 #: Most worker processes :func:`auto_workers` chooses.
 AUTO_WORKERS_MAX = 8
+#: Readings of the running processes :func:`busy_cores` takes, and the pause between them (s).
+_BUSY_READINGS, _BUSY_GAP_S = 3, 0.003
 
 
 def auto_workers(satellites: int) -> int:
@@ -90,25 +93,35 @@ def auto_workers(satellites: int) -> int:
     return max(1, min(cores - busy_cores(), AUTO_WORKERS_MAX))
 
 
-def busy_cores(loadavg: str | None = None) -> int:
-    """Cores other processes keep busy now: the 1-minute load average, but on Linux no more than the processes
-    running at this instant besides this one (``/proc/loadavg``'s fourth field, or ``loadavg``, that file's
-    text).  The average alone lags by a minute: a command run right after another heavy one (a script running
-    several searches in a row) would see its predecessor's load and give up cores that are idle now."""
+def busy_cores(readings: Sequence[str] | None = None) -> int:
+    """Cores other processes keep busy now.  On Linux, the most processes found running besides this one in three
+    readings of ``/proc/loadavg``'s fourth field a few milliseconds apart (``readings``: those texts); elsewhere,
+    or when it cannot be read, the 1-minute load average.  The average lags by a minute: a command run right
+    after another heavy one (a script running several searches in a row) would see its predecessor's load and
+    give up cores that are idle now, and one run just after a heavy job started would take cores that are not;
+    three readings keep a process that is runnable most of the time from being missed."""
     if sys.platform == "win32":  # no load average (and no fork: auto_workers chooses 1 there)
         return 0
-    average = int(os.getloadavg()[0])
-    if loadavg is None:
+    if readings is None:
+        readings = []
+        for k in range(_BUSY_READINGS):
+            try:
+                with open("/proc/loadavg", encoding="ascii") as f:
+                    readings.append(f.read())
+            except OSError:
+                break
+            if k + 1 < _BUSY_READINGS:
+                time.sleep(_BUSY_GAP_S)
+    running = []
+    for text in readings:
         try:
-            with open("/proc/loadavg", encoding="ascii") as f:
-                loadavg = f.read()
-        except OSError:
-            return average
-    try:
-        running = int(loadavg.split()[3].split("/")[0])
-    except (IndexError, ValueError):
-        return average
-    return max(0, min(average, running - 1))
+            running.append(int(text.split()[3].split("/")[0]) - 1)
+        except (IndexError, ValueError):
+            break
+    else:
+        if running:
+            return max(0, max(running))
+    return int(os.getloadavg()[0])
 
 
 def _fork_worker(satellites: list[Any], args: tuple[Any, ...], results: Connection) -> None:
