@@ -74,7 +74,8 @@ class VirtualClock:
         self._elapsed = 0.0
         self._lock = threading.Lock()
         self._advanced = threading.Condition(self._lock)
-        self._deadlines: list[float] = []  #: those of the threads in wait() (s of virtual time)
+        #: (thread ident, deadline in s of virtual time) of each thread in wait()
+        self._deadlines: list[tuple[int, float]] = []
 
     def now(self) -> datetime:
         with self._lock:
@@ -83,9 +84,16 @@ class VirtualClock:
     @property
     def waiting(self) -> int:
         """How many threads are in :meth:`wait` for a moment still ahead of the clock: settled until the clock is
-        advanced again.  A test that advances the clock waits for a loop to get there instead of pausing for it."""
+        advanced again.  A test that advances the clock waits for a loop to get there instead of pausing for it
+        (:meth:`is_waiting` names the loop's thread)."""
         with self._lock:
-            return sum(deadline > self._elapsed for deadline in self._deadlines)
+            return sum(deadline > self._elapsed for _, deadline in self._deadlines)
+
+    def is_waiting(self, thread: threading.Thread | None) -> bool:
+        """Whether ``thread`` is in :meth:`wait` for a moment still ahead of the clock."""
+        ident = None if thread is None else thread.ident
+        with self._lock:
+            return any(who == ident and deadline > self._elapsed for who, deadline in self._deadlines)
 
     def monotonic(self) -> float:
         with self._lock:
@@ -112,10 +120,11 @@ class VirtualClock:
     def wait(self, event: threading.Event, seconds: float) -> bool:
         with self._lock:
             deadline = self._elapsed + max(0.0, seconds)
-            self._deadlines.append(deadline)
+            entry = (threading.get_ident(), deadline)
+            self._deadlines.append(entry)
             try:
                 while not event.is_set() and self._elapsed < deadline:
                     self._advanced.wait(self.POLL_S)
             finally:
-                self._deadlines.remove(deadline)
+                self._deadlines.remove(entry)
         return event.is_set()

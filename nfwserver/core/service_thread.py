@@ -28,6 +28,11 @@ class ServiceThread:
         """Started and not stopped since."""
         return self._thread is not None
 
+    @property
+    def thread(self) -> threading.Thread | None:
+        """The service's thread while it runs (None before :meth:`start` and after :meth:`stop`)."""
+        return self._thread
+
     def start(self) -> None:
         if self._thread is None:
             self._stop.clear()

@@ -24,8 +24,9 @@ def test_waiting_counts_the_threads_waiting_for_a_moment_still_ahead() -> None:
     worker.start()
     try:
         wait_for(lambda: clock.waiting == 1, 5.0, "the loop to wait")
+        assert clock.is_waiting(worker) and not clock.is_waiting(threading.current_thread())
         clock.advance(4.0)  # not yet: still waiting for the same moment
-        assert clock.waiting == 1 and woke == []
+        assert clock.waiting == 1 and woke == [] and clock.is_waiting(worker)
         clock.advance(1.0)  # its moment: it wakes, then waits for the next one
         wait_for(lambda: woke == [5.0] and clock.waiting == 1, 5.0, "the loop to wake once and wait again")
         clock.advance(12.0)  # past two deadlines at once: one wake, as a late wake-up
@@ -33,4 +34,4 @@ def test_waiting_counts_the_threads_waiting_for_a_moment_still_ahead() -> None:
     finally:
         stop.set()
         worker.join(5.0)
-    assert not worker.is_alive() and clock.waiting == 0
+    assert not worker.is_alive() and clock.waiting == 0 and not clock.is_waiting(worker)

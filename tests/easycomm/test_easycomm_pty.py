@@ -64,8 +64,8 @@ def _start(output: EasyCommOutput) -> None:
     """Start the worker and let it open the port and settle into its wait on the virtual clock (it opens at
     once)."""
     output.start()
-    wait_for(lambda: output.connected and output.clock.waiting, 5.0, "the port to open and the worker to wait for "
-             "its next line", interval_s=0.001)
+    wait_for(lambda: output.connected and output.clock.is_waiting(output.thread), 5.0, "the port to open and the "
+             "worker to wait for its next line", interval_s=0.001)
 
 
 def _step(station, output: EasyCommOutput) -> None:
@@ -125,7 +125,8 @@ def test_lines_come_at_the_configured_rate_on_the_clock(tmp_path) -> None:
         for step in [0.1] * 100 + [0.05]:
             station.core.tick()  # as the publisher does
             station.clock.advance(step)
-            wait_for(lambda: station.clock.waiting, 5.0, "the worker to wait for its next line", interval_s=0.001)
+            wait_for(lambda: station.clock.is_waiting(output.thread), 5.0, "the worker to wait for its next line",
+                     interval_s=0.001)
         assert output.lines_written - first == 20  # 2 Hz
     finally:
         output.stop()
@@ -148,7 +149,8 @@ def test_stop_lines_when_tracking_stops_and_at_los(tmp_path) -> None:
         for _ in range(10):  # 5 s across LOS: positions while up, one SA SE at LOS, then silence
             station.core.tick()
             station.clock.advance(0.5)
-            wait_for(lambda: station.clock.waiting, 5.0, "the worker to wait for its next line", interval_s=0.001)
+            wait_for(lambda: station.clock.is_waiting(output.thread), 5.0, "the worker to wait for its next line",
+                     interval_s=0.001)
             station.core.tick()
         assert advance_until(station.clock, lambda: output.last_line == "SA SE", step_s=0.5, limit_s=2.0)
         lines = pty.lines()
