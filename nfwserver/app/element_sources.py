@@ -13,12 +13,10 @@ almost always the wrong file or an error page.
 from __future__ import annotations
 
 import contextlib
-import socket
 import threading
 from collections.abc import Callable, Mapping
 from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
-from importlib import resources
 
 from nfwserver.config.files import FileRefused, FileTooLarge, read_regular_bytes
 from nfwserver.tracking.elements import ElementSet, LoadResult, Rejection, load_elements
@@ -68,12 +66,15 @@ def is_url(source: str) -> bool:
 
 def bundled_elements() -> FetchResult:
     """The element sets shipped with nfwserver (popular amateur and weather satellites)."""
+    from importlib import resources  # here: it brings zipfile, which a command reading a file never needs
+
     text = resources.files("nfwserver.data").joinpath(BUNDLED).read_bytes()
     loaded = load_elements(text, source=BUNDLED_SOURCE)
     return FetchResult(loaded.sets, loaded.rejected, bundled=len(loaded.sets))
 
 
 def _network_reason(exc: BaseException, timeout_s: float) -> str:
+    import socket
     import urllib.error
 
     from nfwserver.app.http_fetch import RedirectRefused
