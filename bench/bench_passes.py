@@ -117,9 +117,9 @@ def _startup() -> list[tuple[str, float]]:
     return rows
 
 
-def _one_satellite(folder: Path) -> tuple[dict[str, tuple[float, float, int]], int]:
+def _one_satellite(folder: Path) -> dict[str, tuple[float, float, int]]:
     """``passes --sat ISS`` (the 80-column table a user sees, and CSV) against skyfield's script, one set in the
-    file, alternating; and the workers ``--workers auto`` would choose now for the whole catalog."""
+    file, alternating."""
     lines = ACTIVE.read_text().splitlines()
     k = next(i for i in range(0, len(lines), 3) if lines[i + 1].startswith("1 25544U"))
     iss = folder / "iss.txt"
@@ -128,9 +128,7 @@ def _one_satellite(folder: Path) -> tuple[dict[str, tuple[float, float, int]], i
     result = _alternate({"ours table": _ours(iss, "table", extra=sat), "skyfield table": _skyfield(iss, "table"),
                          "ours csv": _ours(iss, "csv", extra=sat), "skyfield csv": _skyfield(iss, "csv")},
                         max(REPEAT, 9))
-    from nfwserver.tracking.passes import auto_workers
-
-    return result, auto_workers(len(lines) // 3)
+    return result
 
 
 def _goal(met: bool) -> str:
@@ -142,7 +140,7 @@ def main() -> None:
     folder.mkdir(exist_ok=True)
     subprocess.run([sys.executable, "-m", "compileall", "-q", "nfwserver", "bench"], cwd=ROOT, check=True)
     load_before = os.getloadavg()[0]
-    one, auto_now = _one_satellite(folder)
+    one = _one_satellite(folder)
     print(f"  one satellite: {one}", file=sys.stderr)
     two_k = _subset(2000, folder)
     vs: dict[str, tuple] = {}
@@ -168,6 +166,9 @@ def main() -> None:
     startup = _startup()
     load_after = os.getloadavg()[0]
     n_all = len(ACTIVE.read_text().splitlines()) // 3
+    from nfwserver.tracking.passes import auto_workers
+
+    auto_now = auto_workers(n_all)  # what `--workers auto` would choose at the end
     _report(one, vs, events, whole, week, sky_whole, startup, n_all, auto_now, load_before, load_after)
 
 
