@@ -17,9 +17,13 @@ import threading
 from collections.abc import Callable, Mapping
 from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from nfwserver.config.files import FileRefused, FileTooLarge, read_regular_bytes
 from nfwserver.tracking.elements import ElementSet, LoadResult, Rejection, load_elements
+
+if TYPE_CHECKING:
+    from nfwserver.config.schema import ElementsConfig
 
 BUNDLED = "amateur.txt"
 BUNDLED_SOURCE = f"bundled {BUNDLED}"
@@ -39,6 +43,11 @@ class SourceLimits:
 
     max_bytes: int = 64 * 2**20  #: size of the file or download, bytes (``[elements] max_source_mib``)
     max_sets: int = 100_000  #: element sets in it (``[elements] max_source_sets``)
+
+    @classmethod
+    def of(cls, elements: ElementsConfig) -> SourceLimits:
+        """``[elements] max_source_mib`` and ``max_source_sets``."""
+        return cls(int(elements.max_source_mib * 2**20), elements.max_source_sets)
 
     def too_large(self, source: str) -> SourceError:
         size = f"{self.max_bytes / 2**20:g} MiB" if self.max_bytes >= 2**20 else f"{self.max_bytes:,} bytes"

@@ -28,11 +28,6 @@ def configured_store(config: Config) -> ElementStore | None:
     return ElementStore(None if store == "default" else store)
 
 
-def source_limits(elements: ElementsConfig) -> SourceLimits:
-    """``[elements] max_source_mib`` and ``max_source_sets`` as :class:`SourceLimits`."""
-    return SourceLimits(int(elements.max_source_mib * 2**20), elements.max_source_sets)
-
-
 def configured_urls(elements: ElementsConfig) -> dict[str, str]:
     """Every configured URL: ``[elements] urls`` (label ``""``) then the named sources' URLs (label: the
     preset, e.g. ``amateur (CelesTrak, TLE)``)."""
@@ -45,7 +40,7 @@ def fetch_configured(elements: ElementsConfig, *, fetch_urls: bool, timeout_s: f
     """The sets of every configured source (URLs and named sources only when ``fetch_urls``; ``cancel`` set
     aborts a download in progress)."""
     urls = configured_urls(elements) if fetch_urls else {}
-    return fetch_all(elements.files, tuple(urls), elements.use_bundled, timeout_s, source_limits(elements),
+    return fetch_all(elements.files, tuple(urls), elements.use_bundled, timeout_s, SourceLimits.of(elements),
                      parsing, labels=urls, cancel=cancel)
 
 

@@ -79,14 +79,13 @@ def run_update(args: argparse.Namespace) -> int:
     from rich.console import Console
     from rich.progress import BarColumn, DownloadColumn, Progress, TaskID, TextColumn
 
-    from nfwserver.app.element_sources import SourceError, read_source
-    from nfwserver.app.station_catalog import source_limits
+    from nfwserver.app.element_sources import SourceError, SourceLimits, read_source
 
     config = _config(args)
     store = _store(config)
     labels = _sources(args.sources, config)
     sources = list(labels)
-    limits = source_limits(config.elements)
+    limits = SourceLimits.of(config.elements)
     sets, rejected, failed = [], [], []
     columns = (TextColumn("{task.description}"), BarColumn(), DownloadColumn(), TextColumn("{task.fields[sets]} sets"))
     console = Console(stderr=True)

@@ -172,11 +172,10 @@ def _catalog_from_files(paths: list[str], inputs: TrackingInputs) -> Catalog:
     (:func:`~nfwserver.app.element_sources.read_file` and :func:`~nfwserver.app.element_sources.parse_source`:
     regular files only, size and set limits, no binary data); a file without sets is named and left out, and
     none at all is a :class:`CliError` naming each file's reason."""
-    from nfwserver.app.element_sources import SourceError, parse_source, read_file
-    from nfwserver.app.station_catalog import source_limits
+    from nfwserver.app.element_sources import SourceError, SourceLimits, parse_source, read_file
     from nfwserver.tracking.catalog import Catalog
 
-    limits = source_limits(inputs.config().elements)
+    limits = SourceLimits.of(inputs.config().elements)
     sets = []
     unusable: list[str] = []  # why each file gave no set
     for path in paths:
