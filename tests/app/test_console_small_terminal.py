@@ -44,13 +44,15 @@ def test_the_outgoing_pane_shows_whole_nova_strings_one_row_each() -> None:
     async def scenario(app, pilot, station) -> None:
         station.run(1.0)
         await pilot.press("f1")
-        await settle(app, pilot, until=lambda: "F1 outgoing" in screen_text(app))
+        nova = station.core.current_text()
+        # The pane's title, and its log drawn with the string published (the title can come first).
+        await settle(app, pilot, until=lambda: "F1 outgoing" in screen_text(app) and nova in screen_text(app),
+                     what="the outgoing pane with the published string")
         assert not off_screen(app), off_screen(app)
         pane = app.query_one("#outgoing")
         width = pane.scrollable_content_region.width
         rows = log_text(app, "outgoing").splitlines()
         assert rows and all(len(row) <= width for row in rows)  # inside the pane
-        nova = station.core.current_text()
         assert any(row.endswith(nova) for row in rows), rows  # whole, on one row
         assert nova in screen_text(app)  # and on screen, not cut at the pane's edge
 
