@@ -73,7 +73,11 @@ def test_a_killed_station_leaves_nothing_running_behind(station, tmp_path) -> No
                        "XDG_STATE_HOME": str(tmp_path / "state")}, stdin=subprocess.DEVNULL,
         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        wait_for(lambda: channel.info() is not None and channel.info().pid == again.pid, 30.0, "the new station")
+        def described() -> bool:  # one read: the new station removes the dead one's description, then writes its own
+            info = channel.info()
+            return info is not None and info.pid == again.pid
+
+        wait_for(described, 30.0, "the new station")
         assert _cli(tmp_path, "stop").returncode == 0 and again.wait(10) == 0
     finally:
         if again.poll() is None:
