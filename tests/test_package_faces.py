@@ -13,7 +13,7 @@ import pytest
 
 from tests.conftest import ROOT
 
-LAZY = ("app", "console", "core", "dde", "dialects", "hamlib", "radio", "rotor", "tcp", "tracking")
+LAZY = ("app", "config", "console", "core", "dde", "dialects", "hamlib", "radio", "rotor", "tcp", "tracking")
 
 
 def _typed_names(package: str) -> dict[str, str]:

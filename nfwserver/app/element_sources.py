@@ -17,13 +17,9 @@ import threading
 from collections.abc import Callable, Mapping
 from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 from nfwserver.config.files import FileRefused, FileTooLarge, read_regular_bytes
 from nfwserver.tracking.elements import ElementSet, LoadResult, Rejection, load_elements
-
-if TYPE_CHECKING:
-    from nfwserver.config.schema import ElementsConfig
 
 BUNDLED = "amateur.txt"
 BUNDLED_SOURCE = f"bundled {BUNDLED}"
@@ -45,9 +41,9 @@ class SourceLimits:
     max_sets: int = 100_000  #: element sets in it (``[elements] max_source_sets``)
 
     @classmethod
-    def of(cls, elements: ElementsConfig) -> SourceLimits:
-        """``[elements] max_source_mib`` and ``max_source_sets``."""
-        return cls(int(elements.max_source_mib * 2**20), elements.max_source_sets)
+    def of(cls, max_source_mib: float, max_source_sets: int) -> SourceLimits:
+        """The limits ``[elements] max_source_mib`` (MiB) and ``max_source_sets`` set."""
+        return cls(int(max_source_mib * 2**20), max_source_sets)
 
     def too_large(self, source: str) -> SourceError:
         size = f"{self.max_bytes / 2**20:g} MiB" if self.max_bytes >= 2**20 else f"{self.max_bytes:,} bytes"

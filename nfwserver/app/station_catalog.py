@@ -40,8 +40,9 @@ def fetch_configured(elements: ElementsConfig, *, fetch_urls: bool, timeout_s: f
     """The sets of every configured source (URLs and named sources only when ``fetch_urls``; ``cancel`` set
     aborts a download in progress)."""
     urls = configured_urls(elements) if fetch_urls else {}
-    return fetch_all(elements.files, tuple(urls), elements.use_bundled, timeout_s, SourceLimits.of(elements),
-                     parsing, labels=urls, cancel=cancel)
+    limits = SourceLimits.of(elements.max_source_mib, elements.max_source_sets)
+    return fetch_all(elements.files, tuple(urls), elements.use_bundled, timeout_s, limits, parsing, labels=urls,
+                     cancel=cancel)
 
 
 def load_station_catalog(config: Config, *, fetch_urls: bool = False,

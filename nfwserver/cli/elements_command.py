@@ -85,7 +85,7 @@ def run_update(args: argparse.Namespace) -> int:
     store = _store(config)
     labels = _sources(args.sources, config)
     sources = list(labels)
-    limits = SourceLimits.of(config.elements)
+    limits = SourceLimits.of(config.elements.max_source_mib, config.elements.max_source_sets)
     sets, rejected, failed = [], [], []
     columns = (TextColumn("{task.description}"), BarColumn(), DownloadColumn(), TextColumn("{task.fields[sets]} sets"))
     console = Console(stderr=True)

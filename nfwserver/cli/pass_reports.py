@@ -43,7 +43,7 @@ def report_stale(stale: list[Any], names: Mapping[int, str], at: datetime, stale
 
 def stale_days_of(inputs: TrackingInputs) -> float:
     """``[elements] stale_days`` of the configuration in use."""
-    return float(inputs.config().elements.stale_days)
+    return float(inputs.setting("elements", "stale_days"))
 
 
 def dde_name_map(items: list[Any], catalog: Catalog, more: Sequence[int] = ()) -> dict[int, str]:

@@ -253,7 +253,7 @@ def _chosen_sets(args: argparse.Namespace, inputs: TrackingInputs, catalog: Cata
         chosen.update((n, catalog.get(n)) for n in found)
     default_favourites = not (args.sat or args.group or args.all or args.favourites or getattr(args, "elements", None))
     if args.favourites or default_favourites:
-        favourites = inputs.config().favourites
+        favourites = inputs.setting("satellites", "favourites")
         if args.favourites and not favourites:
             raise CliError("no favourites configured: list catalog numbers in [satellites] favourites")
         present = [n for n in favourites if catalog.get(n) is not None]

@@ -13,7 +13,7 @@ import argparse
 import logging
 from datetime import datetime, timezone
 from functools import cached_property
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from nfwserver.cli.arguments import number_in, observer_value, parse_time_text
 from nfwserver.cli.errors import CliError, load_config_or_fail, say
@@ -41,6 +41,25 @@ class TrackingInputs:
         if self._config is None:
             self._config = _load_config(self._args)
         return self._config
+
+    def setting(self, section: str, key: str) -> Any:
+        """``[section] key`` as the configuration in use holds it (:attr:`Setting.where
+        <nfwserver.config.setting.Setting.where>`).  Without a file (no ``--config``, and the user has none) that
+        is the table's default, read without building the configuration: its records cost a short command
+        such as ``passes --sat`` as much at start as its whole search.  A key without a default (the observer,
+        the horizon) means what the configuration makes of its absence, so it is always read from that."""
+        from nfwserver.config.table import default, setting
+
+        entry = setting(section, key)
+        if self._config is None and entry.default is not None and getattr(self._args, "config", None) is None:
+            from nfwserver.config.files import default_config_path
+
+            if not default_config_path().exists():
+                return default(section, key)
+        value: Any = self.config()
+        for name in entry.where.split("."):
+            value = getattr(value, name)
+        return value
 
     @cached_property
     def _given_observer(self) -> Observer | None:
@@ -91,7 +110,7 @@ class TrackingInputs:
     def ut1_utc(self) -> float:
         """``--ut1-utc``, else the configuration's (s)."""
         ut1_utc = getattr(self._args, "ut1_utc", None)
-        return float(self.config().server.ut1_utc_s if ut1_utc is None else ut1_utc)
+        return float(self.setting("server", "ut1_utc_s") if ut1_utc is None else ut1_utc)
 
     @cached_property
     def catalog(self) -> Catalog:
@@ -175,7 +194,8 @@ def _catalog_from_files(paths: list[str], inputs: TrackingInputs) -> Catalog:
     from nfwserver.app.element_sources import SourceError, SourceLimits, parse_source, read_file
     from nfwserver.tracking.catalog import Catalog
 
-    limits = SourceLimits.of(inputs.config().elements)
+    limits = SourceLimits.of(inputs.setting("elements", "max_source_mib"),
+                             inputs.setting("elements", "max_source_sets"))
     sets = []
     unusable: list[str] = []  # why each file gave no set
     for path in paths:
@@ -196,7 +216,7 @@ def _catalog_from_files(paths: list[str], inputs: TrackingInputs) -> Catalog:
         raise CliError("no usable element sets: " + "; ".join(unusable))
     for reason in unusable:
         say(f"left out: {reason}")
-    return Catalog(sets, dde_names=inputs.config().dde_names)
+    return Catalog(sets, dde_names=inputs.setting("satellites", "names"))
 
 
 def _station_catalog(config: Config) -> Catalog:

@@ -15,6 +15,15 @@ from pathlib import Path
 
 #: Largest configuration or horizon file read (bytes).
 MAX_FILE_BYTES = 1 << 20
+APP_NAME = "nfwserver"
+
+
+def default_config_path() -> Path:
+    """``config.toml`` in the platform's user configuration directory (here, not in the loader: a command
+    asks whether the file exists before it pays for the loader and the configuration's records)."""
+    from platformdirs import user_config_dir
+
+    return Path(user_config_dir(APP_NAME, appauthor=False)) / "config.toml"
 
 
 class FileRefused(ValueError):

@@ -17,7 +17,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from nfwserver.config.files import FileRefused, read_regular_file
+from nfwserver.config.files import FileRefused, default_config_path, read_regular_file
 from nfwserver.config.kinds import ManyProblems, convert
 from nfwserver.config.schema import (
     DEFAULT_OBSERVER,
@@ -51,7 +51,6 @@ def toml_document(text: str) -> dict[str, Any]:
     return document
 
 
-APP_NAME = "nfwserver"
 #: Config fields holding a section record, by field name.
 _RECORDS = {"elements": ElementsConfig, "server": ServerConfig, "radio": RadioConfig, "rotor": RotorConfig,
             "dialects": DialectsConfig, "tcp": TcpConfig, "easycomm": EasyCommConfig, "web": WebConfig}
@@ -64,13 +63,6 @@ class ConfigError(ValueError):
         self.source = source
         self.problems = problems
         super().__init__(f"{source}: " + "; ".join(problems))
-
-
-def default_config_path() -> Path:
-    """``config.toml`` in the platform's user configuration directory."""
-    from platformdirs import user_config_dir
-
-    return Path(user_config_dir(APP_NAME, appauthor=False)) / "config.toml"
 
 
 def _unknown(where: str, kind: str, name: str, valid: tuple[str, ...]) -> str:

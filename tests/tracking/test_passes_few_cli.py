@@ -8,6 +8,7 @@ including passes whose AOS or LOS is unknown or outside the window, and names CS
 from __future__ import annotations
 
 import math
+import os
 import subprocess
 import sys
 import time
@@ -24,7 +25,7 @@ from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.few_passes import FewPasses
 from nfwserver.tracking.pass_records import PassList
 from nfwserver.tracking.pass_spill import SpilledPasses
-from tests.conftest import DATA
+from tests.conftest import DATA, ROOT
 
 START = datetime(2026, 5, 8, tzinfo=timezone.utc)
 #: catalog number, AOS, TCA, LOS (s after the start; None unknown), max elevation, azimuths at AOS and LOS
@@ -94,17 +95,34 @@ def test_the_small_writer_writes_the_catalog_writers_bytes(capsys, monkeypatch, 
 
 def test_one_satellite_is_searched_and_written_without_numpy(tmp_path) -> None:
     """numpy's import alone costs more than the whole search for one satellite (docs/BENCHMARKS.md); OpenSSL's
-    libcrypto (hashlib, secrets: about 3.5 MiB), which only the web token needs, is not loaded either."""
+    libcrypto (hashlib, secrets: about 3.5 MiB), which only the web token needs, is not loaded either; nor,
+    without a configuration file, the configuration's records (nfwserver.config.schema), which cost as much."""
     iss = next(s for s in load_element_file(DATA / "visual.txt").sets if s.catalog_number == 25544)
     path = tmp_path / "iss.txt"
     path.write_text(iss.tle_text())
     code = ("import sys\nfrom nfwserver.cli import main\n"
             f"rc = main(['passes', '--elements', {str(path)!r}, '--sat', 'ISS', '--observer', '52.2,0.12', "
             "'--start', '2026-05-08T00:00Z', '--format', 'csv'])\n"
-            "print('numpy' in sys.modules, '_hashlib' in sys.modules, rc)")
+            "print('numpy' in sys.modules, '_hashlib' in sys.modules, 'nfwserver.config.schema' in sys.modules, rc)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
-    assert out.splitlines()[-1] == "False False 0"
+    assert out.splitlines()[-1] == "False False False 0"
     assert out.count("2026-05-0") >= 4  # the passes were written
+
+
+def test_one_satellite_with_a_configuration_file_follows_it(tmp_path) -> None:
+    """With the user's file the configuration is read: its DDE name for the set and its stale_days apply."""
+    iss = next(s for s in load_element_file(DATA / "visual.txt").sets if s.catalog_number == 25544)
+    path = tmp_path / "iss.txt"
+    path.write_text(iss.tle_text())
+    config = tmp_path / "xdg" / "nfwserver" / "config.toml"
+    config.parent.mkdir(parents=True)
+    config.write_text('[elements]\nstale_days = 1\n[satellites]\nnames = { "25544" = "ZARYA-1" }\n')
+    result = subprocess.run([sys.executable, "-m", "nfwserver", "passes", "--elements", str(path), "--sat", "25544",
+                             "--observer", "52.2,0.12", "--start", "2026-05-10T00:00Z", "--format", "table"],
+                            capture_output=True, text=True, check=True, cwd=ROOT,
+                            env={**os.environ, "PYTHONPATH": str(ROOT), "XDG_CONFIG_HOME": str(tmp_path / "xdg")})
+    assert "ZARYA-1" in result.stdout  # the compact table shows DDE names
+    assert "3 days old at 2026-05-10T00:00:00.000Z (more than [elements] stale_days, 1)" in result.stderr
 
 
 def test_a_case_the_small_search_hands_back_is_searched_by_the_catalog_search(capsys, monkeypatch, elements) -> None:
