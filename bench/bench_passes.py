@@ -166,7 +166,7 @@ def main() -> None:
     startup = _startup()
     load_after = os.getloadavg()[0]
     n_all = len(ACTIVE.read_text().splitlines()) // 3
-    from nfwserver.tracking.passes import auto_workers
+    from nfwserver.tracking.pass_workers import auto_workers
 
     auto_now = auto_workers(n_all)  # what `--workers auto` would choose at the end
     _report(one, vs, events, whole, week, sky_whole, startup, n_all, auto_now, load_before, load_after)

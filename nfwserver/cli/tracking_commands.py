@@ -218,7 +218,8 @@ def _find_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: list[An
     shows them) to show for each satellite that has one (by catalog number), and how many satellites were
     searched."""
     from nfwserver.tracking.pass_records import PassList
-    from nfwserver.tracking.passes import auto_workers, find_passes, find_passes_spilled
+    from nfwserver.tracking.pass_workers import auto_workers
+    from nfwserver.tracking.passes import find_passes, find_passes_spilled
 
     start = args.start
     workers = auto_workers(len(sets)) if args.workers == "auto" else int(args.workers)

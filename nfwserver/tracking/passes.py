@@ -32,14 +32,11 @@ whose rise or set lies beyond the extension gets ``None`` for that time.
 from __future__ import annotations
 
 import math
-import os
-import sys
 import threading
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
-from typing import IO, TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -54,11 +51,12 @@ from nfwserver.tracking.pass_kinematics import PairEvaluator
 from nfwserver.tracking.pass_records import Pass, PassColumns, PassList
 from nfwserver.tracking.pass_screen import screen
 from nfwserver.tracking.pass_spill import SpilledPasses
+from nfwserver.tracking.pass_workers import in_forked_workers
 from nfwserver.tracking.screening import usable_models
 from nfwserver.tracking.timescale import julian_date
 
 if TYPE_CHECKING:  # multiprocessing is imported only when workers are forked (1.3 MiB, 5 ms)
-    from multiprocessing.connection import Connection
+    pass
 
 __all__ = ["Pass", "PassList", "SpilledPasses", "find_passes", "find_passes_spilled"]
 
@@ -73,121 +71,6 @@ _LOW_STEP_S, _SLOW_STEP_S, _OTHER_STEP_S = 1200.0, 3600.0, 1200.0
 _CHUNK = 200
 #: Brackets refined together (at least; a batch takes whole chunks): bounds the memory of one refinement.
 _BATCH_BRACKETS = 10000
-#: Fewest satellites for which :func:`auto_workers` forks (below, forking and gathering cost about what they save).
-AUTO_WORKERS_FROM = 1000
-#: Most worker processes :func:`auto_workers` chooses.
-AUTO_WORKERS_MAX = 8
-#: Readings of the running processes :func:`busy_cores` takes, and the pause between them (s).
-_BUSY_READINGS, _BUSY_GAP_S = 3, 0.003
-
-
-def auto_workers(satellites: int) -> int:
-    """Worker processes that pay for a search of ``satellites`` here and now: one per core not already busy
-    (the cores this process may use less :func:`busy_cores`), from :data:`AUTO_WORKERS_FROM` satellites; 1 on
-    Windows (no fork).  Any number gives the same passes, bit for bit."""
-    if satellites < AUTO_WORKERS_FROM or sys.platform == "win32":
-        return 1
-    cores = os.cpu_count() or 1
-    if sys.platform == "linux":
-        cores = len(os.sched_getaffinity(0))  # the cores this process may run on
-    return max(1, min(cores - busy_cores(), AUTO_WORKERS_MAX))
-
-
-def busy_cores(readings: Sequence[str] | None = None) -> int:
-    """Cores other processes keep busy now.  On Linux, the most processes found running besides this one in three
-    readings of ``/proc/loadavg``'s fourth field a few milliseconds apart (``readings``: those texts); elsewhere,
-    or when it cannot be read, the 1-minute load average.  The average lags by a minute: a command run right
-    after another heavy one (a script running several searches in a row) would see its predecessor's load and
-    give up cores that are idle now, and one run just after a heavy job started would take cores that are not;
-    three readings keep a process that is runnable most of the time from being missed."""
-    if sys.platform == "win32":  # no load average (and no fork: auto_workers chooses 1 there)
-        return 0
-    if readings is None:
-        readings = []
-        for k in range(_BUSY_READINGS):
-            try:
-                with open("/proc/loadavg", encoding="ascii") as f:
-                    readings.append(f.read())
-            except OSError:
-                break
-            if k + 1 < _BUSY_READINGS:
-                time.sleep(_BUSY_GAP_S)
-    running = []
-    for text in readings:
-        try:
-            running.append(int(text.split()[3].split("/")[0]) - 1)
-        except (IndexError, ValueError):
-            break
-    else:
-        if running:
-            return max(0, max(running))
-    return int(os.getloadavg()[0])
-
-
-def _fork_worker(satellites: list[Any], args: tuple[Any, ...], results: Connection) -> None:
-    """A forked worker's whole life: the passes of its share of the chunks (``args``: :func:`_search`'s after the
-    satellites), sent back through ``results`` (or the exception that stopped it).  Runs in the child only; the
-    satellites reached it by the fork (Satrec objects cannot be pickled), only the result is pickled.  A search
-    that spills (``args``' last, a SpilledPasses on a file the parent made) writes its rows to that file and
-    sends back only what orders them (:meth:`SpilledPasses.keys`) and the satellites it left out."""
-    try:
-        found = _search(satellites, *args)
-        outcome: object = (found.keys(), found.skipped) if isinstance(found, SpilledPasses) else found
-    except BaseException as exc:  # handed to the parent, which raises it
-        outcome = exc
-    try:
-        results.send(outcome)
-    finally:
-        results.close()
-
-
-def _in_forked_workers(satellites: list[Any], plan: list[_Chunk], args: tuple[Any, ...], workers: int,
-                       spills: Sequence[IO[bytes]] = ()) -> list[Any]:
-    """The passes of the chunks of ``plan`` found by ``workers`` forked processes, one share each (every
-    ``workers``-th chunk: the chunks of one process, so the passes are those of one process bit for bit), in
-    the order of the shares (POSIX: the caller checked that fork exists).  With ``spills`` (one temporary file
-    per worker), each worker writes its rows to its file and hands back their keys (:func:`_fork_worker`)."""
-    import multiprocessing
-
-    if sys.platform == "win32":  # never true here (the caller checked); it tells the type checker the rest is POSIX
-        raise OSError("fork is POSIX only")
-
-    context = multiprocessing.get_context("fork")
-    receivers: list[Connection] = []
-    processes = []
-    try:
-        for k in range(workers):
-            receiver, sender = context.Pipe(duplex=False)
-            spill = (SpilledPasses(args[1], (args[2] - args[1]).total_seconds(), spills[k]),) if spills else ()
-            process = context.Process(target=_fork_worker, args=(satellites, (plan[k::workers], *args, *spill), sender),
-                                      daemon=True)
-            process.start()
-            sender.close()  # the child holds its own end: EOF here if it dies without an answer
-            receivers.append(receiver)
-            processes.append(process)
-        outcomes = []
-        for receiver, process in zip(receivers, processes):  # before joining: a large answer fills the pipe
-            try:
-                outcomes.append(receiver.recv())
-            except EOFError:  # killed (out of memory, a signal) before it answered
-                process.join(5.0)
-                raise OSError(f"a pass-search worker process ended without its answer (exit status "
-                              f"{process.exitcode})") from None
-        for process in processes:
-            process.join()
-    finally:
-        for receiver in receivers:
-            receiver.close()
-        for process in processes:
-            if process.is_alive():
-                process.terminate()
-                process.join()
-    for outcome in outcomes:
-        if isinstance(outcome, BaseException):
-            raise outcome
-    return outcomes
-
-
 def find_passes(
     satellites: Sequence[Any],
     observer: Observer,
@@ -259,12 +142,12 @@ def _find(satellites: Sequence[Any], observer: Observer, start: datetime, end: d
         if "fork" in multiprocessing.get_all_start_methods():
             workers = min(workers, len(plan))
             if not spilled:
-                return PassList.concat(start, window_s, _in_forked_workers(satellites, plan, args, workers))
+                return PassList.concat(start, window_s, in_forked_workers(_search, satellites, plan, args, workers))
             import tempfile
 
             spills = [tempfile.TemporaryFile() for _ in range(workers)]  # noqa: SIM115 (closed by the result)
             try:
-                parts = _in_forked_workers(satellites, plan, args, workers, spills)
+                parts = in_forked_workers(_search, satellites, plan, args, workers, spills)
             except BaseException:
                 for spill in spills:
                     spill.close()

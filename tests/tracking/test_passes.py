@@ -197,10 +197,10 @@ def test_a_worker_killed_before_it_answers_is_one_clear_error() -> None:
     script = """
 import os, sys
 from datetime import datetime, timezone, timedelta
-from nfwserver.tracking import passes
+from nfwserver.tracking import pass_workers, passes
 from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.observer import Observer
-passes._fork_worker = lambda satellites, args, results: os._exit(3)  # dies at once, in the child
+pass_workers.fork_worker = lambda search, satellites, args, results: os._exit(3)  # dies at once, in the child
 sats = load_element_file(sys.argv[1]).sets[:500]
 start = datetime(2026, 5, 8, tzinfo=timezone.utc)
 try:
