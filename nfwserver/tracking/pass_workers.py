@@ -11,13 +11,14 @@ from __future__ import annotations
 import os
 import sys
 import time
-from collections.abc import Callable, Sequence, Sized
-from typing import IO, TYPE_CHECKING, Any, Protocol, TypeVar
+from collections.abc import Callable, Iterator, Sequence, Sized
+from typing import IO, TYPE_CHECKING, Any, Generic, Protocol, TypeVar
 
 from nfwserver.tracking.pass_spill import SpilledPasses
 
 if TYPE_CHECKING:  # multiprocessing is imported only when workers are forked (1.3 MiB, 5 ms)
     from multiprocessing.connection import Connection
+    from multiprocessing.sharedctypes import Synchronized
 
     from nfwserver.tracking.pass_records import PassList
 
@@ -78,7 +79,7 @@ def busy_cores(readings: Sequence[str] | None = None) -> int:
 
 
 class ChunkWork(Protocol):
-    """What :func:`shares` reads of a chunk of the search's plan (``passes._Chunk``)."""
+    """What :func:`pull_order` reads of a chunk of the search's plan (``passes._Chunk``)."""
 
     @property
     def members(self) -> Sized: ...  # the satellites searched together
@@ -93,19 +94,30 @@ class ChunkWork(Protocol):
 C = TypeVar("C", bound=ChunkWork)
 
 
-def shares(plan: list[C], window_s: float, workers: int) -> list[list[C]]:
-    """The chunks of ``plan`` split into ``workers`` shares of about equal work, each in plan order: the largest
-    chunk first to the least loaded share.  A chunk's work is counted as its coarse samples (satellites times
-    the searched span, ``window_s`` plus the look-back and -ahead, over the step) plus
-    :data:`_PASS_WORK` per pass there can be (``room``): a round-robin deal left one of two workers with a
-    fourth chunk of low orbits for a 2,000-satellite search (212 against 332 ms)."""
+def pull_order(plan: Sequence[ChunkWork], window_s: float) -> list[int]:
+    """The order in which workers take the chunks of ``plan`` (indices): the most work first, so that the last
+    chunks taken are small and the workers end together.  A chunk's work is counted as its coarse samples
+    (satellites times the searched span, ``window_s`` plus the look-back and -ahead, over the step) plus
+    :data:`_PASS_WORK` per pass there can be (``room``)."""
     work = [len(c.members) * (window_s + 2.0 * c.extension_s) / c.step_s + _PASS_WORK * c.room for c in plan]
-    load, picked = [0.0] * workers, [[] for _ in range(workers)]  # type: list[float], list[list[int]]
-    for i in sorted(range(len(plan)), key=lambda i: -work[i]):
-        k = load.index(min(load))
-        load[k] += work[i]
-        picked[k].append(i)
-    return [[plan[i] for i in sorted(share)] for share in picked]
+    return sorted(range(len(plan)), key=lambda i: -work[i])
+
+
+class _Pulled(Generic[C]):
+    """The chunks one worker searches: each taken, when the worker is ready for it, as the next of ``order``
+    that no worker has taken yet (``taken``: a counter the forked workers share)."""
+
+    def __init__(self, plan: Sequence[C], order: list[int], taken: Synchronized[int]) -> None:
+        self.plan, self.order, self.taken = plan, order, taken
+
+    def __iter__(self) -> Iterator[C]:
+        while True:
+            with self.taken.get_lock():
+                k = self.taken.value
+                self.taken.value = k + 1
+            if k >= len(self.order):
+                return
+            yield self.plan[self.order[k]]
 
 
 def fork_worker(search: Search, satellites: list[Any], args: tuple[Any, ...], results: Connection) -> None:
@@ -128,26 +140,32 @@ def fork_worker(search: Search, satellites: list[Any], args: tuple[Any, ...], re
 
 def in_forked_workers(search: Search, satellites: list[Any], plan: list[C], args: tuple[Any, ...], workers: int,
                       spills: Sequence[IO[bytes]] = ()) -> list[Any]:
-    """The passes of the chunks of ``plan`` found by ``workers`` forked processes running ``search``, one share
-    each (:func:`shares`: whole chunks, each searched as one process searches it, so the passes are those of
-    one process bit for bit), in the order of the shares (POSIX: the caller checked that fork exists).  With
-    ``spills`` (one temporary file per worker), each worker writes its rows to its file and hands back their
-    keys (:func:`fork_worker`)."""
+    """The passes of the chunks of ``plan`` found by ``workers`` forked processes running ``search``
+    (``search(satellites, chunks, room, *args)``), in the order of the workers (POSIX: the caller checked that
+    fork exists).  Each worker takes the next chunk (in :func:`pull_order`) when it is ready for one, and
+    searches it whole as one process would, so the passes are those of one process bit for bit whichever
+    worker found them; dealing the chunks out beforehand left one of two workers idle for up to a third of
+    the search (the chunks' work is known only roughly).  With ``spills`` (one temporary file per worker),
+    each worker writes its rows to its file and hands back their keys (:func:`fork_worker`)."""
     import multiprocessing
 
     if sys.platform == "win32":  # never true here (the caller checked); it tells the type checker the rest is POSIX
         raise OSError("fork is POSIX only")
 
     context = multiprocessing.get_context("fork")
-    parts = shares(plan, (args[2] - args[1]).total_seconds(), workers)
+    window_s = (args[2] - args[1]).total_seconds()
+    order = pull_order(plan, window_s)
+    taken = context.Value("q", 0)  # the next place in ``order``, shared by the workers
+    room = -(-sum(c.room for c in plan) // workers)  # a worker's room for passes to start with (grown if need be)
     receivers: list[Connection] = []
     processes = []
     try:
         for k in range(workers):
             receiver, sender = context.Pipe(duplex=False)
-            spill = (SpilledPasses(args[1], (args[2] - args[1]).total_seconds(), spills[k]),) if spills else ()
-            process = context.Process(target=fork_worker, args=(search, satellites, (parts[k], *args, *spill), sender),
-                                      daemon=True)
+            spill = (SpilledPasses(args[1], window_s, spills[k]),) if spills else ()
+            chunks = _Pulled(plan, order, taken)
+            process = context.Process(target=fork_worker, args=(search, satellites, (chunks, room, *args, *spill),
+                                                                sender), daemon=True)
             process.start()
             sender.close()  # the child holds its own end: EOF here if it dies without an answer
             receivers.append(receiver)

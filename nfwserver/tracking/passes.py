@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import math
 import threading
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 from typing import TYPE_CHECKING, Any
@@ -153,7 +153,8 @@ def _find(satellites: Sequence[Any], observer: Observer, start: datetime, end: d
                     spill.close()
                 raise
             return SpilledPasses.joined(start, window_s, spills, parts)
-    return _search(satellites, plan, *args, SpilledPasses(start, window_s) if spilled else None)
+    into = SpilledPasses(start, window_s) if spilled else None
+    return _search(satellites, plan, sum(c.room for c in plan), *args, into)
 
 
 @dataclass(frozen=True)
@@ -196,17 +197,17 @@ def _plan(satellites: Sequence[Any], window_s: float) -> list[_Chunk]:
     return plan
 
 
-def _search(satellites: Sequence[Any], plan: list[_Chunk], observer: Observer, start: datetime, end: datetime,
-            horizon: HorizonTable, ut1_utc: float, fine_step_s: float, spill: SpilledPasses | None = None
-            ) -> PassList | SpilledPasses:
-    """The passes of the chunks of ``plan`` (aware ``start`` and ``end``), in this process (into ``spill`` when
-    given)."""
+def _search(satellites: Sequence[Any], chunks: Iterable[_Chunk], room: int, observer: Observer, start: datetime,
+            end: datetime, horizon: HorizonTable, ut1_utc: float, fine_step_s: float,
+            spill: SpilledPasses | None = None) -> PassList | SpilledPasses:
+    """The passes of ``chunks`` (aware ``start`` and ``end``), in this process (into ``spill`` when given; else
+    into columns with ``room`` rows to start with)."""
     window_s = (end - start).total_seconds()
-    found = spill if spill is not None else PassColumns(sum(c.room for c in plan))
+    found = spill if spill is not None else PassColumns(room)
     batch = Batch()
     jd_start, fr_start = julian_date(start)
     skipped: list[int] = []
-    for chunk in plan:
+    for chunk in chunks:
         numbers = chunk.catalog_numbers
         models = [_model(satellites[i]) for i in chunk.members.tolist()]
         usable = usable_models(models, observer, jd_start, fr_start, ut1_utc)
