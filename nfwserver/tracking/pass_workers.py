@@ -128,21 +128,26 @@ def fork_worker(search: Search, satellites: list[Any], args: tuple[Any, ...], re
     parent made) writes its rows to that file and sends back only what orders them
     (:meth:`SpilledPasses.keys`) and the satellites it left out."""
     try:
-        found = search(satellites, *args)
-        outcome: object = (found.keys(), found.skipped) if isinstance(found, SpilledPasses) else found
-    except BaseException as exc:  # handed to the parent, which raises it
-        outcome = exc
-    try:
-        results.send(outcome)
+        results.send(_answer(search, satellites, args))
     finally:
         results.close()
 
 
+def _answer(search: Search, satellites: list[Any], args: tuple[Any, ...]) -> object:
+    """What a worker hands back (:func:`fork_worker`): its passes, the keys and skipped satellites of its
+    spilled rows, or the exception that stopped it (which the parent raises)."""
+    try:
+        found = search(satellites, *args)
+        return (found.keys(), found.skipped) if isinstance(found, SpilledPasses) else found
+    except BaseException as exc:
+        return exc
+
+
 def in_forked_workers(search: Search, satellites: list[Any], plan: list[C], args: tuple[Any, ...], workers: int,
                       spills: Sequence[IO[bytes]] = ()) -> list[Any]:
-    """The passes of the chunks of ``plan`` found by ``workers`` forked processes running ``search``
-    (``search(satellites, chunks, room, *args)``), in the order of the workers (POSIX: the caller checked that
-    fork exists).  Each worker takes the next chunk (in :func:`pull_order`) when it is ready for one, and
+    """The passes of the chunks of ``plan`` found by ``workers`` processes running ``search`` (``search(satellites,
+    chunks, room, *args)``): this one and ``workers - 1`` forked ones, in that order (POSIX: the caller checked
+    that fork exists).  Each worker takes the next chunk (in :func:`pull_order`) when it is ready for one, and
     searches it whole as one process would, so the passes are those of one process bit for bit whichever
     worker found them; dealing the chunks out beforehand left one of two workers idle for up to a third of
     the search (the chunks' work is known only roughly).  With ``spills`` (one temporary file per worker),
@@ -159,18 +164,20 @@ def in_forked_workers(search: Search, satellites: list[Any], plan: list[C], args
     room = -(-sum(c.room for c in plan) // workers)  # a worker's room for passes to start with (grown if need be)
     receivers: list[Connection] = []
     processes = []
+
+    def share(k: int) -> tuple[Any, ...]:  # worker k's arguments to ``search`` after the satellites
+        spill = (SpilledPasses(args[1], window_s, spills[k]),) if spills else ()
+        return (_Pulled(plan, order, taken), room, *args, *spill)
+
     try:
-        for k in range(workers):
+        for k in range(1, workers):  # this process is worker 0: one fork and one answer fewer to pass back
             receiver, sender = context.Pipe(duplex=False)
-            spill = (SpilledPasses(args[1], window_s, spills[k]),) if spills else ()
-            chunks = _Pulled(plan, order, taken)
-            process = context.Process(target=fork_worker, args=(search, satellites, (chunks, room, *args, *spill),
-                                                                sender), daemon=True)
+            process = context.Process(target=fork_worker, args=(search, satellites, share(k), sender), daemon=True)
             process.start()
             sender.close()  # the child holds its own end: EOF here if it dies without an answer
             receivers.append(receiver)
             processes.append(process)
-        outcomes = []
+        outcomes = [_answer(search, satellites, share(0))]
         for receiver, process in zip(receivers, processes):  # before joining: a large answer fills the pipe
             try:
                 outcomes.append(receiver.recv())
