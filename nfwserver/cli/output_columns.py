@@ -85,6 +85,13 @@ class Text(Column):
     def __len__(self) -> int:
         return len(self.index)
 
+    def picked(self, index: np.ndarray) -> Text:
+        """The column of ``values[index[row]]``: the same strings, each styled once for both columns (a large
+        output's slabs name the same satellites again and again)."""
+        column = Text(self.name, (), np.asarray(index, dtype=np.intp))
+        column.values, column._styles = self.values, self._styles
+        return column
+
     def _styled(self, style: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         if style not in self._styles:
             values = self.values

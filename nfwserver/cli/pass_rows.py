@@ -31,14 +31,13 @@ def above(cols: dict[str, np.ndarray], min_el: float) -> dict[str, np.ndarray]:
     return {key: value[keep] for key, value in cols.items()}
 
 
-def wide_columns(start: datetime, cols: dict[str, np.ndarray], numbers: np.ndarray, names: list[str]
-                 ) -> list[Column]:
+def wide_columns(start: datetime, cols: dict[str, np.ndarray], numbers: np.ndarray, names: Text) -> list[Column]:
     """The every-column rows of the passes ``cols`` (PassList columns, times after ``start``); ``numbers``:
-    every catalog number with a pass, ascending, ``names`` theirs."""
+    every catalog number with a pass, ascending, ``names`` theirs (a column of one name each, in that order)."""
     which = np.searchsorted(numbers, cols["catalog_number"])
     aos_unknown, los_unknown = np.isnan(cols["aos_s"]), np.isnan(cols["los_s"])
     aos, los = Time("aos_utc", start, cols["aos_s"], aos_unknown), Time("los_utc", start, cols["los_s"], los_unknown)
-    return [Integer("catalog_number", cols["catalog_number"]), Text("name", names, which),
+    return [Integer("catalog_number", cols["catalog_number"]), names.picked(which),
             aos, Time("tca_utc", start, cols["tca_s"]), los,
             Number("max_elevation_deg", cols["max_elevation_deg"], 1),
             Number("aos_azimuth_deg", cols["aos_azimuth_deg"], 1, aos_unknown),
@@ -51,7 +50,7 @@ def write_spilled(passes: SpilledPasses, start: datetime, min_el: float, names: 
     """Write ``passes`` (``names``: the name of each catalog number with a pass) as ``fmt`` (CSV or JSON), those
     reaching ``min_el`` deg, a slab at a time."""
     numbers = np.array(sorted(names), dtype=np.int64)
-    shown = [names[n] for n in numbers.tolist()]
+    shown = Text("name", [names[n] for n in numbers.tolist()])
     writer = RowWriter(column_names, fmt, out)
     for slab in passes.slabs(SLAB_ROWS):
         writer.write(wide_columns(start, above(slab.columns, min_el), numbers, shown))

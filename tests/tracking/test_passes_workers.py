@@ -48,7 +48,8 @@ def test_busy_cores_counts_what_runs_now_not_what_ran_a_minute_ago(monkeypatch) 
     assert pass_workers.busy_cores(["1.90 1.20 0.80 1/80 4242\n"] * 3) == 0  # only this process runs now
     assert pass_workers.busy_cores(["1.90 1.20 0.80 2/80 4242\n", "1.90 1.20 0.80 1/80 4242\n"]) == 1
     monkeypatch.setattr(os, "getloadavg", lambda: (0.1, 0.0, 0.0))
-    assert pass_workers.busy_cores(["0.10 0.00 0.00 1/80 1\n", "0.10 0.00 0.00 3/80 1\n", "0.10 0.00 0.00 2/80 1\n"]) == 2
+    readings = ["0.10 0.00 0.00 1/80 1\n", "0.10 0.00 0.00 3/80 1\n", "0.10 0.00 0.00 2/80 1\n"]
+    assert pass_workers.busy_cores(readings) == 2
     monkeypatch.setattr(os, "getloadavg", lambda: (2.4, 1.2, 0.8))
     assert pass_workers.busy_cores(["not a loadavg line"]) == 2  # unreadable: the average
     assert pass_workers.busy_cores([]) == 2
