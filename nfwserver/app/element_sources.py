@@ -13,6 +13,7 @@ almost always the wrong file or an error page.
 from __future__ import annotations
 
 import contextlib
+import re
 import threading
 from collections.abc import Callable, Mapping
 from contextlib import AbstractContextManager
@@ -162,14 +163,18 @@ def read_file(path: str, limits: SourceLimits = SourceLimits()) -> bytes:
         raise SourceError(f"cannot read {path}: {(exc.strerror or str(exc)).lower()}") from None
 
 
+#: What text of element sets does not hold: undecodable bytes, control characters other than tab, line feed,
+#: carriage return and form feed, and DEL.
+_ODD = re.compile("[\x00-\x08\x0b\x0e-\x1f\x7f\ufffd]")
+
+
 def _looks_binary(data: bytes) -> bool:
     """NUL bytes, or text that is mostly not UTF-8 or full of control characters."""
     head = data[:65536]
     if b"\0" in head:
         return True
     text = head.decode("utf-8", errors="replace")
-    odd = sum(1 for c in text if c == "\ufffd" or (c < " " and c not in "\t\n\r\f") or c == "\x7f")
-    return odd > len(text) // 20
+    return len(_ODD.findall(text)) > len(text) // 20
 
 
 def _fewest_sets(data: bytes) -> int:
