@@ -29,8 +29,9 @@ log = logging.getLogger(__name__)
 
 class TrackingInputs:
     """What the options resolve to, each value resolved when first read: the configuration is read (once) when
-    a value the options leave open needs it: the observer and horizon without ``--observer``, UT1-UTC without
-    ``--ut1-utc``, the DDE-name overrides of an ``--elements`` catalog, or the station's catalog."""
+    a value the options leave open needs it: the observer and horizon without ``--observer``, or the station's
+    catalog; single settings (UT1-UTC without ``--ut1-utc``, the DDE-name overrides and the limits of an
+    ``--elements`` catalog, ``stale_days``) through :meth:`setting`, from the file when there is one."""
 
     def __init__(self, args: argparse.Namespace) -> None:
         self._args = args
@@ -39,7 +40,12 @@ class TrackingInputs:
     def config(self) -> Config:
         """The configuration (``--config FILE``, else the user's, else the built-in defaults), read once."""
         if self._config is None:
-            self._config = _load_config(self._args)
+            if "_file_in_use" in self.__dict__ and not self._file_in_use:  # decided once: no file, the defaults
+                from nfwserver.config.schema import Config
+
+                self._config = Config()
+            else:
+                self._config = _load_config(self._args)
         return self._config
 
     def setting(self, section: str, key: str) -> Any:
@@ -51,15 +57,21 @@ class TrackingInputs:
         from nfwserver.config.table import default, setting
 
         entry = setting(section, key)
-        if self._config is None and entry.default is not None and getattr(self._args, "config", None) is None:
-            from nfwserver.config.files import default_config_path
-
-            if not default_config_path().exists():
-                return default(section, key)
+        if self._config is None and entry.default is not None and not self._file_in_use:
+            return default(section, key)
         value: Any = self.config()
         for name in entry.where.split("."):
             value = getattr(value, name)
         return value
+
+    @cached_property
+    def _file_in_use(self) -> bool:
+        """Whether a configuration file is in use (``--config``, or the user's file), decided once per command."""
+        if getattr(self._args, "config", None) is not None:
+            return True
+        from nfwserver.config.files import default_config_path
+
+        return default_config_path().exists()
 
     @cached_property
     def _given_observer(self) -> Observer | None:

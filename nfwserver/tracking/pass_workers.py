@@ -120,27 +120,35 @@ class _Pulled(Generic[C]):
             yield self.plan[self.order[k]]
 
 
+    def stop(self) -> None:
+        """Leave no chunk to take: every worker stops after the chunk it is searching (one has failed)."""
+        with self.taken.get_lock():
+            self.taken.value = len(self.order)
+
+
 def fork_worker(search: Search, satellites: list[Any], args: tuple[Any, ...], results: Connection) -> None:
-    """A forked worker's whole life: the passes of its share of the chunks (``search(satellites, *args)``, the
-    one-process search of :mod:`~nfwserver.tracking.passes`), sent back through ``results`` (or the exception
-    that stopped it).  Runs in the child only; the satellites reached it by the fork (Satrec objects cannot be
-    pickled), only the result is pickled.  A search that spills (``args``' last, a SpilledPasses on a file the
-    parent made) writes its rows to that file and sends back only what orders them
-    (:meth:`SpilledPasses.keys`) and the satellites it left out."""
+    """A forked worker's whole life: the passes of the chunks it takes (``search(satellites, *args)``, the
+    one-process search of :mod:`~nfwserver.tracking.passes`; ``args[0]`` the :class:`_Pulled` chunks), sent back
+    through ``results`` (or the exception that stopped it, after telling the other workers to stop).  Runs in
+    the child only; the satellites reached it by the fork (Satrec objects cannot be pickled), only the result
+    is pickled.  A search that spills (``args``' last, a SpilledPasses on a file the parent made) writes its
+    rows to that file and sends back only what orders them (:meth:`SpilledPasses.keys`) and the satellites it
+    left out."""
     try:
-        results.send(_answer(search, satellites, args))
+        try:
+            outcome: object = _answer(search(satellites, *args))
+        except BaseException as exc:  # handed to the parent, which raises it
+            args[0].stop()
+            outcome = exc
+        results.send(outcome)
     finally:
         results.close()
 
 
-def _answer(search: Search, satellites: list[Any], args: tuple[Any, ...]) -> object:
-    """What a worker hands back (:func:`fork_worker`): its passes, the keys and skipped satellites of its
-    spilled rows, or the exception that stopped it (which the parent raises)."""
-    try:
-        found = search(satellites, *args)
-        return (found.keys(), found.skipped) if isinstance(found, SpilledPasses) else found
-    except BaseException as exc:
-        return exc
+def _answer(found: PassList | SpilledPasses) -> object:
+    """What a worker hands back of its passes ``found``: the passes, or the keys and skipped satellites of its
+    spilled rows."""
+    return (found.keys(), found.skipped) if isinstance(found, SpilledPasses) else found
 
 
 def in_forked_workers(search: Search, satellites: list[Any], plan: list[C], args: tuple[Any, ...], workers: int,
@@ -177,7 +185,12 @@ def in_forked_workers(search: Search, satellites: list[Any], plan: list[C], args
             sender.close()  # the child holds its own end: EOF here if it dies without an answer
             receivers.append(receiver)
             processes.append(process)
-        outcomes = [_answer(search, satellites, share(0))]
+        mine = share(0)
+        try:
+            outcomes = [_answer(search(satellites, *mine))]
+        except BaseException:
+            mine[0].stop()  # the children stop after their chunk (and are ended below)
+            raise
         for receiver, process in zip(receivers, processes):  # before joining: a large answer fills the pipe
             try:
                 outcomes.append(receiver.recv())

@@ -36,7 +36,7 @@ import threading
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -55,9 +55,6 @@ from nfwserver.tracking.pass_workers import in_forked_workers
 from nfwserver.tracking.screening import usable_models
 from nfwserver.tracking.timescale import julian_date
 
-if TYPE_CHECKING:  # multiprocessing is imported only when workers are forked (1.3 MiB, 5 ms)
-    pass
-
 __all__ = ["Pass", "PassList", "SpilledPasses", "find_passes", "find_passes_spilled"]
 
 _FLAT = HorizonTable()
@@ -71,6 +68,8 @@ _LOW_STEP_S, _SLOW_STEP_S, _OTHER_STEP_S = 1200.0, 3600.0, 1200.0
 _CHUNK = 200
 #: Brackets refined together (at least; a batch takes whole chunks): bounds the memory of one refinement.
 _BATCH_BRACKETS = 10000
+
+
 def find_passes(
     satellites: Sequence[Any],
     observer: Observer,

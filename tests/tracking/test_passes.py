@@ -164,28 +164,48 @@ print("same", len(serial))
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="fork")
-def test_a_failure_in_a_worker_process_reaches_the_caller() -> None:
-    """A worker that fails hands its exception back; the caller raises it (no hang, no silent gap)."""
+@pytest.mark.parametrize("where", ["child", "parent"])
+def test_a_failure_in_a_worker_process_reaches_the_caller_at_once(where) -> None:
+    """A worker whose search fails (here: a satellite whose model cannot be made, in a forked worker or in the
+    command's own process) ends the search with that exception: no hang, no silent gap, and the other worker
+    stops after the chunk it is on (at most 200 models made) instead of searching the rest alone (800 and
+    more: the code before did that)."""
     import subprocess
 
     script = """
-import sys
+import multiprocessing, os, sys
 from datetime import datetime, timedelta, timezone
 from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.observer import Observer
 from nfwserver.tracking.passes import find_passes
-sats = load_element_file(sys.argv[1]).sets[:500]
-sats[501 % 500] = object()  # in the second worker's share
+PARENT = os.getpid()
+made = multiprocessing.get_context("fork").Value("i", 0)  # models made, by either process
+
+class Failing:  # a set whose model fails in the chosen process only
+    def __init__(self, element_set):
+        self._set = element_set
+    def __getattr__(self, name):
+        return getattr(self._set, name)
+    def transient_satrec(self):
+        if (os.getpid() == PARENT) == (sys.argv[2] == "parent"):
+            raise RuntimeError("this model cannot be made")
+        with made.get_lock():
+            made.value += 1
+        return self._set.transient_satrec()
+
+sats = [Failing(s) for s in load_element_file(sys.argv[1]).sets[:1000]]
 start = datetime(2026, 5, 8, tzinfo=timezone.utc)
 try:
-    find_passes(sats, Observer(52.2, 0.12, 20.0), start, start + timedelta(hours=6), workers=2)
-except AttributeError as exc:
-    print("raised", exc)
+    find_passes(sats, Observer(52.2, 0.12, 20.0), start, start + timedelta(days=2), workers=2)
+except RuntimeError as exc:
+    print("raised", exc, "with models made:", made.value)
 """
-    done = subprocess.run([sys.executable, "-c", script, str(DATA / "active.txt")], capture_output=True, text=True,
-                          timeout=100)
+    done = subprocess.run([sys.executable, "-c", script, str(DATA / "active.txt"), where], capture_output=True,
+                          text=True, timeout=100)
     assert done.returncode == 0, done.stderr
-    assert done.stdout.startswith("raised "), done.stdout
+    said, _, made = done.stdout.strip().rpartition(" ")
+    assert said == "raised this model cannot be made with models made:", done.stdout
+    assert int(made) <= 200, done.stdout
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="fork")
