@@ -12,7 +12,7 @@ import os
 import sys
 import time
 from collections.abc import Callable, Iterator, Sequence, Sized
-from typing import IO, TYPE_CHECKING, Any, Generic, Protocol, TypeVar
+from typing import IO, TYPE_CHECKING, Any, Protocol
 
 from nfwserver.tracking.pass_spill import SpilledPasses
 
@@ -91,9 +91,6 @@ class ChunkWork(Protocol):
     def room(self) -> int: ...  # passes there can be
 
 
-C = TypeVar("C", bound=ChunkWork)
-
-
 def pull_order(plan: Sequence[ChunkWork], window_s: float) -> list[int]:
     """The order in which workers take the chunks of ``plan`` (indices): the most work first, so that the last
     chunks taken are small and the workers end together.  A chunk's work is counted as its coarse samples
@@ -103,14 +100,14 @@ def pull_order(plan: Sequence[ChunkWork], window_s: float) -> list[int]:
     return sorted(range(len(plan)), key=lambda i: -work[i])
 
 
-class _Pulled(Generic[C]):
+class _Pulled:
     """The chunks one worker searches: each taken, when the worker is ready for it, as the next of ``order``
     that no worker has taken yet (``taken``: a counter the forked workers share)."""
 
-    def __init__(self, plan: Sequence[C], order: list[int], taken: Synchronized[int]) -> None:
+    def __init__(self, plan: Sequence[ChunkWork], order: list[int], taken: Synchronized[int]) -> None:
         self.plan, self.order, self.taken = plan, order, taken
 
-    def __iter__(self) -> Iterator[C]:
+    def __iter__(self) -> Iterator[ChunkWork]:
         while True:
             with self.taken.get_lock():
                 k = self.taken.value
@@ -118,7 +115,6 @@ class _Pulled(Generic[C]):
             if k >= len(self.order):
                 return
             yield self.plan[self.order[k]]
-
 
     def stop(self) -> None:
         """Leave no chunk to take: every worker stops after the chunk it is searching (one has failed)."""
@@ -151,8 +147,8 @@ def _answer(found: PassList | SpilledPasses) -> object:
     return (found.keys(), found.skipped) if isinstance(found, SpilledPasses) else found
 
 
-def in_forked_workers(search: Search, satellites: list[Any], plan: list[C], args: tuple[Any, ...], workers: int,
-                      spills: Sequence[IO[bytes]] = ()) -> list[Any]:
+def in_forked_workers(search: Search, satellites: list[Any], plan: Sequence[ChunkWork], args: tuple[Any, ...],
+                      workers: int, spills: Sequence[IO[bytes]] = ()) -> list[Any]:
     """The passes of the chunks of ``plan`` found by ``workers`` processes running ``search`` (``search(satellites,
     chunks, room, *args)``): this one and ``workers - 1`` forked ones, in that order (POSIX: the caller checked
     that fork exists).  Each worker takes the next chunk (in :func:`pull_order`) when it is ready for one, and
