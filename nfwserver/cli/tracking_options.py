@@ -40,12 +40,12 @@ class TrackingInputs:
     def config(self) -> Config:
         """The configuration (``--config FILE``, else the user's, else the built-in defaults), read once."""
         if self._config is None:
-            if "_file_in_use" in self.__dict__ and not self._file_in_use:  # decided once: no file, the defaults
+            if self._file_in_use:
+                self._config = _load_config(self._args)
+            else:  # the built-in defaults (the file's absence decided once, for :meth:`setting` too)
                 from nfwserver.config.schema import Config
 
                 self._config = Config()
-            else:
-                self._config = _load_config(self._args)
         return self._config
 
     def setting(self, section: str, key: str) -> Any:
