@@ -41,7 +41,7 @@ class TrackingInputs:
         """The configuration (``--config FILE``, else the user's, else the built-in defaults), read once."""
         if self._config is None:
             if self._file_in_use:
-                self._config = _load_config(self._args)
+                self._config = load_config_or_fail(getattr(self._args, "config", None))
             else:  # the built-in defaults (the file's absence decided once, for :meth:`setting` too)
                 from nfwserver.config.schema import Config
 
@@ -191,11 +191,6 @@ def config_file(config: Config) -> str:
     from nfwserver.config import default_config_path
 
     return str(default_config_path())
-
-
-def _load_config(args: argparse.Namespace) -> Config:
-
-    return load_config_or_fail(getattr(args, "config", None))
 
 
 def _catalog_from_files(paths: list[str], inputs: TrackingInputs) -> Catalog:
