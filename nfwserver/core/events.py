@@ -106,13 +106,19 @@ class EventLog:
 
         A reader that passes the seq of the last event it took each time takes every event once, however
         slowly it reads, as long as it is less than ``capacity`` events behind.  Costs O(events above
-        ``after``), not O(capacity)."""
+        ``after`` still held), not O(capacity), in C: the ring's seqs are consecutive, so how many events are
+        newer is known from the newest one's."""
         with self._lock:
-            newer = list(itertools.takewhile(lambda e: e.seq > after, reversed(self._events)))
-        if not newer:
-            return [], 0
-        newer.reverse()
-        return newer[:max(0, limit)], newer[0].seq - after - 1
+            if not self._events:
+                return [], 0
+            newest = self._events[-1].seq
+            held = min(newest - after, len(self._events))  # events above ``after`` in the ring
+            if held <= 0:
+                return [], 0
+            # walked from the newest end: the ``held`` newest, of which the oldest ``limit`` are taken
+            picked = list(itertools.islice(reversed(self._events), max(0, held - max(0, limit)), held))
+        picked.reverse()
+        return picked, (newest - held + 1) - after - 1
 
     def __len__(self) -> int:
         return len(self._events)
