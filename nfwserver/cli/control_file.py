@@ -47,12 +47,13 @@ class ControlFile(ServiceThread):
     thread_name = "nfw-control"
 
     def __init__(self, path: Path, clock: Clock, request: Callable[[str, str], None],
-                 interval_s: float = POLL_S) -> None:
+                 interval_s: float = POLL_S, each_look: Callable[[], None] | None = None) -> None:
         super().__init__()
         self.path = path
         self.clock = clock
         self.request = request
         self.interval_s = interval_s
+        self.each_look = each_look  #: also called at every look (the station's description, written again)
 
     def start(self) -> None:
         """Remove a file left by an earlier run (it was meant for that run), then watch."""
@@ -87,5 +88,7 @@ class ControlFile(ServiceThread):
         while not self.clock.wait(self._stop, self.interval_s):
             try:
                 self.check()
+                if self.each_look is not None:
+                    self.each_look()
             except Exception:  # the watcher must outlive any surprise
                 log.exception("checking the control file failed")

@@ -219,7 +219,8 @@ def _listen(plan: RunPlan, requests: _Requests, clock: Clock,
     signals = StationSignals(signal_actions(headless=not plan.console), requests.on_stop, requests.on_reload)
     signals.install()
     path = control_path() or (channel.default_control if channel is not None else None)
-    control = ControlFile(path, clock, signals.request) if path is not None else None
+    again = channel.describe_again if channel is not None else None
+    control = ControlFile(path, clock, signals.request, each_look=again) if path is not None else None
     if control is not None:
         control.start()
     if channel is not None and control is not None:

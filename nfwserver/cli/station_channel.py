@@ -95,6 +95,7 @@ class StationChannel:
         self.info_path = self.directory / INFO_NAME
         self._lock = _Lock(self.lock_path)
         self._describe_failed = False
+        self._description: StationInfo | None = None  # the last one asked for (written again until it is)
 
     @property
     def default_control(self) -> Path:
@@ -116,6 +117,7 @@ class StationChannel:
     def describe(self, info: StationInfo) -> None:
         """Write ``station.json`` (atomically); only while this process holds the lock.  On Windows the
         replace fails while a reader has the old file open: it is tried again for up to a second."""
+        self._description = info
         record = {"pid": info.pid, "control": str(info.control), "web": info.web_url, "started": info.started}
         problem: OSError | None = None
         for _ in range(20):
@@ -133,8 +135,15 @@ class StationChannel:
                 break
         if not self._describe_failed:  # once per episode: the station runs on without it
             log.warning("cannot write the station's description %s (%s): `nfwserver stop` and `nfwserver "
-                        "dashboard` will not find this station until it can", self.info_path, problem)
+                        "dashboard` will not find this station until it can (tried again every few tenths of a "
+                        "second)", self.info_path, problem)
         self._describe_failed = True
+
+    def describe_again(self) -> None:
+        """Write the last description again if writing it failed (the control file's watcher calls this at each
+        look, so the station is found again as soon as the file can be written); nothing otherwise."""
+        if self._describe_failed and self._description is not None:
+            self.describe(self._description)
 
     def release(self) -> None:
         """Remove the description, then free the lock (the order a waiting ``stop`` relies on)."""

@@ -68,13 +68,20 @@ def test_the_control_file_asks_for_reload_and_stop_and_is_removed(tmp_path: Path
     path = tmp_path / "control"
     assert control_path({"NFW_CONTROL_FILE": str(path)}) == path and control_path({}) is None
     got: list[tuple[str, str]] = []
-    control = ControlFile(path, SystemClock(), lambda word, origin: got.append((word, origin)), interval_s=0.01)
+    looks = [0]  # each_look's calls: one per look
+
+    def looked() -> None:
+        looks[0] += 1
+
+    control = ControlFile(path, SystemClock(), lambda word, origin: got.append((word, origin)), interval_s=0.01,
+                          each_look=looked)
     path.write_text("stop\n")  # left by an earlier run: removed at start, never acted on
     control.start()
     try:
         assert not path.exists()
-        path.write_text("")  # being written: left alone
-        time.sleep(0.05)
+        path.write_text("")  # being written: left alone, look after look
+        seen = looks[0]
+        assert wait_for(lambda: looks[0] >= seen + 3)
         assert path.exists() and got == []
         path.write_text("RELOAD\n")
         assert wait_for(lambda: len(got) == 1) and not path.exists()

@@ -242,8 +242,11 @@ def test_a_description_that_cannot_be_written_is_said_once_and_again_when_it_can
         warnings = [r for r in caplog.records if r.levelno == logging.WARNING]
         assert len(warnings) == 1 and "cannot write the station's description" in warnings[0].getMessage()
         channel.info_path.rmdir()
-        channel.describe(StationInfo(os.getpid(), tmp_path / "control"))
+        channel.describe_again()  # what the control file's watcher calls at each look
         assert json.loads(channel.info_path.read_text())["pid"] == os.getpid()
         assert "is written again" in caplog.text
+        channel.info_path.unlink()
+        channel.describe_again()  # written: nothing to do
+        assert not channel.info_path.exists()
     finally:
         channel.release()
