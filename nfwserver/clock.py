@@ -81,16 +81,9 @@ class VirtualClock:
         with self._lock:
             return self._start + timedelta(seconds=self._elapsed)
 
-    @property
-    def waiting(self) -> int:
-        """How many threads are in :meth:`wait` for a moment still ahead of the clock: settled until the clock is
-        advanced again.  A test that advances the clock waits for a loop to get there instead of pausing for it
-        (:meth:`is_waiting` names the loop's thread)."""
-        with self._lock:
-            return sum(deadline > self._elapsed for _, deadline in self._deadlines)
-
     def is_waiting(self, thread: threading.Thread | None) -> bool:
-        """Whether ``thread`` is in :meth:`wait` for a moment still ahead of the clock."""
+        """Whether ``thread`` is in :meth:`wait` for a moment still ahead of the clock: settled until the clock is
+        advanced again.  A test that advances the clock waits for a loop to get there instead of pausing for it."""
         ident = None if thread is None else thread.ident
         with self._lock:
             return any(who == ident and deadline > self._elapsed for who, deadline in self._deadlines)

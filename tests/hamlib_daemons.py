@@ -74,9 +74,14 @@ class HamlibDaemon:
         for _attempt in range(5):
             cmd = [self.program, "-m", str(self.model), "-T", self.host, "-t", str(self.port), *self.extra]
             proc = self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-            outcome = wait_for(lambda proc=proc: "exited" if proc.poll() is not None else self._accepting(),
-                               max(0.0, deadline - time.monotonic()), f"{' '.join(cmd)} to listen",
-                               interval_s=0.02)
+            try:
+                outcome = wait_for(lambda proc=proc: "exited" if proc.poll() is not None else self._accepting(),
+                                   max(0.0, deadline - time.monotonic()), f"{' '.join(cmd)} to listen",
+                                   interval_s=0.02)
+            except BaseException:  # not listening in time: no daemon left behind
+                proc.kill()
+                proc.wait()
+                raise
             if outcome == "listening":
                 self._started_once = True
                 return self

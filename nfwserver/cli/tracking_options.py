@@ -13,6 +13,7 @@ import argparse
 import logging
 from datetime import datetime, timezone
 from functools import cached_property
+from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
 from nfwserver.cli.arguments import number_in, observer_value, parse_time_text
@@ -59,10 +60,7 @@ class TrackingInputs:
         entry = setting(section, key)
         if self._config is None and entry.default is not None and not self._file_in_use:
             return default(section, key)
-        value: Any = self.config()
-        for name in entry.where.split("."):
-            value = getattr(value, name)
-        return value
+        return attrgetter(entry.where)(self.config())
 
     @cached_property
     def _file_in_use(self) -> bool:

@@ -4,7 +4,7 @@ when there is one, else the table's defaults, which must be exactly what the bui
 from __future__ import annotations
 
 import argparse
-from typing import Any
+from operator import attrgetter
 
 import pytest
 
@@ -24,19 +24,12 @@ def user_file_here(tmp_path, monkeypatch) -> None:
         monkeypatch.setattr(module, "default_config_path", lambda: path)
 
 
-def _at(config: Config, where: str) -> Any:
-    value: Any = config
-    for name in where.split("."):
-        value = getattr(value, name)
-    return value
-
-
 @pytest.mark.parametrize("entry", [s for s in SETTINGS if s.where.split(".")[0] in Config.__dataclass_fields__],
                          ids=lambda s: s.name)
 def test_without_a_file_each_setting_is_the_built_in_configurations(entry) -> None:
     assert not nfwserver.config.files.default_config_path().exists()
     inputs = TrackingInputs(argparse.Namespace(config=None))
-    assert inputs.setting(entry.section, entry.key) == _at(Config(), entry.where)
+    assert inputs.setting(entry.section, entry.key) == attrgetter(entry.where)(Config())
     # the configuration was built only for a key without a default (the observer's Greenwich, the flat horizon)
     assert (inputs._config is None) == (entry.default is not None)
 

@@ -36,7 +36,7 @@ def kill_session(proc: subprocess.Popen, timeout_s: float = 30.0) -> None:
 
     Reading /proc and signalling are not one step: a member may start another process in between (``timeout``
     starting the program, a launcher starting ``wine``), which a single pass would leave running.  So the
-    session is read and killed again until no live member is left (or ``timeout_s`` passes: RuntimeError).
+    session is read and killed again until no live member is left (or ``timeout_s`` passes: WaitTimeout).
     """
     def emptied() -> bool:
         members = session_members(proc.pid)
