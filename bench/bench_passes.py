@@ -125,8 +125,11 @@ def _one_satellite(folder: Path) -> dict[str, tuple[float, float, int]]:
     iss = folder / "iss.txt"
     iss.write_text("\n".join(lines[k : k + 3]) + "\n")
     sat = ("--sat", "ISS")
+    config = folder / "station.toml"  # a station's configuration (what a user who runs the station has)
+    config.write_text('[observer]\nlocation = "JO02ae"\n\n[elements]\nstale_days = 14\n')
     result = _alternate({"ours table": _ours(iss, "table", extra=sat), "skyfield table": _skyfield(iss, "table"),
-                         "ours csv": _ours(iss, "csv", extra=sat), "skyfield csv": _skyfield(iss, "csv")},
+                         "ours csv": _ours(iss, "csv", extra=sat), "skyfield csv": _skyfield(iss, "csv"),
+                         "ours csv config": _ours(iss, "csv", extra=(*sat, "--config", str(config)))},
                         max(REPEAT, 9))
     return result
 
@@ -139,6 +142,9 @@ def main() -> None:
     folder = ROOT / "bench" / "results"
     folder.mkdir(exist_ok=True)
     subprocess.run([sys.executable, "-m", "compileall", "-q", "nfwserver", "bench"], cwd=ROOT, check=True)
+    no_config = folder / "no-config"  # no user configuration file: the built-in defaults (one row gives --config)
+    no_config.mkdir(exist_ok=True)
+    os.environ["XDG_CONFIG_HOME"] = str(no_config)
     load_before = os.getloadavg()[0]
     one = _one_satellite(folder)
     print(f"  one satellite: {one}", file=sys.stderr)
@@ -166,7 +172,7 @@ def main() -> None:
     startup = _startup()
     load_after = os.getloadavg()[0]
     n_all = len(ACTIVE.read_text().splitlines()) // 3
-    from nfwserver.tracking.pass_workers import auto_workers
+    from nfwserver.cli.search_workers import auto_workers
 
     auto_now = auto_workers(n_all)  # what `--workers auto` would choose at the end
     _report(one, vs, events, whole, week, sky_whole, startup, n_all, auto_now, load_before, load_after)
@@ -190,9 +196,10 @@ def _report(one: dict, vs: dict, events: tuple, whole: dict, week: dict, sky_who
           "and LOS of passes cut by the window (outside it), skyfield leaves them empty. FILE is the first "
           "2,000 objects of tests/data/active.txt (or all of them); the programs alternate in one run; "
           f"median of {REPEAT} wall times (9 for one satellite), peak RSS the largest of each run's `wait4` "
-          f"maximum resident set. Load average (1 min) {load_before:.1f} at the start, {load_after:.1f} at the "
-          f"end, {os.cpu_count()} cores shared with other work (`--workers auto` chose {auto_now} worker(s) "
-          "for the whole catalog at the end).\n")
+          f"maximum resident set. No user configuration file (`XDG_CONFIG_HOME` an empty folder), except in "
+          f"the row that gives `--config`. Load average (1 min) {load_before:.1f} at the start, "
+          f"{load_after:.1f} at the end, {os.cpu_count()} cores (`--workers auto` would choose {auto_now} "
+          "worker(s) for the whole catalog at the end).\n")
     print("| one satellite x 24 h (`--sat ISS`, a file holding ISS) | nfwserver | skyfield | ratio | peak RSS "
           "nfwserver / skyfield |")
     print("|---|---|---|---|---|")
@@ -200,6 +207,9 @@ def _report(one: dict, vs: dict, events: tuple, whole: dict, week: dict, sky_who
         (o, o_rss, _), (k, k_rss, _) = one[f"ours {fmt}"], one[f"skyfield {fmt}"]
         label = "the 80-column table (skyfield: its table)" if fmt == "table" else "`--format csv`"
         print(f"| {label} | {o * 1e3:.0f} ms | {k * 1e3:.0f} ms | **{k / o:.2f}x** | {o_rss:.0f} / {k_rss:.0f} MiB |")
+    (o, o_rss, _), (k, k_rss, _) = one["ours csv config"], one["skyfield csv"]
+    print(f"| `--format csv` with a configuration file (`--config`: the configuration is read and built) | "
+          f"{o * 1e3:.0f} ms | {k * 1e3:.0f} ms | {k / o:.2f}x | {o_rss:.0f} / {k_rss:.0f} MiB |")
     print("\n| 2,000 satellites x 24 h | nfwserver | skyfield | ratio | peak RSS nfwserver / skyfield | rows "
           "nfwserver / skyfield |")
     print("|---|---|---|---|---|---|")

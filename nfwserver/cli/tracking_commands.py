@@ -219,8 +219,8 @@ def _find_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: list[An
     caller deletes), the name and the DDE name (at most 12 characters; only for the compact table, which alone
     shows them) to show for each satellite that has one (by catalog number), and how many satellites were
     searched."""
+    from nfwserver.cli.search_workers import auto_workers
     from nfwserver.tracking.pass_records import PassList
-    from nfwserver.tracking.pass_workers import auto_workers
     from nfwserver.tracking.passes import find_passes, find_passes_spilled
 
     start = args.start

@@ -1,5 +1,5 @@
-"""Worker processes for large pass searches: how many pay (``--workers auto``), how the search's chunks are
-shared among them, and the forked processes themselves.
+"""Worker processes for large pass searches: how the search's chunks are shared among them, and the forked
+processes themselves (how many pay is the command's choice: :mod:`nfwserver.cli.search_workers`).
 
 Each worker searches whole chunks of the one-process search's plan (:mod:`~nfwserver.tracking.passes`) exactly as
 one process would, so any number of workers finds the same passes, bit for bit.  Workers are forked (POSIX): the
@@ -8,9 +8,7 @@ satellites' SGP4 models reach them with the fork (they cannot be pickled) and on
 
 from __future__ import annotations
 
-import os
 import sys
-import time
 from collections.abc import Callable, Iterator, Sequence, Sized
 from typing import IO, TYPE_CHECKING, Any, Protocol
 
@@ -27,57 +25,6 @@ Search = Callable[..., "PassList | SpilledPasses"]
 #: Work of one possible pass in coarse samples, for sharing chunks among workers (refining a pass costs ~15
 #: times a coarse sample; ``room`` counts every pass an orbit could give, of which about half are seen).
 _PASS_WORK = 8.0
-#: Fewest satellites for which :func:`auto_workers` forks (below, forking and gathering cost about what they save).
-AUTO_WORKERS_FROM = 1000
-#: Most worker processes :func:`auto_workers` chooses.
-AUTO_WORKERS_MAX = 8
-#: Readings of the running processes :func:`busy_cores` takes, and the pause between them (s).
-_BUSY_READINGS, _BUSY_GAP_S = 3, 0.003
-
-
-def auto_workers(satellites: int) -> int:
-    """Worker processes that pay for a search of ``satellites`` here and now: one per core not already busy
-    (the cores this process may use less :func:`busy_cores`), from :data:`AUTO_WORKERS_FROM` satellites; 1 on
-    Windows (no fork).  Any number gives the same passes, bit for bit."""
-    if satellites < AUTO_WORKERS_FROM or sys.platform == "win32":
-        return 1
-    cores = os.cpu_count() or 1
-    if sys.platform == "linux":
-        cores = len(os.sched_getaffinity(0))  # the cores this process may run on
-    return max(1, min(cores - busy_cores(), AUTO_WORKERS_MAX))
-
-
-def busy_cores(readings: Sequence[str] | None = None) -> int:
-    """Cores other processes keep busy now.  On Linux, the most processes found running besides this one in three
-    readings of ``/proc/loadavg``'s fourth field a few milliseconds apart (``readings``: those texts); elsewhere,
-    or when it cannot be read, the 1-minute load average.  The average lags by a minute: a command run right
-    after another heavy one (a script running several searches in a row) would see its predecessor's load and
-    give up cores that are idle now, and one run just after a heavy job started would take cores that are not;
-    three readings keep a process that is runnable most of the time from being missed."""
-    if sys.platform == "win32":  # no load average (and no fork: auto_workers chooses 1 there)
-        return 0
-    if readings is None:
-        readings = []
-        for k in range(_BUSY_READINGS):
-            try:
-                with open("/proc/loadavg", encoding="ascii") as f:
-                    readings.append(f.read())
-            except OSError:
-                break
-            if k + 1 < _BUSY_READINGS:
-                time.sleep(_BUSY_GAP_S)
-    running = []
-    for text in readings:
-        try:
-            running.append(int(text.split()[3].split("/")[0]) - 1)
-        except (IndexError, ValueError):
-            break
-    else:
-        if running:
-            return max(0, max(running))
-    return int(os.getloadavg()[0])
-
-
 class ChunkWork(Protocol):
     """What :func:`pull_order` reads of a chunk of the search's plan (``passes._Chunk``)."""
 

@@ -8,6 +8,7 @@ import sys
 
 import pytest
 
+from nfwserver.cli import search_workers
 from nfwserver.tracking import pass_workers
 from tests.conftest import DATA, ROOT
 
@@ -30,35 +31,35 @@ def test_one_two_and_three_workers_write_the_same_bytes(tmp_path) -> None:
 
 
 def test_auto_forks_only_for_large_searches_and_idle_cores(monkeypatch) -> None:
-    assert pass_workers.auto_workers(pass_workers.AUTO_WORKERS_FROM - 1) == 1
+    assert search_workers.auto_workers(search_workers.AUTO_WORKERS_FROM - 1) == 1
     if sys.platform == "win32":
-        assert pass_workers.auto_workers(20_000) == 1
+        assert search_workers.auto_workers(20_000) == 1
         return
     cores = len(os.sched_getaffinity(0)) if sys.platform == "linux" else os.cpu_count()
-    monkeypatch.setattr(pass_workers, "busy_cores", lambda: 0)
-    assert pass_workers.auto_workers(20_000) == min(cores, pass_workers.AUTO_WORKERS_MAX)
-    monkeypatch.setattr(pass_workers, "busy_cores", lambda: cores)  # every core busy already
-    assert pass_workers.auto_workers(20_000) == 1
+    monkeypatch.setattr(search_workers, "busy_cores", lambda: 0)
+    assert search_workers.auto_workers(20_000) == min(cores, search_workers.AUTO_WORKERS_MAX)
+    monkeypatch.setattr(search_workers, "busy_cores", lambda: cores)  # every core busy already
+    assert search_workers.auto_workers(20_000) == 1
 
 
 def test_busy_cores_counts_what_runs_now_not_what_ran_a_minute_ago(monkeypatch) -> None:
     """The load average lags: right after another search it still counts that search's core, and just after a
     heavy job started it does not count it yet.  What runs now counts, the most of three readings."""
     monkeypatch.setattr(os, "getloadavg", lambda: (1.9, 1.2, 0.8))
-    assert pass_workers.busy_cores(["1.90 1.20 0.80 1/80 4242\n"] * 3) == 0  # only this process runs now
-    assert pass_workers.busy_cores(["1.90 1.20 0.80 2/80 4242\n", "1.90 1.20 0.80 1/80 4242\n"]) == 1
+    assert search_workers.busy_cores(["1.90 1.20 0.80 1/80 4242\n"] * 3) == 0  # only this process runs now
+    assert search_workers.busy_cores(["1.90 1.20 0.80 2/80 4242\n", "1.90 1.20 0.80 1/80 4242\n"]) == 1
     monkeypatch.setattr(os, "getloadavg", lambda: (0.1, 0.0, 0.0))
     readings = ["0.10 0.00 0.00 1/80 1\n", "0.10 0.00 0.00 3/80 1\n", "0.10 0.00 0.00 2/80 1\n"]
-    assert pass_workers.busy_cores(readings) == 2
+    assert search_workers.busy_cores(readings) == 2
     monkeypatch.setattr(os, "getloadavg", lambda: (2.4, 1.2, 0.8))
-    assert pass_workers.busy_cores(["not a loadavg line"]) == 2  # unreadable: the average
-    assert pass_workers.busy_cores([]) == 2
+    assert search_workers.busy_cores(["not a loadavg line"]) == 2  # unreadable: the average
+    assert search_workers.busy_cores([]) == 2
     if sys.platform == "linux":  # the live file is read, not the average (which would raise here)
         def no_average() -> tuple[float, float, float]:
             raise AssertionError("the load average was read instead of /proc/loadavg")
 
         monkeypatch.setattr(os, "getloadavg", no_average)
-        assert pass_workers.busy_cores() >= 0
+        assert search_workers.busy_cores() >= 0
 
 
 def test_workers_option_takes_auto_or_a_whole_number(capsys) -> None:
