@@ -6,6 +6,8 @@ of any of these values is a bug (the acceptance check greps for them).
 
 from __future__ import annotations
 
+import math
+
 #: Speed of light in vacuum (km/s), exact by definition of the metre.
 SPEED_OF_LIGHT_KM_S = 299_792.458
 
@@ -37,3 +39,5 @@ DAYS_PER_JULIAN_CENTURY = 36_525.0
 JD_J2000 = 2_451_545.0
 #: Earth rotations per UT1 day relative to the mean equinox (IAU 1982 GMST rate at J2000).
 SIDEREAL_TURNS_PER_UT1_DAY = 1.00273790935
+#: The Earth's rotation rate (rad/s) relative to the mean equinox: 7.2921e-5.
+EARTH_ROTATION_RAD_S = 2.0 * math.pi * SIDEREAL_TURNS_PER_UT1_DAY / SECONDS_PER_DAY

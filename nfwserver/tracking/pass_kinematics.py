@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from nfwserver.tracking.constants import SECONDS_PER_DAY, SIDEREAL_TURNS_PER_UT1_DAY, WGS72_MU_KM3_S2
+from nfwserver.tracking.constants import EARTH_ROTATION_RAD_S, SECONDS_PER_DAY, WGS72_MU_KM3_S2
 from nfwserver.tracking.frames import TopocentricFrame
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer
@@ -35,7 +35,7 @@ _ACC_REL = 6e-3
 #: short-period terms are not differentiated exactly): measured up to 2.1 m/s over the catalog.
 _VEL_ERR_KM_S = 3e-3
 #: The Earth's rotation rate (rad/s), for the centrifugal and Coriolis terms of the acceleration.
-_OMEGA = 2.0 * np.pi * SIDEREAL_TURNS_PER_UT1_DAY / SECONDS_PER_DAY
+_OMEGA = EARTH_ROTATION_RAD_S
 
 
 @dataclass

@@ -11,8 +11,8 @@ The plane is fixed by SGP4 every :data:`PLANE_STEP_S` seconds (a handful of prop
 of one per coarse grid point); between those samples its unit normal is interpolated linearly.  The
 osculating plane departs from that interpolation by J2's short-period terms: measured at most 0.042 deg
 over a week, every 97 s, with samples 12 h apart, for the 14,538 near-Earth orbits with ``e < 0.1`` of
-tests/data/active.txt (tests/tracking/test_pass_plane.py measures it again); :data:`PLANE_SLACK_RAD` allows
-0.5 deg.  Within an
+tests/data/active.txt (tests/tracking/test_pass_plane.py checks 300 of them, every 300 s, against a fifth
+of the allowance); :data:`PLANE_SLACK_RAD` allows 0.5 deg.  Within an
 interval the observer's direction moves by at most the Earth's rotation rate times the cosine of its
 geocentric latitude, and the plane by its sampled turning rate.
 
@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from nfwserver.tracking.constants import SECONDS_PER_DAY, WGS72_MU_KM3_S2
+from nfwserver.tracking.constants import EARTH_ROTATION_RAD_S, SECONDS_PER_DAY, WGS72_MU_KM3_S2
 from nfwserver.tracking.timescale import gmst1982
 
 if TYPE_CHECKING:
@@ -41,8 +41,8 @@ PLANE_STEP_S = 12.0 * 3600.0
 PLANE_SLACK_RAD = math.radians(0.5)
 #: Largest mean eccentricity judged here (the screen's rate bound for a partly sampled orbit assumes it).
 MAX_ECCENTRICITY = 0.01
-#: The Earth's rotation rate (rad/s), generously rounded up.
-EARTH_RATE = 7.3e-5
+#: The Earth's rotation rate (rad/s) rounded up (7.3e-5), for bounds.
+EARTH_RATE = math.ceil(EARTH_ROTATION_RAD_S * 1e7) / 1e7
 #: Relative allowance on the apogee radius (short-period terms) and an absolute one (km).
 _RADIUS_SLACK, _RADIUS_SLACK_KM = 1.01, 20.0
 #: Largest relative spread of the osculating semi-major axes at the samples of an orbit judged here.

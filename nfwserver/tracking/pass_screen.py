@@ -1,6 +1,8 @@
 """Pass search, stage 1: screen a catalog on a coarse grid and bracket every event.
 
-Every satellite is propagated on a common coarse grid (``SatrecArray``, one compiled call).  From
+Every satellite is propagated on a common coarse grid (``SatrecArray``, one compiled call), except, under a
+flat horizon, the near-circular low orbits whose planes prove most intervals invisible beforehand
+(:mod:`~nfwserver.tracking.pass_plane`): those are propagated only at the ends of the intervals left.  From
 the Earth-central angle between the observer and the satellite, the largest angle at which it
 can be above the lowest horizon point, and a bound on how fast that margin can shrink (the
 satellite's angular rate plus the change of the visibility limit with height), each coarse
