@@ -31,6 +31,11 @@ def above(cols: dict[str, np.ndarray], min_el: float) -> dict[str, np.ndarray]:
     return {key: value[keep] for key, value in cols.items()}
 
 
+def name_column(numbers: np.ndarray, names: Mapping[int, str]) -> Text:
+    """The names of ``numbers`` (catalog numbers, ascending) as the rows' ``name`` column takes them."""
+    return Text("name", [names[n] for n in numbers.tolist()])
+
+
 def wide_columns(start: datetime, cols: dict[str, np.ndarray], numbers: np.ndarray, names: Text) -> list[Column]:
     """The every-column rows of the passes ``cols`` (PassList columns, times after ``start``); ``numbers``:
     every catalog number with a pass, ascending, ``names`` theirs (a column of one name each, in that order)."""
@@ -50,7 +55,7 @@ def write_spilled(passes: SpilledPasses, start: datetime, min_el: float, names: 
     """Write ``passes`` (``names``: the name of each catalog number with a pass) as ``fmt`` (CSV or JSON), those
     reaching ``min_el`` deg, a slab at a time."""
     numbers = np.array(sorted(names), dtype=np.int64)
-    shown = Text("name", [names[n] for n in numbers.tolist()])
+    shown = name_column(numbers, names)
     writer = RowWriter(column_names, fmt, out)
     for slab in passes.slabs(SLAB_ROWS):
         writer.write(wide_columns(start, above(slab.columns, min_el), numbers, shown))

@@ -181,8 +181,7 @@ def _run_catalog_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: 
     import numpy as np
 
     from nfwserver.cli.bulk_output import write_rows
-    from nfwserver.cli.output_columns import Text
-    from nfwserver.cli.pass_rows import above, wide_columns, write_spilled
+    from nfwserver.cli.pass_rows import above, name_column, wide_columns, write_spilled
     from nfwserver.cli.pass_table import compact_columns
     from nfwserver.tracking.pass_records import PassList
 
@@ -208,8 +207,7 @@ def _run_catalog_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: 
                                    np.searchsorted(numbers, cols["catalog_number"]), args.local), "table", sys.stdout)
         return 0
     wide_table_local_note(args)
-    write_rows(wide_columns(start, cols, numbers, Text("name", [names[n] for n in numbers.tolist()])), args.format,
-               sys.stdout)
+    write_rows(wide_columns(start, cols, numbers, name_column(numbers, names)), args.format, sys.stdout)
     return 0
 
 

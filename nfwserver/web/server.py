@@ -62,7 +62,6 @@ from nfwserver.web.station_parts import (
     EventFollower,
     LogCursor,
     clients_part,
-    event_json,
     links_part,
     radio_part,
     rotor_part,
@@ -284,11 +283,8 @@ class WebServer:
         if self.stats.streams == 0:  # no frame thread at work: this request's own, from the live state
             self._safe_frame()
         frame = dict(self._latest)
-        frame["log"], frame["log_skipped"] = self.history(), 0
+        frame["log"], frame["log_skipped"] = LogCursor(self.core.events).history(HISTORY_EVENTS), 0
         return json.dumps(frame, allow_nan=False, default=str).encode()
-
-    def history(self) -> list[dict[str, object]]:
-        return [event_json(e) for e in self.core.events.recent(HISTORY_EVENTS)]
 
     def page_log(self) -> tuple[LogCursor, list[dict[str, object]]]:
         """A new page's place in the log, just past its history (the last :data:`HISTORY_EVENTS` lines):

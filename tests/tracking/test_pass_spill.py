@@ -13,7 +13,6 @@ import pytest
 import nfwserver.cli.pass_rows as pass_rows
 from nfwserver.cli import main
 from nfwserver.cli.bulk_output import write_rows
-from nfwserver.cli.output_columns import Text
 from nfwserver.cli.pass_reports import PASS_COLUMNS
 from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.observer import Observer
@@ -116,8 +115,8 @@ def test_passes_written_a_slab_at_a_time_are_the_whole_lists_bytes(capsys, monke
     numbers = np.array(found.catalog_numbers(), dtype=np.int64)
     names = {s.catalog_number: s.name for s in sets}
     whole = io.StringIO()
-    shown = Text("name", [names[n] for n in numbers.tolist()])
-    write_rows(pass_rows.wide_columns(START, found.columns, numbers, shown), fmt, whole)
+    write_rows(pass_rows.wide_columns(START, found.columns, numbers, pass_rows.name_column(numbers, names)), fmt,
+               whole)
     assert len(found) > 5 * 97
     assert written == whole.getvalue()
 
