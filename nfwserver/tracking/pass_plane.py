@@ -67,7 +67,7 @@ def plane_geometry(satrecs: list[Any], origin: np.ndarray, e_lo: float, jd0: flo
     ``jd0 + fr0``) for an observer at Earth-fixed ``origin`` (km) and the elevation ``e_lo`` (rad); None when none
     can be judged."""
     if not satrecs or not hasattr(satrecs[0], "_sgp4") or len(grid) < 2:
-        return None  # sgp4's pure-Python model (no SatrecArray): the screen judges every interval
+        return None  # sgp4's pure-Python model (no compiled _sgp4 to call): the screen judges every interval
     judged = np.array([getattr(sr, "method", "d") == "n" and sr.ecco < MAX_ECCENTRICITY for sr in satrecs])
     if not judged.any():
         return None

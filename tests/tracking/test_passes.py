@@ -168,8 +168,8 @@ print("same", len(serial))
 def test_a_failure_in_a_worker_process_reaches_the_caller_at_once(where) -> None:
     """A worker whose search fails (here: a satellite whose model cannot be made, in a forked worker or in the
     command's own process) ends the search with that exception: no hang, no silent gap, and the other worker
-    stops after the chunk it is on (at most 200 models made) instead of searching the rest alone (800 and
-    more: the code before did that)."""
+    stops after the chunk it is on (200 models; 400 if it had taken a second one before the failure was known)
+    instead of searching the rest alone (800: the code before did that)."""
     import subprocess
 
     script = """
@@ -205,7 +205,7 @@ except RuntimeError as exc:
     assert done.returncode == 0, done.stderr
     said, _, made = done.stdout.strip().rpartition(" ")
     assert said == "raised this model cannot be made with models made:", done.stdout
-    assert int(made) <= 200, done.stdout
+    assert int(made) <= 400, done.stdout
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="fork")
