@@ -2,8 +2,9 @@
 
 The station is the real process (``python -m nfwserver run --headless --config FILE``: ISS selected, TUNE ON,
 the default 5 Hz).  Its clients run in other processes, as real clients do: 1, 10 and 100 TCP ``WATCH`` clients,
-then 1, 10 and 50 event streams (``GET /api/stream``, what a browser's page holds open).  For each, over
-:data:`SECONDS` seconds after a second of warm-up:
+then 1, 10 and 50 event streams (``GET /api/stream``, what a browser's page holds open; each from an address of its
+own, 127.0.1.x, as browsers on other machines: the web server serves at most 16 connections from one
+address).  For each, over :data:`SECONDS` seconds after a second of warm-up:
 
 - delivery latency: from the tick's instant (the time its web frame carries, in milliseconds) to the arrival of
   its line (TCP) or frame (web) at each client, p50 and p99 over every client and tick.  A TCP line is matched
@@ -44,8 +45,10 @@ def _free_port() -> int:
         return int(s.getsockname()[1])
 
 
-def _stream(host: str, port: int) -> socket.socket:
-    sock = socket.create_connection((host, port))
+def _stream(host: str, port: int, source: str | None = None) -> socket.socket:
+    """An event stream of the page, from the address ``source`` (a browser of its own: the web server serves at
+    most 16 connections from one address)."""
+    sock = socket.create_connection((host, port), source_address=(source, 0) if source else None)
     sock.sendall(f"GET /api/stream HTTP/1.0\r\nHost: {host}:{port}\r\n\r\n".encode())
     sock.setblocking(False)
     return sock
@@ -71,13 +74,13 @@ def client_process(kind: str, host: str, tcp_port: int, web_port: int, n: int) -
     "ready"; records from a "start" line on stdin until a "stop" line, then prints the latencies (ms) and each
     client's count of ticks received, as JSON."""
     socks = []
-    for _ in range(n):
+    for i in range(n):
         if kind == "tcp":
             sock = socket.create_connection((host, tcp_port))
             sock.sendall(b"WATCH\r\n")
             sock.setblocking(False)
         else:
-            sock = _stream(host, web_port)
+            sock = _stream(host, web_port, f"127.0.1.{i + 1}")  # each browser from an address of its own
         socks.append(sock)
     reference = _stream(host, web_port) if kind == "tcp" else None
     sel = selectors.DefaultSelector()
@@ -163,7 +166,7 @@ class Station:
             f'[elements]\nfiles = ["{ROOT / "tests" / "data" / "visual.txt"}"]\nuse_bundled = false\nstore = "none"\n'
             f'[server]\nsatellite = 25544\ntune = true\nstate_file = "none"\nrate_hz = {RATE_HZ}\n'
             f'[tcp]\nenabled = true\nport = {self.tcp}\nmax_clients = 512\nmax_per_address = 512\n'
-            f'[web]\nenabled = true\nport = {self.web}\n')
+            f'[web]\nenabled = true\nport = {self.web}\nallow = ["127.0.0.0/8"]\n')
         self.proc = subprocess.Popen([sys.executable, "-m", "nfwserver", "run", "--headless", "--config", str(config),
                                       "--log-file", str(folder / "station.log")], cwd=ROOT,
                                      stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
