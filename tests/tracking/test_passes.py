@@ -179,7 +179,8 @@ from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.observer import Observer
 from nfwserver.tracking.passes import find_passes
 PARENT = os.getpid()
-made = multiprocessing.get_context("fork").Value("i", 0)  # models made, by either process
+# models made: shared, without a lock (one process writes it; a worker ended mid-update must not leave a lock held)
+made = multiprocessing.get_context("fork").RawValue("i", 0)
 
 class Failing:  # a set whose model fails in the chosen process only
     def __init__(self, element_set):
@@ -189,8 +190,7 @@ class Failing:  # a set whose model fails in the chosen process only
     def transient_satrec(self):
         if (os.getpid() == PARENT) == (sys.argv[2] == "parent"):
             raise RuntimeError("this model cannot be made")
-        with made.get_lock():
-            made.value += 1
+        made.value += 1
         return self._set.transient_satrec()
 
 sats = [Failing(s) for s in load_element_file(sys.argv[1]).sets[:1000]]
