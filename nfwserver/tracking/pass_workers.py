@@ -128,7 +128,12 @@ def in_forked_workers(search: Search, satellites: list[Any], plan: Sequence[Chun
             sender.close()  # the child holds its own end: EOF here if it dies without an answer
             receivers.append(receiver)
             processes.append(process)
-        outcomes = [_answer(search(satellites, *share(0)))]  # failing, it raises: the children are ended below
+        mine = share(0)
+        try:
+            outcomes = [_answer(search(satellites, *mine))]
+        except BaseException:
+            mine[0].stop()  # the children stop after their chunk on their own, besides being ended below
+            raise
         for receiver, process in zip(receivers, processes):  # before joining: a large answer fills the pipe
             try:
                 outcomes.append(receiver.recv())
