@@ -1,5 +1,5 @@
 """Allow ``python -m nfwserver``."""
 
-from nfwserver.cli import main
+from nfwserver.cli import entry
 
-raise SystemExit(main())
+raise SystemExit(entry())

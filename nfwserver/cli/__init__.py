@@ -12,6 +12,7 @@ usage errors, 1 for runtime errors, with one clear sentence and no traceback for
 from __future__ import annotations
 
 import argparse
+import gc
 import importlib
 import logging
 import sys
@@ -26,7 +27,7 @@ from nfwserver.cli.errors import CliError, say
 COMMAND_MODULES: tuple[str, ...] = tuple(dict.fromkeys(module for _, module, _ in COMMANDS))
 
 
-__all__ = ["CliError", "TerminalFormatter", "build_parser", "main", "say"]
+__all__ = ["CliError", "TerminalFormatter", "build_parser", "entry", "main", "say"]
 
 
 class TerminalFormatter(logging.Formatter):
@@ -65,6 +66,20 @@ def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
         else:
             subparsers.add_parser(name, help=help_text, add_help=False)
     return parser
+
+
+def entry() -> int:
+    """The ``nfwserver`` process (the installed command, ``python -m nfwserver``): :func:`main`, whose objects
+    are then left to the process's end.  The interpreter's shutdown searches every object it still tracks for
+    reference cycles, module by module (45 ms of a 0.5 s ``passes`` over 2,000 satellites); frozen
+    (:func:`gc.freeze`), they are freed without that search.  Only what would be freed as part of a cycle is
+    left to the system, which reclaims the whole process anyway: the command has written and flushed its
+    output, and ``atexit`` handlers (logging's flush) still run.  Not for callers that go on after
+    :func:`main` (tests): their cycles would never be collected."""
+    try:
+        return main()
+    finally:
+        gc.freeze()
 
 
 def main(argv: Sequence[str] | None = None) -> int:
