@@ -78,10 +78,22 @@ class RowWriter:
             return
         if self.fmt == "table":
             self._held.append(columns)
+            self.rows += n
         else:
-            for rows in _blocks(n):
-                self.out.write(self._csv(columns, rows) if self.fmt == "csv" else self._json(columns, rows))
-        self.rows += n
+            for rows in _blocks(n):  # a block at a time: a few MiB of text
+                self.put(self._block(columns, rows), rows.stop - rows.start)
+
+    def text(self, columns: Sequence[Column]) -> str:
+        """The CSV or JSON text of the rows of ``columns`` (one per name, all of one length), as :meth:`write`
+        writes it (see :meth:`put`).  It depends on these rows alone: other processes can make it."""
+        return "".join(self._block(columns, rows) for rows in _blocks(len(columns[0]) if columns else 0))
+
+    def put(self, text: str, rows: int) -> None:
+        """Write ``text``, the :meth:`text` of ``rows`` rows, after the rows written so far (CSV or JSON)."""
+        if self.fmt == "json" and self.rows == 0 and rows:
+            text = "[\n" + text[2:]  # the output's first row opens the array
+        self.out.write(text)
+        self.rows += rows
 
     def close(self) -> None:
         """End the output: the closing bracket of JSON, the whole of a table."""
@@ -89,6 +101,9 @@ class RowWriter:
             self.out.write("\n]\n" if self.rows else "[]\n")
         elif self.fmt == "table":
             self._table()
+
+    def _block(self, columns: Sequence[Column], rows: slice) -> str:
+        return self._csv(columns, rows) if self.fmt == "csv" else self._json(columns, rows)
 
     def _csv(self, columns: Sequence[Column], rows: slice) -> str:
         k = rows.stop - rows.start
@@ -103,8 +118,7 @@ class RowWriter:
         for i, column in enumerate(columns):
             pieces += [_column((", " if i else "") + self._keys[i], k), column.cells(rows, "json").codes]
         pieces.append(_column("}", k))
-        text = _text_of(pieces)
-        return "[\n" + text[2:] if self.rows == 0 and rows.start == 0 else text
+        return _text_of(pieces)  # each row after ",\n"
 
     def _table(self) -> None:
         widths = [len(name) for name in self.names]

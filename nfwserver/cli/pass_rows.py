@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, TextIO
 import numpy as np
 
 from nfwserver.cli.bulk_output import RowWriter
+from nfwserver.cli.forked_rows import write_in_order
 from nfwserver.cli.output_columns import Column, Duration, Flag, Integer, Number, Text, Time
 
 if TYPE_CHECKING:
@@ -21,6 +22,11 @@ if TYPE_CHECKING:
 
 #: Passes written from a spilled search at a time (a slab: 3.5 MiB of columns).
 SLAB_ROWS = 1 << 16
+#: Slabs' rows when several processes make the text: at least, and at most (the text of 16,384 rows, ~2.3 MB,
+#: waits in a pipe and is copied twice; a week's 650,000 rows in 40 slabs).
+_SHARED_SLAB_ROWS = (2048, 1 << 14)
+#: Slabs each process makes at least, when there are enough rows (so that they end close together).
+_SLABS_EACH = 4
 
 
 def above(cols: dict[str, np.ndarray], min_el: float) -> dict[str, np.ndarray]:
@@ -51,12 +57,20 @@ def wide_columns(start: datetime, cols: dict[str, np.ndarray], numbers: np.ndarr
 
 
 def write_spilled(passes: SpilledPasses, start: datetime, min_el: float, names: Mapping[int, str],
-                  column_names: list[str], fmt: str, out: TextIO) -> None:
+                  column_names: list[str], fmt: str, out: TextIO, processes: int = 1) -> None:
     """Write ``passes`` (``names``: the name of each catalog number with a pass) as ``fmt`` (CSV or JSON), those
-    reaching ``min_el`` deg, a slab at a time."""
+    reaching ``min_el`` deg, a slab at a time; with ``processes`` > 1, forked processes make some slabs' text
+    (:mod:`nfwserver.cli.forked_rows`), in slabs small enough to share among them."""
     numbers = np.array(sorted(names), dtype=np.int64)
     shown = name_column(numbers, names)
     writer = RowWriter(column_names, fmt, out)
-    for slab in passes.slabs(SLAB_ROWS):
-        writer.write(wide_columns(start, above(slab.columns, min_el), numbers, shown))
+    fewest, most = _SHARED_SLAB_ROWS
+    rows = SLAB_ROWS if processes <= 1 else min(max(-(-len(passes) // (_SLABS_EACH * processes)), fewest), most)
+
+    with passes.sorted(rows) as slabs:
+        def make(k: int) -> tuple[str, int]:
+            cols = above(slabs.slab(k).columns, min_el)
+            return writer.text(wide_columns(start, cols, numbers, shown)), len(cols["tca_s"])
+
+        write_in_order(len(slabs), make, writer.put, processes)
     writer.close()

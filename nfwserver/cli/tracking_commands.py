@@ -183,15 +183,17 @@ def _run_catalog_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: 
     from nfwserver.cli.bulk_output import write_rows
     from nfwserver.cli.pass_rows import above, name_column, wide_columns, write_spilled
     from nfwserver.cli.pass_table import compact_columns
+    from nfwserver.cli.search_workers import auto_workers
     from nfwserver.tracking.pass_records import PassList
 
     start = args.start
     # CSV and JSON are written as they come: the search's passes wait in temporary files, not in memory.
-    passes, names, short_names, searched = _find_passes(args, inputs, sets, args.format in ("csv", "json"))
+    workers = auto_workers(len(sets)) if args.workers == "auto" else int(args.workers)
+    passes, names, short_names, searched = _find_passes(args, inputs, sets, args.format in ("csv", "json"), workers)
     if not isinstance(passes, PassList):
         try:
             always_up_note([names[n] for n in passes.always_up(args.min_el)])
-            write_spilled(passes, start, args.min_el, names, PASS_COLUMNS, args.format, sys.stdout)
+            write_spilled(passes, start, args.min_el, names, PASS_COLUMNS, args.format, sys.stdout, workers)
         finally:
             passes.close()
         return 0
@@ -211,18 +213,16 @@ def _run_catalog_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: 
     return 0
 
 
-def _find_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: list[Any], spilled: bool
+def _find_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: list[Any], spilled: bool, workers: int
                  ) -> tuple[PassList | SpilledPasses, dict[int, str], dict[int, str], int]:
-    """The passes of ``sets`` over the window the options ask for (``spilled``: in temporary files, which the
-    caller deletes), the name and the DDE name (at most 12 characters; only for the compact table, which alone
-    shows them) to show for each satellite that has one (by catalog number), and how many satellites were
-    searched."""
-    from nfwserver.cli.search_workers import auto_workers
+    """The passes of ``sets`` over the window the options ask for, found by ``workers`` processes (``spilled``:
+    in temporary files, which the caller deletes), the name and the DDE name (at most 12 characters; only for
+    the compact table, which alone shows them) to show for each satellite that has one (by catalog number), and
+    how many satellites were searched."""
     from nfwserver.tracking.pass_records import PassList
     from nfwserver.tracking.passes import find_passes, find_passes_spilled
 
     start = args.start
-    workers = auto_workers(len(sets)) if args.workers == "auto" else int(args.workers)
     # The search leaves out the sets unusable at the start (it makes their models anyway); they and the
     # stale sets are reported after it, before any row (the compact table names them with its satellites).
     search = find_passes_spilled if spilled else find_passes

@@ -14,6 +14,8 @@ Times are seconds after ``start`` (NaN when unknown), angles degrees, as in the 
 
 from __future__ import annotations
 
+import os
+import sys
 import tempfile
 from collections.abc import Iterator, Sequence
 from datetime import datetime
@@ -132,6 +134,13 @@ class SpilledPasses:
     def slabs(self, rows: int = 1 << 16) -> Iterator[PassList]:
         """The passes sorted by AOS (TCA when unknown), then catalog number, ``rows`` at a time (each slab a
         :class:`PassList`, the last maybe shorter).  Once only: the keys are freed as the slabs are read."""
+        with self.sorted(rows) as slabs:
+            for k in range(len(slabs)):
+                yield slabs.slab(k)
+
+    def sorted(self, rows: int = 1 << 16) -> SortedSlabs:
+        """The passes sorted as :meth:`slabs` yields them, in a temporary file from which any slab can be read
+        (:meth:`SortedSlabs.slab`, also in a process forked after this call).  Once only: the keys are freed."""
         # PassColumns.pass_list's sort of the same rows in the same order (ties in the order the rows were found)
         order = np.lexsort((self._numbers.values(), self._first.values()))
         self._first, self._numbers = _Growing(np.float64), _Growing(np.int32)  # unmapped
@@ -139,18 +148,14 @@ class SpilledPasses:
         rank = np.empty(n, dtype=np.int32 if n < 2**31 else np.int64)  # each row's place in the sorted passes
         rank[order] = np.arange(n, dtype=rank.dtype)
         del order
-        with tempfile.TemporaryFile() as slabs:  # the rows again, slab after slab (in each, in the files' order)
+        slabs = tempfile.TemporaryFile()  # noqa: SIM115 (closed by SortedSlabs.close)
+        try:  # the rows again, slab after slab (in each, in the files' order)
             self._by_slab(rank, rows, slabs)
-            slabs.seek(0)
-            for s0 in range(0, n, rows):
-                s1 = min(s0 + rows, n)
-                block = np.frombuffer(slabs.read((s1 - s0) * ROW.itemsize), dtype=ROW)
-                places = rank[np.flatnonzero((rank >= s0) & (rank < s1))] - s0  # the slab's rows, files' order
-                slab = {name: np.empty(s1 - s0, dtype=dtype) for name, dtype in COLUMNS}
-                for name, _ in COLUMNS:
-                    slab[name][places] = block[name]
-                del block
-                yield PassList(self.start, self.window_s, slab, sort=False, skipped=self.skipped)
+            slabs.flush()
+        except BaseException:
+            slabs.close()
+            raise
+        return SortedSlabs(self, rank, rows, slabs)
 
     def _by_slab(self, rank: np.ndarray, rows: int, out: IO[bytes]) -> None:
         """Copy the files' rows to ``out`` grouped by slab (``rank // rows``), each slab's rows in the files'
@@ -170,6 +175,51 @@ class SpilledPasses:
                         out.write(grouped[lo:hi].tobytes())
                         written[s] += hi - lo
             at += count
+
+class SortedSlabs:
+    """Sorted passes (:meth:`SpilledPasses.sorted`) ``rows`` at a time; a context manager that deletes its
+    temporary file at its end."""
+
+    def __init__(self, passes: SpilledPasses, rank: np.ndarray, rows: int, file: IO[bytes]) -> None:
+        self.start, self.window_s, self.skipped = passes.start, passes.window_s, passes.skipped
+        self.rows, self._rank, self._file = rows, rank, file
+
+    def __len__(self) -> int:
+        return -(-len(self._rank) // self.rows)
+
+    def __enter__(self) -> SortedSlabs:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Delete the temporary file."""
+        self._file.close()
+
+    def slab(self, k: int) -> PassList:
+        """Slab ``k`` (from 0): the sorted passes ``k * rows`` to ``(k + 1) * rows``, the last slab maybe shorter.
+        Read at its place in the file (``pread``), so processes sharing the file's position do not disturb
+        each other."""
+        s0 = k * self.rows
+        s1 = min(s0 + self.rows, len(self._rank))
+        if not 0 <= s0 < s1:
+            raise IndexError(k)
+        block = np.frombuffer(_read_at(self._file, (s1 - s0) * ROW.itemsize, s0 * ROW.itemsize), dtype=ROW)
+        places = self._rank[np.flatnonzero((self._rank >= s0) & (self._rank < s1))] - s0  # the files' order
+        slab = {name: np.empty(s1 - s0, dtype=dtype) for name, dtype in COLUMNS}
+        for name, _ in COLUMNS:
+            slab[name][places] = block[name]
+        return PassList(self.start, self.window_s, slab, sort=False, skipped=self.skipped)
+
+
+def _read_at(file: IO[bytes], size: int, offset: int) -> bytes:
+    """``size`` bytes of ``file`` from ``offset``, its position left alone where the system allows (POSIX)."""
+    if sys.platform == "win32":  # no pread there (and no forked process to share the position with)
+        file.seek(offset)
+        return file.read(size)
+    return os.pread(file.fileno(), size, offset)
+
 
 class _Growing:
     """A key column appended to part by part, in anonymous memory maps (grown by doubling: pages never written

@@ -16,18 +16,22 @@ from tests.conftest import DATA, ROOT
 @pytest.mark.skipif(sys.platform == "win32", reason="fork")
 def test_one_two_and_three_workers_write_the_same_bytes(tmp_path) -> None:
     """Before, each worker searched every n-th satellite, in chunks of other satellites than one process
-    makes: its times differed in the microseconds (CSV's sixth decimal of a duration, a TCA's millisecond)."""
+    makes: its times differed in the microseconds (CSV's sixth decimal of a duration, a TCA's millisecond).
+    The rows' text is made by as many processes, a slab each in turn (cli/forked_rows.py)."""
     elements = tmp_path / "some.txt"
     elements.write_text("\n".join((DATA / "active.txt").read_text().splitlines()[: 3 * 1500]) + "\n")
-    outputs = []
-    for workers in ("1", "2", "3"):
+    outputs = {}
+    for fmt, workers in (("csv", "1"), ("csv", "2"), ("csv", "3"), ("json", "1"), ("json", "2")):
         done = subprocess.run(
             [sys.executable, "-m", "nfwserver", "passes", "--elements", str(elements), "--all", "--observer",
-             "52.2,0.12,20", "--start", "2026-05-08T00:00:00Z", "--hours", "24", "--format", "csv",
+             "52.2,0.12,20", "--start", "2026-05-08T00:00:00Z", "--hours", "24", "--format", fmt,
              "--workers", workers], cwd=ROOT, capture_output=True, text=True, timeout=300, check=True)
-        outputs.append(done.stdout)
-    assert outputs[0].count("\n") > 3000
-    assert outputs[1] == outputs[0] and outputs[2] == outputs[0]
+        outputs[fmt, workers] = done.stdout
+    # more rows than the 4 slabs of 2,048 each process makes at least (pass_rows._SHARED_SLAB_ROWS): the
+    # forked processes make some slabs' text too
+    assert outputs["csv", "1"].count("\n") > 3 * 2048
+    assert outputs["csv", "2"] == outputs["csv", "1"] and outputs["csv", "3"] == outputs["csv", "1"]
+    assert outputs["json", "2"] == outputs["json", "1"]
 
 
 def test_auto_forks_only_for_large_searches_and_idle_cores(monkeypatch) -> None:
