@@ -64,10 +64,13 @@ def write_spilled(passes: SpilledPasses, start: datetime, min_el: float, names: 
     numbers = np.array(sorted(names), dtype=np.int64)
     shown = name_column(numbers, names)
     writer = RowWriter(column_names, fmt, out)
+    if processes <= 1:  # a block's text at a time (forked processes hand back a slab's)
+        for slab in passes.slabs(SLAB_ROWS):
+            writer.write(wide_columns(start, above(slab.columns, min_el), numbers, shown))
+        writer.close()
+        return
     fewest, most = _SHARED_SLAB_ROWS
-    rows = SLAB_ROWS if processes <= 1 else min(max(-(-len(passes) // (_SLABS_EACH * processes)), fewest), most)
-
-    with passes.sorted(rows) as slabs:
+    with passes.sorted(min(max(-(-len(passes) // (_SLABS_EACH * processes)), fewest), most)) as slabs:
         def make(k: int) -> tuple[str, int]:
             cols = above(slabs.slab(k).columns, min_el)
             return writer.text(wide_columns(start, cols, numbers, shown)), len(cols["tca_s"])

@@ -128,3 +128,38 @@ def test_an_empty_search_writes_an_empty_array_and_closes_twice() -> None:
     assert out.getvalue() == "[]\n" and list(empty.slabs()) == [] and empty.always_up() == []
     empty.close()
     empty.close()
+
+
+class _Writes(io.StringIO):
+    """A stream that remembers how many rows each write held."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.rows: list[int] = []
+
+    def write(self, text: str) -> int:
+        self.rows.append(text.count("\n"))
+        return super().write(text)
+
+
+@pytest.mark.parametrize("fmt", ["csv", "json"])
+def test_one_or_more_processes_write_the_same_text_a_bounded_piece_at_a_time(fmt: str) -> None:
+    """One process writes a block's text at a time (BLOCK_ROWS rows), forked ones hand back a slab's (at most
+    16,384 rows): a week's text is never held whole."""
+    outs = []
+    for processes in (1, 2):
+        spilled = SpilledPasses(START, 3600.0)
+        for part in _parts(5, 600):
+            spilled.add(part)
+        spilled.seal()
+        out = _Writes()
+        try:
+            pass_rows.write_spilled(spilled, START, 0.0, {n: f"SAT {n}" for n in range(1, 6)}, PASS_COLUMNS, fmt,
+                                    out, processes)
+        finally:
+            spilled.close()
+        outs.append(out)
+    assert outs[0].getvalue() == outs[1].getvalue()
+    assert sum(outs[0].rows) > 5 * 2048
+    assert max(outs[0].rows) <= 2048 + 2  # (with JSON's opening line, or CSV's header)
+    assert max(outs[1].rows) <= 16384
