@@ -21,6 +21,7 @@ from typing import TextIO
 
 import numpy as np
 
+from nfwserver.cli.forked_rows import write_in_order
 from nfwserver.cli.output_columns import SPACE, Cells, Column, codes_of
 
 #: Rows formatted at a time (bounds the temporary matrices: a few MiB).
@@ -59,10 +60,11 @@ def _column(text: str, rows: int) -> np.ndarray:
 
 class RowWriter:
     """Writes rows given as columns, a block at a time: CSV and JSON as they come, a table (which must know
-    every width first) when closed.  Call :meth:`close` once after the last block."""
+    every width first) when closed, its blocks' text made by ``processes`` processes (forked: POSIX; see
+    :mod:`nfwserver.cli.forked_rows`).  Call :meth:`close` once after the last block."""
 
-    def __init__(self, names: Sequence[str], fmt: str, out: TextIO) -> None:
-        self.names, self.fmt, self.out = list(names), fmt, out
+    def __init__(self, names: Sequence[str], fmt: str, out: TextIO, processes: int = 1) -> None:
+        self.names, self.fmt, self.out, self.processes = list(names), fmt, out, processes
         self.rows = 0  #: rows written (or held, for a table)
         self._held: list[Sequence[Column]] = []
         if fmt == "csv":
@@ -126,9 +128,13 @@ class RowWriter:
             for rows in _blocks(len(columns[0])):
                 widths = [max(w, column.longest(rows, "table")) for w, column in zip(widths, columns)]
         self.out.write("  ".join(name.ljust(w) for name, w in zip(self.names, widths)).rstrip() + "\n")
-        for columns in self._held:
-            for rows in _blocks(len(columns[0])):
-                self.out.write(self._table_rows(columns, rows, widths))
+        blocks = [(columns, rows) for columns in self._held for rows in _blocks(len(columns[0]))]
+
+        def make(k: int) -> tuple[str, int]:
+            columns, rows = blocks[k]
+            return self._table_rows(columns, rows, widths), rows.stop - rows.start
+
+        write_in_order(len(blocks), make, lambda text, _: self.out.write(text), self.processes)
         self._held.clear()
 
     @staticmethod
@@ -155,8 +161,9 @@ def _blocks(n: int) -> list[slice]:
     return [slice(b, min(b + BLOCK_ROWS, n)) for b in range(0, n, BLOCK_ROWS)]
 
 
-def write_rows(columns: Sequence[Column], fmt: str, out: TextIO) -> None:
-    """Write ``columns`` (all of one length) to ``out`` as a ``table``, ``csv`` or ``json``."""
-    writer = RowWriter([c.name for c in columns], fmt, out)
+def write_rows(columns: Sequence[Column], fmt: str, out: TextIO, processes: int = 1) -> None:
+    """Write ``columns`` (all of one length) to ``out`` as a ``table``, ``csv`` or ``json`` (a table's text made
+    by ``processes`` processes)."""
+    writer = RowWriter([c.name for c in columns], fmt, out, processes)
     writer.write(columns)
     writer.close()

@@ -1,8 +1,9 @@
 """A large output's rows made by several processes and written in order by this one.
 
 The text of a whole catalog's week (650,000 passes, 90 MB of CSV) takes a process 1.5 s to make, a fifth of
-the command.  Each slab's text depends on that slab's rows alone, so forked processes can make some while this
-one makes others and writes them all in their order: the bytes are those of one process.  Only the text comes
+the command.  Each slab's text depends on that slab's rows alone (and, for a table, on the widths found first),
+so forked processes can make some while this one makes others and writes them all in their order: the bytes are
+those of one process.  Only the text comes
 back (pickled through a pipe); the rows reach the forked processes with the fork.  POSIX only (fork); one
 process elsewhere, or for one slab.
 """
@@ -20,7 +21,7 @@ if TYPE_CHECKING:  # multiprocessing is imported only when processes are forked
 MakeText = Callable[[int], tuple[str, int]]
 
 
-def write_in_order(count: int, make: MakeText, put: Callable[[str, int], None], processes: int) -> None:
+def write_in_order(count: int, make: MakeText, put: Callable[[str, int], object], processes: int) -> None:
     """``put`` the texts ``make`` makes of slabs ``0 .. count - 1``, in that order.  With ``processes`` > 1
     (POSIX), process ``p`` of them makes slabs ``p, p + processes, ...``: this one is process 0 and writes each
     slab as its turn comes, waiting for the forked one that makes it (which makes its next meanwhile).  A

@@ -206,10 +206,11 @@ def _run_catalog_passes(args: argparse.Namespace, inputs: TrackingInputs, sets: 
         if not len(cols["catalog_number"]):
             no_passes_warning(args, searched)
         write_rows(compact_columns(start, cols, [short_names[n] for n in numbers.tolist()],
-                                   np.searchsorted(numbers, cols["catalog_number"]), args.local), "table", sys.stdout)
+                                   np.searchsorted(numbers, cols["catalog_number"]), args.local), "table", sys.stdout,
+                   workers)
         return 0
     wide_table_local_note(args)
-    write_rows(wide_columns(start, cols, numbers, name_column(numbers, names)), args.format, sys.stdout)
+    write_rows(wide_columns(start, cols, numbers, name_column(numbers, names)), args.format, sys.stdout, workers)
     return 0
 
 

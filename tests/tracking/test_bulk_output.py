@@ -6,6 +6,7 @@ import csv
 import io
 import json
 import math
+import sys
 from datetime import datetime, timedelta, timezone
 
 import numpy as np
@@ -103,6 +104,27 @@ def test_table_csv_and_json_of_mixed_columns() -> None:
     assert doc[2]["when"] is None and doc[2]["deg"] is None and doc[1]["deg"] == -0.04
     assert got.getvalue().count("\n") == 9 + 2
     assert math.isclose(doc[7]["deg"], -3.25)
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="fork")
+@pytest.mark.parametrize("processes", [1, 3])
+def test_a_long_table_made_by_several_processes_is_the_aligned_table(processes: int) -> None:
+    """Its widths are those of every row; its blocks' text may be made by forked processes (cli/forked_rows.py)."""
+    n = 3 * bulk_output.BLOCK_ROWS + 17
+    rng = np.random.default_rng(3)
+    ids, values = rng.integers(1, 10**6, n), rng.normal(0.0, 100.0, n)
+    names = ["A", "LONGER NAME", "ÄÖÜ"]
+    which = rng.integers(0, 3, n)
+    cells = [[str(i), names[w], f"{v:.1f}"] for i, w, v in zip(ids.tolist(), which.tolist(), values.tolist())]
+    header = ["id", "name", "value"]
+    widths = [max(len(c), *(len(r[i]) for r in cells)) for i, c in enumerate(header)]
+    lines = ["  ".join(c.ljust(w) for c, w in zip(header, widths)).rstrip()]
+    lines += ["  ".join(v.rjust(w) if v[:1].isdigit() or v[:1] == "-" else v.ljust(w)
+                        for v, w in zip(r, widths)).rstrip() for r in cells]
+    got = io.StringIO()
+    bulk_output.write_rows([bo.Integer("id", ids), bo.Text("name", names, which), bo.Number("value", values, 1)],
+                           "table", got, processes)
+    assert got.getvalue() == "\n".join(lines) + "\n"
 
 
 @pytest.mark.parametrize("style", ["table", "csv", "json"])
