@@ -105,6 +105,8 @@ class RowWriter:
             self._table()
 
     def _block(self, columns: Sequence[Column], rows: slice) -> str:
+        if self.fmt == "table":  # a table's text needs every width first: close() writes it
+            raise ValueError("a table's rows have no text of their own before the table is closed")
         return self._csv(columns, rows) if self.fmt == "csv" else self._json(columns, rows)
 
     def _csv(self, columns: Sequence[Column], rows: slice) -> str:

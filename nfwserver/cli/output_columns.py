@@ -280,7 +280,8 @@ def _digits(scaled: np.ndarray, negative: np.ndarray, empty: np.ndarray, decimal
     n_whole = _digit_count(scaled // int(_POW10[decimals]))
     sign = (negative & ~empty).astype(np.intp)
     lengths = np.where(empty, 0, sign + n_whole + (decimals + 1 if decimals else 0))
-    width = max(1, int(lengths.max(initial=1)))
+    # Every row's digits are laid out before the empty ones are cleared: room for one digit at least.
+    width = max(1 + (decimals + 1 if decimals else 0), int(lengths.max(initial=0)))
     codes = np.zeros((rows, width), dtype=np.uint8)
     rest = scaled.copy()
     column = width - 1

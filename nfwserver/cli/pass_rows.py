@@ -13,20 +13,16 @@ from typing import TYPE_CHECKING, TextIO
 
 import numpy as np
 
-from nfwserver.cli.bulk_output import RowWriter
+from nfwserver.cli.bulk_output import BLOCK_ROWS, RowWriter
 from nfwserver.cli.forked_rows import write_in_order
 from nfwserver.cli.output_columns import Column, Duration, Flag, Integer, Number, Text, Time
 
 if TYPE_CHECKING:
     from nfwserver.tracking.pass_spill import SpilledPasses
 
-#: Passes written from a spilled search at a time (a slab: 3.5 MiB of columns).
-SLAB_ROWS = 1 << 16
-#: Slabs' rows when several processes make the text: at least, and at most (the text of 16,384 rows, ~2.3 MB,
-#: waits in a pipe and is copied twice; a week's 650,000 rows in 40 slabs).
-_SHARED_SLAB_ROWS = (2048, 1 << 14)
-#: Slabs each process makes at least, when there are enough rows (so that they end close together).
-_SLABS_EACH = 4
+#: Passes written from a spilled search at a time (a slab: one block of text, so that the text waiting in a
+#: process is one block's, whichever process makes it).
+SLAB_ROWS = BLOCK_ROWS
 
 
 def above(cols: dict[str, np.ndarray], min_el: float) -> dict[str, np.ndarray]:
@@ -59,18 +55,12 @@ def wide_columns(start: datetime, cols: dict[str, np.ndarray], numbers: np.ndarr
 def write_spilled(passes: SpilledPasses, start: datetime, min_el: float, names: Mapping[int, str],
                   column_names: list[str], fmt: str, out: TextIO, processes: int = 1) -> None:
     """Write ``passes`` (``names``: the name of each catalog number with a pass) as ``fmt`` (CSV or JSON), those
-    reaching ``min_el`` deg, a slab at a time; with ``processes`` > 1, forked processes make some slabs' text
-    (:mod:`nfwserver.cli.forked_rows`), in slabs small enough to share among them."""
+    reaching ``min_el`` deg, a slab of :data:`SLAB_ROWS` at a time; with ``processes`` > 1, forked processes make
+    some slabs' text (:mod:`nfwserver.cli.forked_rows`)."""
     numbers = np.array(sorted(names), dtype=np.int64)
     shown = name_column(numbers, names)
     writer = RowWriter(column_names, fmt, out)
-    if processes <= 1:  # a block's text at a time (forked processes hand back a slab's)
-        for slab in passes.slabs(SLAB_ROWS):
-            writer.write(wide_columns(start, above(slab.columns, min_el), numbers, shown))
-        writer.close()
-        return
-    fewest, most = _SHARED_SLAB_ROWS
-    with passes.sorted(min(max(-(-len(passes) // (_SLABS_EACH * processes)), fewest), most)) as slabs:
+    with passes.sort_into_slabs(SLAB_ROWS) as slabs:
         def make(k: int) -> tuple[str, int]:
             cols = above(slabs.slab(k).columns, min_el)
             return writer.text(wide_columns(start, cols, numbers, shown)), len(cols["tca_s"])

@@ -169,7 +169,7 @@ class PassColumns:
             return
         n = self._rows
         if not self._columns or n + k > self._capacity:
-            capacity = self._capacity if not self._columns else max(2 * self._capacity, n + k)
+            capacity = max(2 * self._capacity if self._columns else self._capacity, n + k)  # the first part too
             for name, dtype in COLUMNS:
                 grown = mapped(capacity, dtype)
                 if name in self._columns:

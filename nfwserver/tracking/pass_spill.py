@@ -119,7 +119,6 @@ class SpilledPasses:
         numbers: list[int] = distinct(self._numbers.values()).tolist()
         return numbers
 
-
     def always_up(self, min_el: float = 0.0) -> list[int]:
         """Catalog numbers of the passes with neither AOS nor LOS (reaching ``min_el`` deg, unless 0), in the
         order of the sorted passes."""
@@ -134,13 +133,13 @@ class SpilledPasses:
     def slabs(self, rows: int = 1 << 16) -> Iterator[PassList]:
         """The passes sorted by AOS (TCA when unknown), then catalog number, ``rows`` at a time (each slab a
         :class:`PassList`, the last maybe shorter).  Once only: the keys are freed as the slabs are read."""
-        with self.sorted(rows) as slabs:
+        with self.sort_into_slabs(rows) as slabs:
             for k in range(len(slabs)):
                 yield slabs.slab(k)
 
-    def sorted(self, rows: int = 1 << 16) -> SortedSlabs:
+    def sort_into_slabs(self, rows: int = 1 << 16) -> SortedSlabs:
         """The passes sorted as :meth:`slabs` yields them, in a temporary file from which any slab can be read
-        (:meth:`SortedSlabs.slab`, also in a process forked after this call).  Once only: the keys are freed."""
+        (:meth:`SortedSlabs.slab`, also by a process forked after this call).  Once only: the keys are freed."""
         # PassColumns.pass_list's sort of the same rows in the same order (ties in the order the rows were found)
         order = np.lexsort((self._numbers.values(), self._first.values()))
         self._first, self._numbers = _Growing(np.float64), _Growing(np.int32)  # unmapped
@@ -155,7 +154,9 @@ class SpilledPasses:
         except BaseException:
             slabs.close()
             raise
-        return SortedSlabs(self, rank, rows, slabs)
+        # The sorted places of the rows as they lie in that file: a slab's rows are there in the files' order.
+        places = rank[np.argsort(rank // rows, kind="stable")]
+        return SortedSlabs(self, places, rows, slabs)
 
     def _by_slab(self, rank: np.ndarray, rows: int, out: IO[bytes]) -> None:
         """Copy the files' rows to ``out`` grouped by slab (``rank // rows``), each slab's rows in the files'
@@ -177,15 +178,15 @@ class SpilledPasses:
             at += count
 
 class SortedSlabs:
-    """Sorted passes (:meth:`SpilledPasses.sorted`) ``rows`` at a time; a context manager that deletes its
-    temporary file at its end."""
+    """Sorted passes (:meth:`SpilledPasses.sort_into_slabs`) ``rows`` at a time; a context manager that deletes
+    its temporary file at its end.  ``places``: each row of the file's place in the sorted passes."""
 
-    def __init__(self, passes: SpilledPasses, rank: np.ndarray, rows: int, file: IO[bytes]) -> None:
+    def __init__(self, passes: SpilledPasses, places: np.ndarray, rows: int, file: IO[bytes]) -> None:
         self.start, self.window_s, self.skipped = passes.start, passes.window_s, passes.skipped
-        self.rows, self._rank, self._file = rows, rank, file
+        self.rows, self._places, self._file = rows, places, file
 
     def __len__(self) -> int:
-        return -(-len(self._rank) // self.rows)
+        return -(-len(self._places) // self.rows)
 
     def __enter__(self) -> SortedSlabs:
         return self
@@ -202,11 +203,11 @@ class SortedSlabs:
         Read at its place in the file (``pread``), so processes sharing the file's position do not disturb
         each other."""
         s0 = k * self.rows
-        s1 = min(s0 + self.rows, len(self._rank))
+        s1 = min(s0 + self.rows, len(self._places))
         if not 0 <= s0 < s1:
             raise IndexError(k)
         block = np.frombuffer(_read_at(self._file, (s1 - s0) * ROW.itemsize, s0 * ROW.itemsize), dtype=ROW)
-        places = self._rank[np.flatnonzero((self._rank >= s0) & (self._rank < s1))] - s0  # the files' order
+        places = self._places[s0:s1] - s0
         slab = {name: np.empty(s1 - s0, dtype=dtype) for name, dtype in COLUMNS}
         for name, _ in COLUMNS:
             slab[name][places] = block[name]

@@ -8,10 +8,10 @@ satellites' SGP4 models reach them with the fork (they cannot be pickled) and on
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Callable, Iterator, Sequence, Sized
 from typing import IO, TYPE_CHECKING, Any, Protocol
 
+from nfwserver.forked_children import ForkedChildren
 from nfwserver.tracking.pass_spill import SpilledPasses
 
 if TYPE_CHECKING:  # multiprocessing is imported only when workers are forked (1.3 MiB, 5 ms)
@@ -97,59 +97,35 @@ def _answer(found: PassList | SpilledPasses) -> object:
 def in_forked_workers(search: Search, satellites: list[Any], plan: Sequence[ChunkWork], args: tuple[Any, ...],
                       workers: int, spills: Sequence[IO[bytes]] = ()) -> list[Any]:
     """The passes of the chunks of ``plan`` found by ``workers`` processes running ``search`` (``search(satellites,
-    chunks, room, *args)``): this one and ``workers - 1`` forked ones, in that order (POSIX: the caller checked
-    that fork exists).  Each worker takes the next chunk (in :func:`pull_order`) when it is ready for one, and
-    searches it whole as one process would, so the passes are those of one process bit for bit whichever
-    worker found them; dealing the chunks out beforehand left one of two workers idle for up to a third of
-    the search (the chunks' work is known only roughly).  With ``spills`` (one temporary file per worker),
-    each worker writes its rows to its file and hands back their keys (:func:`fork_worker`)."""
+    chunks, room, *args)``): this one and ``workers - 1`` forked ones, in that order (the caller checked
+    :func:`~nfwserver.forked_children.can_fork`).  Each worker takes the next chunk (in :func:`pull_order`) when
+    it is ready for one, and searches it whole as one process would, so the passes are those of one process bit
+    for bit whichever worker found them; dealing the chunks out beforehand left one of two workers idle for up
+    to a third of the search (the chunks' work is known only roughly).  With ``spills`` (one temporary file per
+    worker), each worker writes its rows to its file and hands back their keys (:func:`fork_worker`)."""
     import multiprocessing
-
-    if sys.platform == "win32":  # never true here (the caller checked); it tells the type checker the rest is POSIX
-        raise OSError("fork is POSIX only")
 
     context = multiprocessing.get_context("fork")
     window_s = (args[2] - args[1]).total_seconds()
     order = pull_order(plan, window_s)
     taken = context.Value("q", 0)  # the next place in ``order``, shared by the workers
     room = -(-sum(c.room for c in plan) // workers)  # a worker's room for passes to start with (grown if need be)
-    receivers: list[Connection] = []
-    processes = []
 
     def share(k: int) -> tuple[Any, ...]:  # worker k's arguments to ``search`` after the satellites
         spill = (SpilledPasses(args[1], window_s, spills[k]),) if spills else ()
         return (_Pulled(plan, order, taken), room, *args, *spill)
 
-    try:
+    with ForkedChildren("a pass-search worker") as children:
         for k in range(1, workers):  # this process is worker 0: one fork and one answer fewer to pass back
-            receiver, sender = context.Pipe(duplex=False)
-            process = context.Process(target=fork_worker, args=(search, satellites, share(k), sender), daemon=True)
-            process.start()
-            sender.close()  # the child holds its own end: EOF here if it dies without an answer
-            receivers.append(receiver)
-            processes.append(process)
+            children.start(fork_worker, (search, satellites, share(k)))
         mine = share(0)
         try:
             outcomes = [_answer(search(satellites, *mine))]
         except BaseException:
             mine[0].stop()  # the children stop after their chunk on their own, besides being ended below
             raise
-        for receiver, process in zip(receivers, processes):  # before joining: a large answer fills the pipe
-            try:
-                outcomes.append(receiver.recv())
-            except EOFError:  # killed (out of memory, a signal) before it answered
-                process.join(5.0)
-                raise OSError(f"a pass-search worker process ended without its answer (exit status "
-                              f"{process.exitcode})") from None
-        for process in processes:
-            process.join()
-    finally:
-        for receiver in receivers:
-            receiver.close()
-        for process in processes:
-            if process.is_alive():
-                process.terminate()
-                process.join()
+        outcomes += [children.recv(k) for k in range(workers - 1)]  # before joining: a large answer fills the pipe
+        children.join()
     for outcome in outcomes:
         if isinstance(outcome, BaseException):
             raise outcome

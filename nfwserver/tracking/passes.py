@@ -32,7 +32,6 @@ whose rise or set lies beyond the extension gets ``None`` for that time.
 from __future__ import annotations
 
 import math
-import threading
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
@@ -40,6 +39,7 @@ from typing import Any
 
 import numpy as np
 
+from nfwserver.forked_children import can_fork
 from nfwserver.tracking.constants import MINUTES_PER_DAY, SECONDS_PER_DAY
 from nfwserver.tracking.frames import TopocentricFrame
 from nfwserver.tracking.horizon import HorizonTable
@@ -135,23 +135,20 @@ def _find(satellites: Sequence[Any], observer: Observer, start: datetime, end: d
         return SpilledPasses(start, max(window_s, 0.0)).seal() if spilled else PassList(start, max(window_s, 0.0))
     plan = _plan(satellites, window_s)
     args = (observer, start, end, horizon, ut1_utc, fine_step_s)
-    if workers > 1 and len(plan) > 1 and threading.active_count() == 1:
-        import multiprocessing
+    if workers > 1 and len(plan) > 1 and can_fork():
+        workers = min(workers, len(plan))
+        if not spilled:
+            return PassList.concat(start, window_s, in_forked_workers(_search, satellites, plan, args, workers))
+        import tempfile
 
-        if "fork" in multiprocessing.get_all_start_methods():
-            workers = min(workers, len(plan))
-            if not spilled:
-                return PassList.concat(start, window_s, in_forked_workers(_search, satellites, plan, args, workers))
-            import tempfile
-
-            spills = [tempfile.TemporaryFile() for _ in range(workers)]  # noqa: SIM115 (closed by the result)
-            try:
-                parts = in_forked_workers(_search, satellites, plan, args, workers, spills)
-            except BaseException:
-                for spill in spills:
-                    spill.close()
-                raise
-            return SpilledPasses.joined(start, window_s, spills, parts)
+        spills = [tempfile.TemporaryFile() for _ in range(workers)]  # noqa: SIM115 (closed by the result)
+        try:
+            parts = in_forked_workers(_search, satellites, plan, args, workers, spills)
+        except BaseException:
+            for spill in spills:
+                spill.close()
+            raise
+        return SpilledPasses.joined(start, window_s, spills, parts)
     into = SpilledPasses(start, window_s) if spilled else None
     return _search(satellites, plan, sum(c.room for c in plan), *args, into)
 

@@ -67,7 +67,7 @@ def _killed_in_a_forked_process(k: int) -> tuple[str, int]:
 
 
 def test_a_killed_forked_process_is_an_error_not_missing_rows() -> None:
-    with pytest.raises(OSError, match="ended before it made them all"):
+    with pytest.raises(OSError, match="a row-making process ended without its answer"):
         _written(4, _killed_in_a_forked_process, 2)
     assert multiprocessing.active_children() == []
 

@@ -7,12 +7,12 @@ from __future__ import annotations
 import gc
 import subprocess
 import sys
-from importlib.metadata import entry_points
 from pathlib import Path
 
 import pytest
 
 from nfwserver.cli import main
+from nfwserver.config.loader import toml_document
 from tests.conftest import ROOT
 
 # The module ``python -m nfwserver`` runs (the Windows launcher runs the same), then what the process left frozen.
@@ -45,8 +45,8 @@ def test_the_process_entry_freezes_what_the_command_leaves(argv: tuple[str, ...]
 
 
 def test_the_installed_command_is_the_process_entry() -> None:
-    scripts = {point.name: point.value for point in entry_points(group="console_scripts")}
-    assert scripts["nfwserver"] == "nfwserver.cli:entry"
+    project = toml_document((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    assert project["scripts"]["nfwserver"] == "nfwserver.cli:entry"
 
 
 def test_main_alone_freezes_nothing(capsys: pytest.CaptureFixture[str]) -> None:

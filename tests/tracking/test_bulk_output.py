@@ -14,6 +14,7 @@ import pytest
 
 from nfwserver.cli import bulk_output
 from nfwserver.cli import output_columns as bo
+from nfwserver.cli.forked_rows import write_in_order
 from nfwserver.cli.tracking_options import format_time
 
 _EPOCH = datetime(1970, 1, 1, tzinfo=timezone.utc)
@@ -108,8 +109,15 @@ def test_table_csv_and_json_of_mixed_columns() -> None:
 
 @pytest.mark.skipif(sys.platform == "win32", reason="fork")
 @pytest.mark.parametrize("processes", [1, 3])
-def test_a_long_table_made_by_several_processes_is_the_aligned_table(processes: int) -> None:
+def test_a_long_table_made_by_several_processes_is_the_aligned_table(monkeypatch, processes: int) -> None:
     """Its widths are those of every row; its blocks' text may be made by forked processes (cli/forked_rows.py)."""
+    asked: list[int] = []
+
+    def recorded(count, make, put, processes) -> None:  # the real writer, with the processes it was asked for
+        asked.append(processes)
+        write_in_order(count, make, put, processes)
+
+    monkeypatch.setattr(bulk_output, "write_in_order", recorded)
     n = 3 * bulk_output.BLOCK_ROWS + 17
     rng = np.random.default_rng(3)
     ids, values = rng.integers(1, 10**6, n), rng.normal(0.0, 100.0, n)
@@ -125,6 +133,17 @@ def test_a_long_table_made_by_several_processes_is_the_aligned_table(processes: 
     bulk_output.write_rows([bo.Integer("id", ids), bo.Text("name", names, which), bo.Number("value", values, 1)],
                            "table", got, processes)
     assert got.getvalue() == "\n".join(lines) + "\n"
+    assert asked == [processes]
+
+
+@pytest.mark.parametrize("style", ["table", "csv", "json"])
+def test_a_block_whose_numbers_are_all_empty(style: str) -> None:
+    """(A slab of passes all up for the whole window has no AOS azimuth: this raised IndexError.)"""
+    buf = io.StringIO()
+    bulk_output.write_rows([bo.Integer("a", np.array([1, 2])), bo.Number("b", np.array([np.nan, 3.0]), 1,
+                                                                         np.array([True, True]))], style, buf)
+    assert buf.getvalue() == {"table": "a  b\n1\n2\n", "csv": "a,b\n1,\n2,\n",
+                              "json": '[\n{"a": 1, "b": null},\n{"a": 2, "b": null}\n]\n'}[style]
 
 
 @pytest.mark.parametrize("style", ["table", "csv", "json"])

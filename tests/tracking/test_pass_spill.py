@@ -4,6 +4,7 @@ in its order, and ``passes`` writes from them the bytes of the whole list writte
 from __future__ import annotations
 
 import io
+import json
 import math
 from datetime import datetime, timedelta, timezone
 
@@ -13,6 +14,7 @@ import pytest
 import nfwserver.cli.pass_rows as pass_rows
 from nfwserver.cli import main
 from nfwserver.cli.bulk_output import write_rows
+from nfwserver.cli.forked_rows import write_in_order
 from nfwserver.cli.pass_reports import PASS_COLUMNS
 from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.observer import Observer
@@ -142,24 +144,52 @@ class _Writes(io.StringIO):
         return super().write(text)
 
 
+@pytest.mark.parametrize("min_el", [0.0, 60.0])
 @pytest.mark.parametrize("fmt", ["csv", "json"])
-def test_one_or_more_processes_write_the_same_text_a_bounded_piece_at_a_time(fmt: str) -> None:
-    """One process writes a block's text at a time (BLOCK_ROWS rows), forked ones hand back a slab's (at most
-    16,384 rows): a week's text is never held whole."""
+def test_one_or_more_processes_write_the_same_text_a_block_at_a_time(monkeypatch, fmt: str, min_el: float) -> None:
+    """Whichever process makes a slab's text, a write holds one block (BLOCK_ROWS rows): a week's text is never
+    held whole.  With ``min_el``, slabs lose rows (some all of them: JSON's first row is then a later slab's)."""
+    asked: list[int] = []
+
+    def recorded(count, make, put, processes) -> None:  # the real writer, with the processes it was asked for
+        asked.append(processes)
+        write_in_order(count, make, put, processes)
+
+    monkeypatch.setattr(pass_rows, "write_in_order", recorded)
+    monkeypatch.setattr(pass_rows, "SLAB_ROWS", 97)  # many slabs, some emptied by min_el
     outs = []
-    for processes in (1, 2):
+    for processes in (1, 2, 3):
         spilled = SpilledPasses(START, 3600.0)
         for part in _parts(5, 600):
+            part["max_elevation_deg"][part["tca_s"] < 1500.0] = 10.0  # the earliest passes: below min_el
             spilled.add(part)
         spilled.seal()
         out = _Writes()
         try:
-            pass_rows.write_spilled(spilled, START, 0.0, {n: f"SAT {n}" for n in range(1, 6)}, PASS_COLUMNS, fmt,
+            pass_rows.write_spilled(spilled, START, min_el, {n: f"SAT {n}" for n in range(1, 6)}, PASS_COLUMNS, fmt,
                                     out, processes)
         finally:
             spilled.close()
         outs.append(out)
-    assert outs[0].getvalue() == outs[1].getvalue()
-    assert sum(outs[0].rows) > 5 * 2048
-    assert max(outs[0].rows) <= 2048 + 2  # (with JSON's opening line, or CSV's header)
-    assert max(outs[1].rows) <= 16384
+    assert asked == [1, 2, 3]
+    assert outs[0].getvalue() == outs[1].getvalue() == outs[2].getvalue()
+    if fmt == "json":
+        json.loads(outs[0].getvalue())
+    assert sum(outs[0].rows) > 2 * 97
+    if min_el:
+        assert outs[0].rows[1:4] == [0, 0, 0]  # after the header, the first slabs wrote nothing
+    assert max(max(out.rows) for out in outs) <= 97 + 2  # (with JSON's opening line, or CSV's header)
+
+
+def test_reading_a_slab_leaves_the_files_position_alone() -> None:
+    """A forked process reads slabs from the file its parent reads: each read is at its own place (pread)."""
+    spilled = SpilledPasses(START, 3600.0)
+    for part in _parts(6, 50):
+        spilled.add(part)
+    with spilled.seal().sort_into_slabs(40) as slabs:
+        file = slabs._file
+        file.seek(123)
+        first = slabs.slab(0).columns
+        assert file.tell() == 123
+        assert slabs.slab(1).columns["tca_s"][0] >= first["tca_s"][0] - 1e9  # a slab, read at its place
+        assert file.tell() == 123

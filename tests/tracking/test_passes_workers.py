@@ -8,7 +8,8 @@ import sys
 
 import pytest
 
-from nfwserver.cli import search_workers
+from nfwserver.cli import bulk_output, main, pass_rows, search_workers
+from nfwserver.cli.forked_rows import write_in_order
 from nfwserver.tracking import pass_workers
 from tests.conftest import DATA, ROOT
 
@@ -32,6 +33,25 @@ def test_one_two_and_three_workers_write_the_same_bytes(tmp_path) -> None:
     assert outputs["csv", "1"].count("\n") > 3 * 2048
     assert outputs["csv", "2"] == outputs["csv", "1"] and outputs["csv", "3"] == outputs["csv", "1"]
     assert outputs["json", "2"] == outputs["json", "1"]
+
+
+@pytest.mark.parametrize("fmt", [("csv",), ("json",), ("table", "--wide"), ("table",)])
+def test_the_rows_are_made_by_as_many_processes_as_the_search(monkeypatch, capsys, tmp_path, fmt) -> None:
+    """The writers are asked for the search's processes (they fork only where that is safe: forked_children)."""
+    asked: list[int] = []
+
+    def recorded(count, make, put, processes) -> None:  # the real writer, with the processes it was asked for
+        asked.append(processes)
+        write_in_order(count, make, put, processes)
+
+    monkeypatch.setattr(pass_rows, "write_in_order", recorded)
+    monkeypatch.setattr(bulk_output, "write_in_order", recorded)
+    elements = tmp_path / "some.txt"
+    elements.write_text("\n".join((DATA / "active.txt").read_text().splitlines()[: 3 * 300]) + "\n")
+    assert main(["passes", "--elements", str(elements), "--all", "--observer", "52.2,0.12,20", "--start",
+                 "2026-05-08T00:00:00Z", "--hours", "24", "--format", *fmt, "--workers", "3"]) == 0
+    assert capsys.readouterr().out.count("\n") > 1000
+    assert asked == [3]
 
 
 def test_auto_forks_only_for_large_searches_and_idle_cores(monkeypatch) -> None:
