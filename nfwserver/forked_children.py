@@ -56,7 +56,12 @@ class ForkedChildren:
         receiver, sender = context.Pipe(duplex=False)
         inherited = [*self._receivers, receiver]
         process = context.Process(target=_child, args=(target, args, sender, inherited), daemon=True)
-        process.start()
+        try:
+            process.start()
+        except BaseException:  # not forked (no memory, too many processes): the pipe is nobody's
+            receiver.close()
+            sender.close()
+            raise
         sender.close()  # the child holds its own: EOF here if it dies without an answer
         self._receivers.append(receiver)
         self._processes.append(process)

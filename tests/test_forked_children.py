@@ -53,6 +53,7 @@ def _gone(pid: int) -> bool:
 def test_no_child_outlives_a_killed_parent(sig: signal.Signals) -> None:
     """Each child closes the parent's reading ends it inherited, so the parent's death breaks its pipe."""
     parent = subprocess.Popen([sys.executable, "-c", _PARENT], cwd=ROOT, stdout=subprocess.PIPE, text=True)
+    children: list[int] = []
     try:
         assert parent.stdout is not None
         children = [int(pid) for pid in parent.stdout.readline().split()]
@@ -61,7 +62,11 @@ def test_no_child_outlives_a_killed_parent(sig: signal.Signals) -> None:
         parent.wait(timeout=30)
         wait_for(lambda: all(_gone(pid) for pid in children), timeout_s=30, what="every child ended")
     finally:
-        parent.kill()
+        for pid in [parent.pid, *children]:  # (the children too, should this test fail)
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
         parent.wait()
         if parent.stdout is not None:
             parent.stdout.close()

@@ -177,6 +177,7 @@ class SpilledPasses:
                         written[s] += hi - lo
             at += count
 
+
 class SortedSlabs:
     """Sorted passes (:meth:`SpilledPasses.sort_into_slabs`) ``rows`` at a time; a context manager that deletes
     its temporary file at its end.  ``places``: each row of the file's place in the sorted passes."""

@@ -8,6 +8,7 @@ satellites' SGP4 models reach them with the fork (they cannot be pickled) and on
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Iterator, Sequence, Sized
 from typing import IO, TYPE_CHECKING, Any, Protocol
 
@@ -25,6 +26,8 @@ Search = Callable[..., "PassList | SpilledPasses"]
 #: Work of one possible pass in coarse samples, for sharing chunks among workers (refining a pass costs ~15
 #: times a coarse sample; ``room`` counts every pass an orbit could give, of which about half are seen).
 _PASS_WORK = 8.0
+
+
 class ChunkWork(Protocol):
     """What :func:`pull_order` reads of a chunk of the search's plan (``passes._Chunk``)."""
 
@@ -49,13 +52,17 @@ def pull_order(plan: Sequence[ChunkWork], window_s: float) -> list[int]:
 
 class _Pulled:
     """The chunks one worker searches: each taken, when the worker is ready for it, as the next of ``order``
-    that no worker has taken yet (``taken``: a counter the forked workers share)."""
+    that no worker has taken yet (``taken``: a counter the forked workers share).  A forked worker whose parent
+    (the process that made this) has gone takes none: nobody would read its passes."""
 
     def __init__(self, plan: Sequence[ChunkWork], order: list[int], taken: Synchronized[int]) -> None:
         self.plan, self.order, self.taken = plan, order, taken
+        self.parent = os.getpid()
 
     def __iter__(self) -> Iterator[ChunkWork]:
         while True:
+            if os.getpid() != self.parent and os.getppid() != self.parent:  # orphaned (the command was killed)
+                return
             with self.taken.get_lock():
                 k = self.taken.value
                 self.taken.value = k + 1
@@ -84,6 +91,8 @@ def fork_worker(search: Search, satellites: list[Any], args: tuple[Any, ...], re
             args[0].stop()
             outcome = exc
         results.send(outcome)
+    except OSError:  # the parent has gone (killed, or ending the workers after a failure of its own)
+        pass
     finally:
         results.close()
 

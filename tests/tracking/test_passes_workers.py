@@ -28,8 +28,7 @@ def test_one_two_and_three_workers_write_the_same_bytes(tmp_path) -> None:
              "52.2,0.12,20", "--start", "2026-05-08T00:00:00Z", "--hours", "24", "--format", fmt,
              "--workers", workers], cwd=ROOT, capture_output=True, text=True, timeout=300, check=True)
         outputs[fmt, workers] = done.stdout
-    # more rows than the 4 slabs of 2,048 each process makes at least (pass_rows._SHARED_SLAB_ROWS): the
-    # forked processes make some slabs' text too
+    # more rows than 3 slabs of pass_rows.SLAB_ROWS (2,048): each process makes some slabs' text
     assert outputs["csv", "1"].count("\n") > 3 * 2048
     assert outputs["csv", "2"] == outputs["csv", "1"] and outputs["csv", "3"] == outputs["csv", "1"]
     assert outputs["json", "2"] == outputs["json", "1"]
