@@ -4,9 +4,10 @@ A whole catalog over a week has ~650,000 passes: 36 MB of :class:`~nfwserver.tra
 columns, and sorting them needs the sort's keys and order and a column's copy beside them.  Writing them out
 (CSV, JSON) needs only a few thousand rows at a time, in order, so :class:`SpilledPasses` appends each part the
 search finds to a temporary file (row by row, 56 bytes a row) and keeps in memory only what orders the rows
-(the time of the pass's first event and its catalog number: 16 bytes a row).  :meth:`SpilledPasses.slabs` then
-yields the passes sorted as a :class:`PassList` would hold them, ``rows`` at a time: each slab is gathered by
-one sequential read of the file.  The rows are those of the in-memory list, bit for bit and in the same order
+(the time of the pass's first event and its catalog number: 16 bytes a row).
+:meth:`SpilledPasses.sort_into_slabs` then copies the rows to a second file slab after slab, from which each slab
+of the passes, sorted as a :class:`PassList` would hold them, is read in one piece by whichever process makes
+its text.  The rows are those of the in-memory list, bit for bit and in the same order
 (the same keys, the same stable sort of the rows in the order they were found).
 
 Times are seconds after ``start`` (NaN when unknown), angles degrees, as in the PassList columns.
@@ -130,16 +131,10 @@ class SpilledPasses:
         shown: list[int] = numbers[np.lexsort((numbers, first))].tolist()
         return shown
 
-    def slabs(self, rows: int = 1 << 16) -> Iterator[PassList]:
-        """The passes sorted by AOS (TCA when unknown), then catalog number, ``rows`` at a time (each slab a
-        :class:`PassList`, the last maybe shorter).  Once only: the keys are freed as the slabs are read."""
-        with self.sort_into_slabs(rows) as slabs:
-            for k in range(len(slabs)):
-                yield slabs.slab(k)
-
     def sort_into_slabs(self, rows: int = 1 << 16) -> SortedSlabs:
-        """The passes sorted as :meth:`slabs` yields them, in a temporary file from which any slab can be read
-        (:meth:`SortedSlabs.slab`, also by a process forked after this call).  Once only: the keys are freed."""
+        """The passes sorted by AOS (TCA when unknown), then catalog number, in a temporary file from which any
+        slab of ``rows`` can be read (:meth:`SortedSlabs.slab`, also by a process forked after this call).  Once
+        only: the keys are freed."""
         # PassColumns.pass_list's sort of the same rows in the same order (ties in the order the rows were found)
         order = np.lexsort((self._numbers.values(), self._first.values()))
         self._first, self._numbers = _Growing(np.float64), _Growing(np.int32)  # unmapped
@@ -188,6 +183,9 @@ class SortedSlabs:
 
     def __len__(self) -> int:
         return -(-len(self._places) // self.rows)
+
+    def __iter__(self) -> Iterator[PassList]:
+        return (self.slab(k) for k in range(len(self)))
 
     def __enter__(self) -> SortedSlabs:
         return self

@@ -73,7 +73,8 @@ def test_slabs_hold_the_in_memory_lists_rows_in_its_order(slab: int) -> None:
         assert spilled.always_up() == cols["catalog_number"][up].tolist() != []
         high = up & (cols["max_elevation_deg"] >= 45.0)
         assert spilled.always_up(45.0) == cols["catalog_number"][high].tolist()
-        slabs = list(spilled.slabs(slab))
+        with spilled.sort_into_slabs(slab) as sorted_slabs:
+            slabs = list(sorted_slabs)
         assert [len(s) for s in slabs[:-1]] == [slab] * (len(slabs) - 1)
         assert slabs[0].skipped == (3, 7)
         _same({name: np.concatenate([s.columns[name] for s in slabs]) for name, _ in COLUMNS}, cols)
@@ -98,7 +99,8 @@ def test_workers_files_joined_read_as_one_list() -> None:
     assert joined.skipped == (0, 10, 12)
     cols = expected.columns
     assert joined.always_up() == cols["catalog_number"][np.isnan(cols["aos_s"]) & np.isnan(cols["los_s"])].tolist()
-    slabs = list(joined.slabs(50))
+    with joined.sort_into_slabs(50) as sorted_slabs:
+        slabs = list(sorted_slabs)
     _same({name: np.concatenate([s.columns[name] for s in slabs]) for name, _ in COLUMNS}, cols)
 
 
@@ -127,7 +129,9 @@ def test_an_empty_search_writes_an_empty_array_and_closes_twice() -> None:
     empty = SpilledPasses(START, 3600.0).seal()
     out = io.StringIO()
     pass_rows.write_spilled(empty, START, 0.0, {}, PASS_COLUMNS, "json", out)
-    assert out.getvalue() == "[]\n" and list(empty.slabs()) == [] and empty.always_up() == []
+    assert out.getvalue() == "[]\n" and empty.always_up() == []
+    with empty.sort_into_slabs() as none:
+        assert len(none) == 0 and list(none) == []
     empty.close()
     empty.close()
 
