@@ -3,7 +3,8 @@
 The pass search's workers (:mod:`nfwserver.tracking.pass_workers`) and the makers of a large output's text
 (:mod:`nfwserver.cli.forked_rows`) share this life cycle:
 
-- a child is forked with what it needs (no pickling on the way in) and sends its answers back pickled;
+- a child is forked with what it needs (no pickling on the way in) and sends its answers back pickled; an
+  exception that ends it is its last answer, raised in the parent when read;
 - each child closes, first thing, the ends of the pipes it inherited that are not its to write: had it kept
   the parent's reading ends, a parent killed (a signal, the out-of-memory killer) would leave it blocked
   forever in a send to a pipe nobody reads, holding its memory and the command's standard output;
@@ -46,8 +47,8 @@ class ForkedChildren:
         self._processes: list[BaseProcess] = []
 
     def start(self, target: Callable[..., None], args: tuple[Any, ...]) -> None:
-        """Fork a child running ``target(*args, sender)``, ``sender`` the writing end of its pipe (which the
-        target closes when done); answers are read with :meth:`recv` by the child's number (from 0)."""
+        """Fork a child running ``target(*args, sender)``, ``sender`` the writing end of its pipe; answers are
+        read with :meth:`recv` by the child's number (from 0)."""
         import multiprocessing
 
         if sys.platform == "win32":  # never true here (callers check can_fork); it tells the type checker so
@@ -67,14 +68,17 @@ class ForkedChildren:
         self._processes.append(process)
 
     def recv(self, k: int) -> object:
-        """Child ``k``'s next answer (blocks until it comes)."""
+        """Child ``k``'s next answer (blocks until it comes); the exception that ended the child is raised."""
         try:
-            return self._receivers[k].recv()
+            answer: object = self._receivers[k].recv()
         except EOFError:  # killed (out of memory, a signal) before it answered
             process = self._processes[k]
             process.join(5.0)
             raise OSError(f"{self.what} process ended without its answer (exit status {process.exitcode})"
                           ) from None
+        if isinstance(answer, BaseException):
+            raise answer
+        return answer
 
     def join(self) -> None:
         """Wait for every child to end (after their last answers)."""
@@ -96,7 +100,16 @@ class ForkedChildren:
 
 def _child(target: Callable[..., None], args: tuple[Any, ...], sender: Connection, inherited: list[Connection]
            ) -> None:
-    """A child's whole life: the parent's reading ends it inherited closed, then ``target``."""
+    """A child's whole life: the parent's reading ends it inherited closed, then ``target``, whose exception,
+    if it raises one, is the child's last answer (:meth:`ForkedChildren.recv` raises it in the parent)."""
     for receiver in inherited:
         receiver.close()
-    target(*args, sender)
+    try:
+        try:
+            target(*args, sender)
+        except BaseException as exc:
+            sender.send(exc)
+    except OSError:  # the parent has gone (killed, or ending the children after a failure of its own)
+        pass
+    finally:
+        sender.close()

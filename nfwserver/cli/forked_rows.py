@@ -40,23 +40,13 @@ def write_in_order(count: int, make: MakeText, put: Callable[[str, int], object]
         for k in range(count):
             p = k % processes
             made = make(k) if not p else children.recv(p - 1)
-            if isinstance(made, BaseException):
-                raise made
             text, rows = cast("tuple[str, int]", made)  # what _make_texts sends
             put(text, rows)
         children.join()
 
 
 def _make_texts(make: MakeText, slabs: Iterable[int], results: Connection) -> None:
-    """A forked process's whole life: the texts of ``slabs``, sent one by one in order (or the exception that
-    stopped it).  Each send waits until the parent reads it, so at most one text waits in this process."""
-    try:
-        try:
-            for k in slabs:
-                results.send(make(k))
-        except BaseException as exc:  # handed to the parent, which raises it
-            results.send(exc)
-    except OSError:  # the parent has gone (it failed itself, and ends this process)
-        pass
-    finally:
-        results.close()
+    """A forked process's whole life: the texts of ``slabs``, sent one by one in order.  Each send waits until
+    the parent reads it, so at most one text waits in this process."""
+    for k in slabs:
+        results.send(make(k))

@@ -79,22 +79,17 @@ class _Pulled:
 def fork_worker(search: Search, satellites: list[Any], args: tuple[Any, ...], results: Connection) -> None:
     """A forked worker's whole life: the passes of the chunks it takes (``search(satellites, *args)``, the
     one-process search of :mod:`~nfwserver.tracking.passes`; ``args[0]`` the :class:`_Pulled` chunks), sent back
-    through ``results`` (or the exception that stopped it, after telling the other workers to stop).  Runs in
-    the child only; the satellites reached it by the fork (Satrec objects cannot be pickled), only the result
-    is pickled.  A search that spills (``args``' last, a SpilledPasses on a file the parent made) writes its
-    rows to that file and sends back only what orders them (:meth:`SpilledPasses.keys`) and the satellites it
-    left out."""
+    through ``results``; a failure first tells the other workers to stop, then reaches the parent
+    (:class:`~nfwserver.forked_children.ForkedChildren`).  Runs in the child only; the satellites reached it by
+    the fork (Satrec objects cannot be pickled), only the result is pickled.  A search that spills (``args``'
+    last, a SpilledPasses on a file the parent made) writes its rows to that file and sends back only what
+    orders them (:meth:`SpilledPasses.keys`) and the satellites it left out."""
     try:
-        try:
-            outcome: object = _answer(search(satellites, *args))
-        except BaseException as exc:  # handed to the parent, which raises it
-            args[0].stop()
-            outcome = exc
-        results.send(outcome)
-    except OSError:  # the parent has gone (killed, or ending the workers after a failure of its own)
-        pass
-    finally:
-        results.close()
+        found = search(satellites, *args)
+    except BaseException:
+        args[0].stop()
+        raise
+    results.send(_answer(found))
 
 
 def _answer(found: PassList | SpilledPasses) -> object:
@@ -135,9 +130,6 @@ def in_forked_workers(search: Search, satellites: list[Any], plan: Sequence[Chun
             raise
         outcomes += [children.recv(k) for k in range(workers - 1)]  # before joining: a large answer fills the pipe
         children.join()
-    for outcome in outcomes:
-        if isinstance(outcome, BaseException):
-            raise outcome
     return outcomes
 
 
