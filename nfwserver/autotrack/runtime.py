@@ -134,11 +134,13 @@ class AutotrackRuntime:
             retry = self._select_retry
         if not on or schedule is None:
             return None
-        wanted = schedule.current_or_next(now)
-        if wanted is None or (wanted.catalog_number == selected and retry is None):
+        row = schedule.current_or_next_row(now)
+        if row is None:
             return None
-        if retry is not None and now < retry and wanted.catalog_number == selected:
+        number = int(schedule.columns["catalog_number"][row])
+        if number == selected and (retry is None or now < retry):
             return None
+        wanted = schedule.pass_at(row)
         why = self._select(wanted.catalog_number)
         with self._lock:
             if not self._on:  # switched off meanwhile: what was chosen since wins

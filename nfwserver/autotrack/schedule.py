@@ -12,6 +12,7 @@ import math
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from datetime import datetime, timedelta
+from functools import cached_property
 
 import numpy as np
 
@@ -108,22 +109,28 @@ class Schedule:
 
     def scheduled_rows(self) -> np.ndarray:
         """The rows of the scheduled passes, in AOS order."""
-        return np.flatnonzero(self.decisions.scheduled)
+        return self._scheduled[0]
+
+    @cached_property
+    def _scheduled(self) -> tuple[np.ndarray, np.ndarray]:
+        """The scheduled rows and their LOS (s after the start; +inf when unknown), both ascending: scheduled
+        passes are apart, so their LOS are in AOS order (made by the rule, not by a later element update)."""
+        rows = np.flatnonzero(self.decisions.scheduled)
+        los = self.columns["los_s"][rows]
+        return rows, np.maximum.accumulate(np.where(np.isnan(los), np.inf, los)) if len(los) else los
+
+    def current_or_next_row(self, when: datetime) -> int | None:
+        """The row of the scheduled pass in progress at ``when``, else of the next one; None when no scheduled
+        pass ends after ``when``.  Its satellite is the one selected at ``when``: the next pass's from the
+        previous scheduled pass's LOS on."""
+        rows, los = self._scheduled
+        k = int(np.searchsorted(los, (when - self.start).total_seconds(), side="right"))
+        return int(rows[k]) if k < len(rows) else None
 
     def current_or_next(self, when: datetime) -> PlannedPass | None:
-        """The scheduled pass in progress at ``when``, else the next one; None when no scheduled pass ends
-        after ``when``.  Its satellite is the one selected at ``when``: the next pass's from the previous
-        scheduled pass's LOS on."""
-        rows = self.scheduled_rows()
-        los = self.columns["los_s"][rows]
-        after = (when - self.start).total_seconds()
-        ahead = rows[np.isnan(los) | (los > after)]
-        return self.pass_at(int(ahead[0])) if len(ahead) else None
-
-    def selected_at(self, when: datetime) -> int | None:
-        """The catalog number autotrack selects at ``when`` (see :meth:`current_or_next`)."""
-        found = self.current_or_next(when)
-        return found.catalog_number if found is not None else None
+        """The pass of :meth:`current_or_next_row` as a record."""
+        row = self.current_or_next_row(when)
+        return self.pass_at(row) if row is not None else None
 
     def scheduled_passes(self) -> list[PlannedPass]:
         return [self.pass_at(int(i)) for i in self.scheduled_rows()]
