@@ -232,3 +232,23 @@ def test_the_clock_going_back_plans_again() -> None:
     planned = runtime.schedule
     runtime.tick(START)
     assert runtime.schedule is not planned and runtime.schedule.start < START
+
+
+def test_a_replan_asked_while_planning_is_not_lost() -> None:
+    station = Station(_catalog())
+    runtime = station.runtime()
+    real = runtime._planner
+    plans = []
+
+    def asking(now, previous):  # new elements arrive while the plan is being made
+        plans.append(now)
+        if len(plans) == 1:
+            runtime.replan()
+        return real(now, previous)
+
+    runtime._planner = asking
+    runtime.tick(START)
+    runtime.tick(START + timedelta(seconds=1))
+    assert len(plans) == 2
+    runtime.tick(START + timedelta(seconds=2))
+    assert len(plans) == 2
