@@ -267,3 +267,13 @@ def test_the_status_names_the_next_scheduled_pass() -> None:
     runtime = station.runtime(settings=settings)
     runtime.tick(START)
     assert runtime.status(START).problems == ("NOSUCH is not in the catalog",)
+
+
+def test_an_empty_list_says_why_nothing_is_planned() -> None:
+    station = Station(_catalog())
+    runtime = station.runtime(settings=AutotrackSettings(()))
+    runtime.tick(START)
+    status = runtime.status(START)
+    assert status.next_pass is None and station.calls == []
+    assert status.problems == ("no satellites to work: list them in [autotrack] satellites or [satellites] "
+                               "favourites",)
