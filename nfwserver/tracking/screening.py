@@ -20,11 +20,9 @@ import numpy.typing as npt
 
 from nfwserver.tracking.look_angles import look_angles_array
 from nfwserver.tracking.observer import Observer
+from nfwserver.tracking.pass_events import MAX_PLAUSIBLE_RANGE_KM
 from nfwserver.tracking.staleness import STALE_AFTER_DAYS, stale_satellites
 from nfwserver.tracking.timescale import julian_date
-
-#: Ranges beyond this (km) are treated as propagation failures.
-MAX_PLAUSIBLE_RANGE_KM = 1.5e6
 
 __all__ = ["MAX_PLAUSIBLE_RANGE_KM", "STALE_AFTER_DAYS", "Screened", "screen_satellites", "stale_satellites",
            "usable_mask", "usable_models"]
