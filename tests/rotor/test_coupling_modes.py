@@ -1,4 +1,4 @@
-"""Autotracking against the OrbitDRV and FlipAnts documents: table loads stop it; flip forced on/off or auto."""
+"""Autotracking against the FlipAnts document: flip forced on/off or auto."""
 
 from __future__ import annotations
 
@@ -9,7 +9,6 @@ import pytest
 from nfwserver.core.publisher import run_virtual
 from nfwserver.rotor.coupling import RotorCoupling
 from nfwserver.rotor.geometry import RotorGeometry
-from nfwserver.rotor.kct_table import NormalEntry
 from tests.dde.conftest import ISS_PASS
 from tests.rotor.conftest import pass_crossing_north, rotor_station
 
@@ -18,58 +17,6 @@ def _with_events(start, geometry, **kwargs):
     events: list[str] = []
     clock, server, rotor, driver, coupling, _ = rotor_station(start, geometry, on_event=events.append, **kwargs)
     return clock, server, rotor, driver, coupling, events
-
-
-# -- item 7: OrbitDRV's pass-through rule -------------------------------------------------------------
-
-def test_a_table_load_while_autotracking_disables_autotracking_until_track_on() -> None:
-    # OrbitDRV: "if OrbitDRV passes through a Table Load (AH=7) call to RotorDRV, OrbitDRV disables
-    # itself.  The assumption is that if the user is loading KCT tables, he doesn't want OrbitDRV to
-    # control the antennas anymore."
-    geometry = RotorGeometry.preset("overlap-450")
-    clock, server, rotor, driver, coupling, events = _with_events(ISS_PASS.aos + timedelta(seconds=60), geometry)
-    run_virtual(server, clock, 10)
-    assert rotor.commands and coupling.suspended is None
-    entry_time = clock.now().replace(microsecond=0) + timedelta(seconds=5)
-    driver.add_entry(NormalEntry(entry_time, 10, 10, "TABLE"))
-    assert coupling.suspended is not None
-    assert any(e.startswith("autotracking disabled") for e in events)  # visible to the console
-    before = len(rotor.commands)
-    run_virtual(server, clock, 30)
-    # The only command after the load is the table's own entry (az 10, el 10; on this 0..450 rotor the
-    # branch nearest the antennas may be 370): autotracking sent none.
-    assert [(az % 360.0, el) for az, el in rotor.commands[before:]] == [(10.0, 10.0)]
-    assert server.snapshot().state.tracking  # the Nova side still says TRACK ON; the coupling knows better
-    server.command("TRACK OFF")
-    run_virtual(server, clock, 1)
-    server.command("TRACK ON")  # enabled again
-    run_virtual(server, clock, 5)
-    assert coupling.suspended is None and "autotracking enabled again" in events
-    assert len(rotor.commands) > before + 1 and rotor.commands[-1][1] != 10.0
-
-
-def test_a_table_load_without_autotracking_changes_nothing() -> None:
-    geometry = RotorGeometry.preset("overlap-450")
-    clock, server, rotor, driver, coupling, events = _with_events(ISS_PASS.aos + timedelta(seconds=60), geometry)
-    server.command("TRACK OFF")
-    run_virtual(server, clock, 1)
-    driver.add_entry(NormalEntry(clock.now() + timedelta(minutes=30), 10, 10, "TABLE"))
-    assert coupling.suspended is None and not events
-    server.command("TRACK ON")
-    run_virtual(server, clock, 3)
-    assert rotor.commands
-
-
-def test_resume_is_the_enable_call() -> None:
-    geometry = RotorGeometry.preset("overlap-450")
-    clock, server, rotor, driver, coupling, events = _with_events(ISS_PASS.aos + timedelta(seconds=60), geometry)
-    run_virtual(server, clock, 2)
-    driver.add_entry(b"\x00" * 23)  # refused by the driver (code 1), but the call passed through OrbitDRV
-    assert coupling.suspended is not None
-    coupling.resume()
-    before = len(rotor.commands)
-    run_virtual(server, clock, 10)
-    assert len(rotor.commands) > before
 
 
 # -- item 8: flip forced on / off / auto (FlipAnts functions 7F, 7E) ------------------------------------
@@ -133,12 +80,9 @@ def test_functions_7f_and_7e_at_run_time() -> None:
         RotorCoupling(driver, lambda t: None, lambda t: None, flip_mode="inverted")
 
 
-def test_driver_announcements_reach_the_console_events() -> None:
-    # KCT 10h: "A 0FFh byte will generate the rising warble used for AOS notification."
+def test_driver_alarms_reach_the_console_events() -> None:
     geometry = RotorGeometry.preset("overlap-450")
     clock, server, rotor, driver, coupling, events = _with_events(ISS_PASS.aos + timedelta(seconds=60), geometry)
-    driver.announce(b"QRV\xff")
     rotor.az_stalled = True
     run_virtual(server, clock, 1)
-    assert events[:2] == ["Morse: QRV", "AOS warble"]
     assert any(e.startswith("ALARM: azimuth rotor stalled") for e in events)

@@ -158,7 +158,6 @@ def test_an_outage_of_rotctld_is_not_taken_for_a_stall() -> None:
         clock = VirtualClock(CROSSING.aos)
         backend = RotctldBackend(clock, geometry, port=daemon.port, timeout_s=0.5)
         driver = KctDriver(clock, backend, geometry, stall_timeout_s=15.0)
-        driver.enable(True)
         driver.service()
         assert driver.set_target(azimuth_deg=120.0, elevation_deg=30.0)
         driver.service()
