@@ -16,7 +16,7 @@ from functools import cached_property
 from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
-from nfwserver.cli.arguments import number_in, observer_value, parse_time_text
+from nfwserver.cli.arguments import number_in, observer_value
 from nfwserver.cli.errors import CliError, load_config_or_fail, say
 
 if TYPE_CHECKING:  # imported when the options are resolved: `--help` and parsing stay light
@@ -163,14 +163,6 @@ def add_tracking_options(parser: argparse.ArgumentParser, output_format: bool = 
     if output_format:
         parser.add_argument("--format", choices=("table", "csv", "json"), default="table",
                             help="output format: an aligned table, CSV with a header row, or a JSON array of objects")
-
-
-def parse_time(text: str) -> datetime:
-    """``now``, a relative time (``+2h``, ``-30m``) or ISO-8601 (UTC without a zone).
-
-    Raises :class:`ValueError` with a clear sentence.
-    """
-    return parse_time_text(text)
 
 
 def format_time(when: datetime) -> str:

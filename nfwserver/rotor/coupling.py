@@ -151,17 +151,6 @@ class RotorCoupling(TickWorker):
                     "are out of reach and will be ignored")
         self._event(f"flip mode {mode}{note}", logging.WARNING if note else logging.INFO)
 
-    def set_flip(self, al: int) -> bool:
-        """FlipAnts function 7F: AL=00 normal, AL=01 inverted; other values are reserved (ignored, False)."""
-        if al not in (0, 1):
-            return False
-        self.set_flip_mode("on" if al == 1 else "off")
-        return True
-
-    def flip_status(self) -> int:
-        """FlipAnts function 7E: 00 if antenna tracking mode is normal, 01 if inverted."""
-        return 1 if self.flip_state else 0
-
     # -- planning --------------------------------------------------------------------------
     def _plan(self, track: Sequence[tuple[datetime, float, float]], mode: str) -> PassPlan:
         sky = [(az, el) for _, az, el in track]

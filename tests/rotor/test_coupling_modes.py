@@ -29,7 +29,7 @@ def test_flip_on_inverts_every_target_even_when_the_pass_fits_normally() -> None
     sky = []
     server.subscribe(lambda s: sky.append((s.look_angles.azimuth_deg, s.look_angles.elevation_deg)))
     run_virtual(server, clock, 120)
-    assert coupling.flip_status() == 1 and rotor.commands
+    assert coupling.flip_state and rotor.commands
     assert all(el >= 90.0 for _, el in rotor.commands)
     az, el = rotor.commands[-1]
     sat_az, sat_el = sky[-1]
@@ -43,7 +43,7 @@ def test_flip_off_never_inverts_even_where_auto_would() -> None:
     clock, server, rotor, driver, coupling, _ = _with_events(crossing.aos - timedelta(seconds=30), geometry,
                                                              satellite=catnr, flip_mode="off", after_los="stay")
     run_virtual(server, clock, (crossing.los - crossing.aos).total_seconds() + 30)
-    assert coupling.flip_status() == 0
+    assert not coupling.flip_state
     assert rotor.commands and all(0 <= el <= 90 and 0 <= az <= 360 for az, el in rotor.commands)
 
 
@@ -63,15 +63,14 @@ def test_functions_7f_and_7e_at_run_time() -> None:
     clock, server, rotor, driver, coupling, events = _with_events(ISS_PASS.aos + timedelta(seconds=60), geometry,
                                                                   after_los="stay")
     run_virtual(server, clock, 10)
-    assert coupling.flip_status() == 0 and rotor.commands[-1][1] <= 90  # auto: this pass fits normally
-    assert coupling.set_flip(1)  # "01 for inverted antenna tracking"
+    assert not coupling.flip_state and rotor.commands[-1][1] <= 90  # auto: this pass fits normally
+    coupling.set_flip_mode("on")  # FLIP ON
     run_virtual(server, clock, 10)
-    assert coupling.flip_status() == 1 and rotor.commands[-1][1] > 90  # re-planned mid-pass, as asked
-    assert coupling.set_flip(2) is False  # "Other values of AL are reserved."
+    assert coupling.flip_state and rotor.commands[-1][1] > 90  # re-planned mid-pass, as asked
     assert coupling.flip_mode == "on"
-    assert coupling.set_flip(0)  # "00 for normal antenna tracking"
+    coupling.set_flip_mode("off")  # FLIP OFF
     run_virtual(server, clock, 10)
-    assert coupling.flip_status() == 0 and rotor.commands[-1][1] <= 90
+    assert not coupling.flip_state and rotor.commands[-1][1] <= 90
     coupling.set_flip_mode("auto")
     assert "flip mode auto" in events
     with pytest.raises(ValueError):
