@@ -23,8 +23,6 @@ heals, is :mod:`~nfwserver.rotor.kct_rotor_link`.
 
 from __future__ import annotations
 
-import logging
-
 from nfwserver.clock import Clock
 from nfwserver.health import LinkHealth
 from nfwserver.rotor.backend import RotorBackend
@@ -35,8 +33,6 @@ from nfwserver.rotor.kct_status import DriverStatus, KctStatusBit
 
 __all__ = ["KctDriver", "ParkingParameters"]
 
-log = logging.getLogger(__name__)
-
 
 def _valid_target(el: float, az: float) -> bool:
     return -90.0 <= el <= 269.0 and 0.0 <= az < 360.0
@@ -46,15 +42,14 @@ class KctDriver(KctRotorLink):
     """The driver model; see the module docstring."""
 
     def __init__(self, clock: Clock, backend: RotorBackend, geometry: RotorGeometry | None = None,
-                 elevation_installed: bool = True, utc_offset_hours: int = 0,
                  stall_timeout_s: float | None = 15.0, health: LinkHealth | None = None) -> None:
-        super().__init__(clock, backend, geometry, elevation_installed, stall_timeout_s, health)
-        self.utc_offset_hours = utc_offset_hours
+        super().__init__(clock, backend, geometry, stall_timeout_s, health)
         self.parking = Parking()
 
     # -- function 0 ----------------------------------------------------------------------
     def status(self) -> DriverStatus:
-        """Function 0: status bits, installation, UTC offset, binary positions."""
+        """Function 0: the status bits (its other values, the installation, UTC offset and binary positions,
+        served DOS displays; no face shows them)."""
         bits = KctStatusBit(0)
         if self._card_absent:
             bits |= KctStatusBit.CARD_ABSENT
@@ -69,13 +64,7 @@ class KctDriver(KctRotorLink):
                 bits |= KctStatusBit.AZ_MOVING | (KctStatusBit.AZ_INCREASING if daz > 0 else 0)
             if abs(delev) > 0.5:
                 bits |= KctStatusBit.EL_MOVING | (KctStatusBit.EL_INCREASING if delev > 0 else 0)
-        az_bin = el_bin = 0
-        if pos is not None:
-            g = self.geometry
-            az_bin = round((pos[0] - g.az_min) / (g.az_max - g.az_min) * 255)
-            el_bin = round((pos[1] - g.el_min) / (g.el_max - g.el_min) * 255)
-        return DriverStatus(bits, self.elevation_installed, self.utc_offset_hours,
-                            min(max(el_bin, 0), 255), min(max(az_bin, 0), 255))
+        return DriverStatus(bits)
 
     # -- functions 3 and 4 -----------------------------------------------------------------
     def positions(self) -> tuple[float | None, float | None, float | None, float | None]:

@@ -37,17 +37,18 @@ log = logging.getLogger("nfwserver.rotor.kct_driver")
 
 #: When a stalled rotor is tried again by itself: after 5 s, doubling up to once a minute.
 STALL_BACKOFF = Backoff(5.0, 60.0)
+#: Axes the stall watch follows: azimuth and elevation.
+_AXES = 2
 
 
 class KctRotorLink:
     """The rotor-facing state and calls of the driver; see the module docstring."""
 
     def __init__(self, clock: Clock, backend: RotorBackend, geometry: RotorGeometry | None,
-                 elevation_installed: bool, stall_timeout_s: float | None, health: LinkHealth | None) -> None:
+                 stall_timeout_s: float | None, health: LinkHealth | None) -> None:
         self.clock = clock
         self.backend = backend
         self.geometry = geometry or RotorGeometry()
-        self.elevation_installed = elevation_installed
         #: the ``rotor`` link: failing from a declared stall until the re-armed rotor moves again
         self.health = health if health is not None else LinkHealth("rotor", clock, STALL_BACKOFF, logger=log)
         self.annunciator = Annunciator(clock.now)
@@ -63,10 +64,6 @@ class KctRotorLink:
         #: and forgotten the target (a restarted dummy rotctld sits at 0/0), so it is sent again at once
         self._resend = False
 
-    @property
-    def _axes(self) -> int:
-        return 2 if self.elevation_installed else 1
-
     # -- reading back ---------------------------------------------------------------------
     def read_position(self) -> tuple[float, float] | None:
         """Read the rotor back (rotor frame); None when it cannot be reached."""
@@ -78,11 +75,11 @@ class KctRotorLink:
             return None
         except RotorError as exc:
             self._diagnostics.warning("read", "rotor position read failed: %s", exc)
-            self._stalled(self.stall.backend_error(self._axes), f"the rotor refused {self.stall.errors} calls in a row")
+            self._stalled(self.stall.backend_error(_AXES), f"the rotor refused {self.stall.errors} calls in a row")
             return None
         if isinstance(self.backend, StallReporting):
             self._stalled(self.stall.reported(self.backend.stalled_axes()), "the rotor reports it")
-        moving = self.stall.observe(self.clock.monotonic(), self._sent, self._position, self._axes)
+        moving = self.stall.observe(self.clock.monotonic(), self._sent, self._position, _AXES)
         self._stalled(moving, f"no movement toward the target for {self.stall.timeout_s} s")
         if not self.health.ok and not any(self.stall.stalled) and self.stall.errors == 0 and self.stall.progressed:
             self.health.succeeded()  # re-armed, accepted, and moving (or already there): the stall is over
@@ -159,7 +156,7 @@ class KctRotorLink:
 
     def off_target(self) -> bool:
         """The rotor is neither where it was last sent nor moving there (see :meth:`link_state`)."""
-        return bool(self.stall.idle_axes(self.clock.monotonic(), self._sent, self._position, self._axes))
+        return bool(self.stall.idle_axes(self.clock.monotonic(), self._sent, self._position, _AXES))
 
     def _stop_rotor(self) -> None:
         try:
@@ -185,7 +182,7 @@ class KctRotorLink:
         if command is None:  # set_target takes only targets this rotor can reach
             return
         stalled, pos = self.stall.stalled, self._position
-        if all(stalled[: self._axes]) or (any(stalled) and pos is None):
+        if all(stalled[: _AXES]) or (any(stalled) and pos is None):
             return
         rotor_az = pos[0] if stalled[0] and pos is not None else command[0]
         rotor_el = pos[1] if stalled[1] and pos is not None else command[1]
@@ -204,7 +201,7 @@ class KctRotorLink:
             # Visible at once on the rotor link; three in a row make a stall (held, retried after back-off).
             self.health.failed(f"the rotor refused a move to ({rotor_az:.1f}, {rotor_el:.1f}): {exc}", attempt=False)
             self.stall.forget_progress()
-            self._stalled(self.stall.backend_error(self._axes), f"the rotor refused {self.stall.errors} calls in a row")
+            self._stalled(self.stall.backend_error(_AXES), f"the rotor refused {self.stall.errors} calls in a row")
             return
         self.stall.backend_ok()
         self._card_absent = False
