@@ -20,7 +20,7 @@ from nfwserver.cli.arguments import number_in, observer_value
 from nfwserver.cli.errors import CliError, load_config_or_fail, say
 
 if TYPE_CHECKING:  # imported when the options are resolved: `--help` and parsing stay light
-    from nfwserver.config import Config
+    from nfwserver.config.schema import Config
     from nfwserver.tracking.catalog import Catalog
     from nfwserver.tracking.horizon import HorizonTable
     from nfwserver.tracking.observer import Observer
@@ -178,7 +178,7 @@ def config_file(config: Config) -> str:
     """The configuration file ``config`` came from, or the file the user would create."""
     if not config.source.startswith("<"):
         return config.source
-    from nfwserver.config import default_config_path
+    from nfwserver.config.files import default_config_path
 
     return str(default_config_path())
 

@@ -121,7 +121,7 @@ def test_a_reload_asked_for_while_the_station_starts_is_carried_out_once_it_is_u
     from nfwserver.app.station import Station
     from nfwserver.cli.run_command import _Requests
     from nfwserver.clock import VirtualClock
-    from nfwserver.config import load_config
+    from nfwserver.config.loader import load_config
     from nfwserver.fake_dde import FakeDdeSystem
     from tests.dde.conftest import ISS_PASS
 

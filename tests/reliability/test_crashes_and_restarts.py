@@ -144,7 +144,7 @@ def test_rotor_resumes_within_two_seconds_after_each_of_20_rotctld_restarts() ->
 def test_the_dde_feed_never_pauses_while_daemons_die_and_return() -> None:
     """A full station in real time (10 Hz) with rotctld and rigctld killed and restarted under it."""
     from nfwserver.app.station import Station
-    from nfwserver.config import parse_config
+    from nfwserver.config.loader import parse_config
     from nfwserver.fake_dde import FakeDdeSystem
 
     with HamlibDaemon("rotctld") as rot, HamlibDaemon("rigctld") as rig:

@@ -19,7 +19,7 @@ from nfwserver.app.element_sources import fetch_all
 from nfwserver.app.session_state import SessionState, StateFile
 from nfwserver.app.station import Station
 from nfwserver.clock import VirtualClock
-from nfwserver.config import parse_config
+from nfwserver.config.loader import parse_config
 from nfwserver.core.events import Direction
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tracking.elements import load_elements
@@ -135,7 +135,7 @@ def test_configuration_changed_while_running(tmp_path) -> None:
     """The watcher runs on the station's virtual clock: no real sleeps, only clock steps."""
     path = tmp_path / "c.toml"
     path.write_text('[observer]\nlocation = "JO02ae"\n[server]\nrate_hz = 5\nstate_file = "none"\n')
-    from nfwserver.config import load_config
+    from nfwserver.config.loader import load_config
 
     clock = VirtualClock(datetime(2026, 5, 8, tzinfo=timezone.utc))
     station = Station(load_config(path), clock, transport=FakeDdeSystem().server_transport())
@@ -170,7 +170,7 @@ def test_an_empty_or_half_saved_file_is_refused_and_the_running_configuration_st
     The refusal shows as the ``config`` fault until a whole file is applied, which clears it."""
     path = tmp_path / "c.toml"
     path.write_text('[observer]\nlocation = "QF56od"\n[server]\nrate_hz = 5\nstate_file = "none"\n')
-    from nfwserver.config import load_config
+    from nfwserver.config.loader import load_config
 
     clock = VirtualClock(datetime(2026, 5, 8, tzinfo=timezone.utc))
     station = Station(load_config(path), clock, transport=FakeDdeSystem().server_transport())

@@ -120,7 +120,7 @@ def test_daemon_killed_and_restarted_mid_pass() -> None:
 def test_park_stops_tracking_and_sends_the_rotor_to_its_park_position_until_track_on() -> None:
     """``PARK`` (TCP and console, through the command table): TRACK OFF, the rotor to the park position,
     and samples computed before TRACK OFF reached the state are not followed."""
-    from nfwserver.tcp import NovaTcpServer
+    from nfwserver.tcp.server import NovaTcpServer
     from tests.tcp.conftest import LOOPBACK_ONLY, LineClient
 
     geometry = RotorGeometry(-180.0, 450.0, 0.0, 90.0)

@@ -25,7 +25,7 @@ CHILD = textwrap.dedent("""
     from nfwserver.clock import SystemClock
     from nfwserver.config.schema import TcpConfig
     from nfwserver.core.station_core import StationCore
-    from nfwserver.tcp import NovaTcpServer
+    from nfwserver.tcp.server import NovaTcpServer
     from tests.dde.conftest import CATALOG, OBSERVER
     logging.basicConfig(level=logging.WARNING, stream=sys.stderr)
     core = StationCore(CATALOG, OBSERVER, SystemClock())
