@@ -17,7 +17,7 @@ from bench.realtime_loop import ClientProcess, run_publisher
 from nfwserver.clock import SystemClock, VirtualClock
 from nfwserver.config.schema import TcpConfig
 from nfwserver.core.station_core import StationCore
-from nfwserver.tcp import NovaTcpServer
+from nfwserver.tcp.server import NovaTcpServer
 from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.observer import Observer

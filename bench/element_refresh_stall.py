@@ -21,7 +21,7 @@ from pathlib import Path
 
 from nfwserver.app.station import Station
 from nfwserver.clock import SystemClock
-from nfwserver.config import parse_config
+from nfwserver.config.loader import parse_config
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tracking.tle import tle_checksum
 

@@ -73,8 +73,8 @@ def test_the_simulate_example_uses_files_that_exist(monkeypatch, capsys) -> None
 
 
 def test_the_tcp_and_easycomm_examples_are_valid_configuration() -> None:
-    from nfwserver.config import parse_config
-    from nfwserver.tcp import GREETING
+    from nfwserver.config.loader import parse_config
+    from nfwserver.tcp.greeting import GREETING
 
     section = README[README.index("## Reaching the station from outside"):README.index("## Command line")]
     config = parse_config("".join(re.findall(r"```toml\n(.*?)```", section, re.S)))
@@ -104,7 +104,7 @@ def test_the_journey_is_on_the_first_screen_after_the_two_newcomer_commands() ->
 def test_the_journey_runs_as_written(provider, tmp_path, capsys) -> None:  # noqa: F811 - the imported fixture
     """Each command of the journey, in order, on a fresh user (private configuration and data directories), with
     the element presets pointed at a local HTTP server and the TCP port at a free one."""
-    from nfwserver.config import load_config
+    from nfwserver.config.loader import load_config
     from tests.hamlib_daemons import free_port
 
     base, state = provider

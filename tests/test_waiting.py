@@ -82,9 +82,9 @@ def test_settle_has_no_pause_without_a_condition_and_names_what_it_awaited() -> 
     async def scenario() -> None:
         app: App[None] = App()
         async with app.run_test() as pilot:
-            with pytest.raises(WaitTimeout, match="did not show the footer within 0.2 s"):
+            with pytest.raises(WaitTimeout, match="after 0.2 s waiting for the console to show the footer"):
                 await settle(app, pilot, until=lambda: False, limit_s=0.2, what="the footer")
-            with pytest.raises(WaitTimeout, match="did not reach the search within 0.1 s"):
+            with pytest.raises(WaitTimeout, match="after 0.1 s waiting for the console to reach the search"):
                 await spin_until(lambda: False, 0.1, "the search")
 
     asyncio.run(scenario())

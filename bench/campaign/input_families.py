@@ -24,7 +24,7 @@ from bench.campaign.tally import Tally
 from nfwserver.app.element_store import ElementStore
 from nfwserver.app.station import Station
 from nfwserver.clock import SystemClock
-from nfwserver.config import ConfigError, parse_config
+from nfwserver.config.loader import ConfigError, parse_config
 from nfwserver.fake_dde import DdeError, FakeDdeSystem
 from nfwserver.tracking.elements import load_element_file, load_elements
 

@@ -22,7 +22,7 @@ from bench.campaign.tally import Tally
 from nfwserver.app.session_state import StateFile
 from nfwserver.app.station import Station
 from nfwserver.clock import SystemClock
-from nfwserver.config import parse_config
+from nfwserver.config.loader import parse_config
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tracking.elements import load_element_file
 

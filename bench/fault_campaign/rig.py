@@ -26,7 +26,7 @@ from pathlib import Path
 
 from nfwserver.app.station import Station
 from nfwserver.clock import VirtualClock
-from nfwserver.config import parse_config
+from nfwserver.config.loader import parse_config
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tcp.status_line import parse_status
 from nfwserver.tracking.catalog import Catalog

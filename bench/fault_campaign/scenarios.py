@@ -18,7 +18,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from bench.fault_campaign.rig import ELEMENTS, ISS, ROOT, FaultRig, LorisCounts, TickRecord
-from nfwserver.config import parse_config
+from nfwserver.config.loader import parse_config
 from nfwserver.tcp.connection import EVICT_AFTER_S
 from nfwserver.tracking.elements import load_element_file, load_elements
 from nfwserver.tracking.tle import tle_checksum

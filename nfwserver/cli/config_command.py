@@ -57,14 +57,14 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
 
 
 def run_path(args: argparse.Namespace) -> int:
-    from nfwserver.config import default_config_path
+    from nfwserver.config.files import default_config_path
 
     print(default_config_path())
     return 0
 
 
 def run_init(args: argparse.Namespace) -> int:
-    from nfwserver.config import default_config_path
+    from nfwserver.config.files import default_config_path
     from nfwserver.config.render import template
     from nfwserver.config.tokens import TEMPLATE_TOKEN, new_token
     from nfwserver.file_lock import locked
@@ -164,8 +164,7 @@ def _written(path: str | None) -> dict[str, Any]:
 def _private_mode(text: str, path: Path) -> int | None:
     """0600 for a configuration that holds the web token (a secret: only its owner may read it), else None
     (the file keeps its mode)."""
-    from nfwserver.config import ConfigError
-    from nfwserver.config.loader import parse_config
+    from nfwserver.config.loader import ConfigError, parse_config
 
     try:
         return 0o600 if parse_config(text, str(path), path.parent).web.token else None
@@ -180,8 +179,8 @@ def _written_through(path: Path) -> Path:
 
 
 def _edited(text: str, section: str, key: str, value: Any, path: Path) -> str:
-    from nfwserver.config import ConfigError
     from nfwserver.config.edit import set_key
+    from nfwserver.config.loader import ConfigError
 
     try:
         return set_key(text, section, key, value, str(path), path.parent)
@@ -191,9 +190,9 @@ def _edited(text: str, section: str, key: str, value: Any, path: Path) -> str:
 
 def run_set(args: argparse.Namespace) -> int:
     """``config set SECTION.KEY VALUE``: edit, validate the whole file, write atomically."""
-    from nfwserver.config import ConfigError, default_config_path
     from nfwserver.config.edit import parse_value, split_key
-    from nfwserver.config.loader import read_config_text
+    from nfwserver.config.files import default_config_path
+    from nfwserver.config.loader import ConfigError, read_config_text
     from nfwserver.config.render import template
     from nfwserver.config.table import setting
     from nfwserver.file_lock import locked
@@ -222,8 +221,7 @@ def run_set(args: argparse.Namespace) -> int:
 def _change_note(old_text: str, new_text: str, path: Path) -> str:
     """How a running station takes the change (:func:`nfwserver.app.change_note.change_note`)."""
     from nfwserver.app.change_note import change_note
-    from nfwserver.config import ConfigError
-    from nfwserver.config.loader import parse_config
+    from nfwserver.config.loader import ConfigError, parse_config
 
     new = parse_config(new_text, str(path), path.parent)
     try:

@@ -44,7 +44,7 @@ def _system_open(path: Path) -> None:
 
 def open_in_editor(path: Path | None) -> int:
     """Create the file from the template if it is missing, print its path, open it; the exit code."""
-    from nfwserver.config import default_config_path
+    from nfwserver.config.files import default_config_path
     from nfwserver.config.render import template
     from nfwserver.file_lock import locked
     from nfwserver.storage import atomic_write_text

@@ -21,7 +21,7 @@ from nfwserver.config.element_presets import DEFAULT_PRESET, PRESETS
 
 if TYPE_CHECKING:
     from nfwserver.app.element_store import ElementStore
-    from nfwserver.config import Config
+    from nfwserver.config.schema import Config
 
 
 def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:

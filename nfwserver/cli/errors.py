@@ -12,7 +12,7 @@ import sys
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from nfwserver.config import Config
+    from nfwserver.config.schema import Config
 
 __all__ = ["CliError", "load_config_or_fail", "say"]
 
@@ -30,7 +30,7 @@ def say(text: str) -> None:
 def load_config_or_fail(path: str | None) -> Config:
     """The configuration at ``path`` (None: the default file, or the built-in defaults without one); a file the
     loader refuses is a :class:`CliError` naming why."""
-    from nfwserver.config import ConfigError, load_config  # loaded by the commands that need it only
+    from nfwserver.config.loader import ConfigError, load_config  # loaded by the commands that need it only
 
     try:
         return load_config(path)

@@ -29,7 +29,7 @@ from nfwserver.clock import Clock, SystemClock
 if TYPE_CHECKING:
     from nfwserver.app.station import Station
     from nfwserver.cli.log_file import StationLogFile
-    from nfwserver.config import Config
+    from nfwserver.config.schema import Config
     from nfwserver.console.app import NfwConsole
     from nfwserver.dde.transport import DdeServerTransport
 
@@ -89,7 +89,7 @@ class RunPlan:
 
 
 def run(args: argparse.Namespace) -> int:
-    from nfwserver.config import default_config_path
+    from nfwserver.config.files import default_config_path
 
     config = load_config_or_fail(args.config)
     if args.duration is not None and not args.duration > 0:
@@ -119,7 +119,7 @@ def with_web(config: Config) -> Config:
 
 def _notes(station: Station, config: Config) -> tuple[list[str], str]:
     """Start-up notes for the terminal, and the console's hint (no observer, stale elements)."""
-    from nfwserver.config import observer_hint
+    from nfwserver.config.loader import observer_hint
 
     source = config.path or config.source
     notes = [f"configuration: {source}", station.transport_note, f"{len(station.catalog)} satellites loaded",

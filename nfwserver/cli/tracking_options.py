@@ -16,11 +16,11 @@ from functools import cached_property
 from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
-from nfwserver.cli.arguments import number_in, observer_value, parse_time_text
+from nfwserver.cli.arguments import number_in, observer_value
 from nfwserver.cli.errors import CliError, load_config_or_fail, say
 
 if TYPE_CHECKING:  # imported when the options are resolved: `--help` and parsing stay light
-    from nfwserver.config import Config
+    from nfwserver.config.schema import Config
     from nfwserver.tracking.catalog import Catalog
     from nfwserver.tracking.horizon import HorizonTable
     from nfwserver.tracking.observer import Observer
@@ -165,14 +165,6 @@ def add_tracking_options(parser: argparse.ArgumentParser, output_format: bool = 
                             help="output format: an aligned table, CSV with a header row, or a JSON array of objects")
 
 
-def parse_time(text: str) -> datetime:
-    """``now``, a relative time (``+2h``, ``-30m``) or ISO-8601 (UTC without a zone).
-
-    Raises :class:`ValueError` with a clear sentence.
-    """
-    return parse_time_text(text)
-
-
 def format_time(when: datetime) -> str:
     """UTC with milliseconds (truncated) and Z: ``2026-05-08T12:00:00.000Z`` (no ``strftime``: this runs
     once per table cell)."""
@@ -186,7 +178,7 @@ def config_file(config: Config) -> str:
     """The configuration file ``config`` came from, or the file the user would create."""
     if not config.source.startswith("<"):
         return config.source
-    from nfwserver.config import default_config_path
+    from nfwserver.config.files import default_config_path
 
     return str(default_config_path())
 

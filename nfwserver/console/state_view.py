@@ -176,8 +176,6 @@ def rotor_line(rotor: RotorCoupling) -> Text:
     flip = f"flip {rotor.flip_mode} ({'inverted' if rotor.flip_state else 'normal'})"
     bits = driver.status().bits
     line = Text(f"Rotor: target {target}  actual {actual}  {flip}  KCT 0x{int(bits):02X}")
-    if rotor.suspended:
-        line.append(f"  SUSPENDED: {rotor.suspended}", style="red")
     return line
 
 

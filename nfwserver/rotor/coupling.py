@@ -15,14 +15,8 @@ On every tick with ``TRACK ON``, :meth:`RotorCoupling.process`:
 - lets the driver run its clock duties and reads the rotor back, reporting the sky position the
   antennas point at through ``on_position`` (the server's ``report_antenna_position``).
 
-**Table loads stop autotracking** (OrbitDRV: "if OrbitDRV passes through a Table Load (AH=7) call to
-RotorDRV, OrbitDRV disables itself.  The assumption is that if the user is loading KCT tables, he
-doesn't want OrbitDRV to control the antennas anymore.").  Any Add-entry call made while autotracking
--- accepted or refused by the driver, as OrbitDRV disables itself on passing the call through --
-suspends autotracking: no more targets, no parking, until autotracking is enabled again, by a new
-``TRACK ON`` (a tick with track_on after one without) or :meth:`RotorCoupling.resume`.  The driver
-keeps running its table.  Both changes, and the driver's announcements (AOS/LOS warbles, stall
-alarms), are reported through ``on_event(text)`` for the console and the event log, and logged.
+The driver's alarms (a stalled rotor) and the coupling's own events are reported through ``on_event(text)``
+for the console and the event log, and logged.
 
 It takes plain callables for the tracking engine, so it does not depend on the DDE core:
 ``predict(when) -> (az, el)`` and ``pass_track(when) -> [(when, az, el), ...]`` for the pass in
@@ -52,7 +46,6 @@ log = logging.getLogger(__name__)
 Predict = Callable[[datetime], tuple[float, float] | None]
 PassTrack = Callable[[datetime], Sequence[tuple[datetime, float, float]] | None]
 AFTER_LOS = ("park", "next-aos", "stay")
-TABLE_LOAD_REASON = "a KCT time/target table entry was loaded (function 7)"
 
 
 def angular_distance(az1: float, el1: float, az2: float, el2: float) -> float:
@@ -95,7 +88,6 @@ class RotorCoupling(TickWorker):
         self.on_event = on_event
         self.plan: PassPlan | None = None
         self.flip_state = flip_mode == "on"  #: inverted pointing now (what FlipAnts' 7E reports)
-        self.suspended: str | None = None  #: why autotracking is suspended, or None
         self._sent: tuple[float, float] | None = None  # sky (az, el) of the last target sent
         self._tracking = False  # autotracking was active on the last tick
         self._track_on_seen = False
@@ -110,7 +102,6 @@ class RotorCoupling(TickWorker):
         self._park_asked = False  # PARK asked for; done at the next tick
         #: when PARK was asked for: samples computed until then, still marked tracking, are not followed
         self._parked_at: datetime | None = None
-        driver.table_load_listeners.append(self._table_loaded)
         driver.annunciator.listeners.append(self._announced)
 
     # -- events and run-time controls ----------------------------------------------------
@@ -129,22 +120,6 @@ class RotorCoupling(TickWorker):
             self.on_event(describe(item))
         except Exception:
             log.exception("rotor event listener failed")
-
-    def _table_loaded(self) -> None:
-        if self._tracking and self.suspended is None:
-            self.suspended = TABLE_LOAD_REASON
-            self._tracking = False
-            self._event(f"autotracking disabled: {TABLE_LOAD_REASON}; TRACK ON enables it again", logging.WARNING)
-
-    def resume(self) -> None:
-        """Enable autotracking again after a table load (the console's / TCP ``TRACK ON`` may call this);
-        a stalled rotor is tried again at once."""
-        self.driver.retry_now()
-        if self.suspended is not None:
-            self.suspended = None
-            with self._lock:
-                self._replan = True
-            self._event("autotracking enabled again")
 
     def request_park(self) -> None:
         """Send the rotor to its park position at its next tick (``PARK``; any thread may call this).  The
@@ -175,17 +150,6 @@ class RotorCoupling(TickWorker):
             note = (f"; this rotor's elevation stops at {self.driver.geometry.el_max:g} deg, so inverted targets "
                     "are out of reach and will be ignored")
         self._event(f"flip mode {mode}{note}", logging.WARNING if note else logging.INFO)
-
-    def set_flip(self, al: int) -> bool:
-        """FlipAnts function 7F: AL=00 normal, AL=01 inverted; other values are reserved (ignored, False)."""
-        if al not in (0, 1):
-            return False
-        self.set_flip_mode("on" if al == 1 else "off")
-        return True
-
-    def flip_status(self) -> int:
-        """FlipAnts function 7E: 00 if antenna tracking mode is normal, 01 if inverted."""
-        return 1 if self.flip_state else 0
 
     # -- planning --------------------------------------------------------------------------
     def _plan(self, track: Sequence[tuple[datetime, float, float]], mode: str) -> PassPlan:
@@ -251,11 +215,11 @@ class RotorCoupling(TickWorker):
         if parked_at is not None and sample.time <= parked_at and sample.tracking:
             sample = replace(sample, tracking=False)  # computed before PARK's TRACK OFF: not followed
         if sample.tracking and not self._track_on_seen:
-            self.resume()  # a new TRACK ON enables autotracking again
+            self.driver.retry_now()  # a new TRACK ON tries a stalled rotor again at once
         self._track_on_seen = sample.tracking
         if sample.catalog_number != self._catalog_number:
             self._satellite_changed(sample.catalog_number)
-        self._tracking = sample.tracking and self.suspended is None
+        self._tracking = sample.tracking
         la = sample.look_angles
         if self._tracking and la is not None:
             if sample.above_horizon:

@@ -1,15 +1,15 @@
 """The side of the KCT driver that faces the rotor: sending targets, reading back, stalls and their healing.
 
 :class:`KctRotorLink` is the base of :class:`~nfwserver.rotor.kct_driver.KctDriver`; it owns the backend,
-the geometry, the current target (KCT frame: elevation -90..269, azimuth 0..359), the slew offsets and
-the stall watch (:mod:`~nfwserver.rotor.stall`).  A target is mapped into the rotor's azimuth range
-continuously from its last position (a 359 -> 1 step never becomes a 358-degree swing), slew added, and
-sent only when it changed.  A stalled axis is stopped and held; nothing latches: :meth:`retry_now` (an
-operator's action) re-arms it at once, and the driver's service call re-arms it by itself after the
-``rotor`` link's back-off (:data:`STALL_BACKOFF`: 5 s doubling to a minute, so a jammed motor is driven
-for at most one stall timeout a minute).  The stall is that link's fault from the moment it is declared
-until the re-armed rotor accepts a command and moves toward its target (or is found already there).  A single refused
-move is the link's fault at once (not yet a stall: three in a row are), cleared the same way.
+the geometry, the current target (KCT frame: elevation -90..269, azimuth 0..359) and the stall watch
+(:mod:`~nfwserver.rotor.stall`).  A target is mapped into the rotor's azimuth range continuously from its
+last position (a 359 -> 1 step never becomes a 358-degree swing) and sent only when it changed.  A stalled
+axis is stopped and held; nothing latches: :meth:`retry_now` (an operator's action) re-arms it at once, and
+the driver's service call re-arms it by itself after the ``rotor`` link's back-off (:data:`STALL_BACKOFF`:
+5 s doubling to a minute, so a jammed motor is driven for at most one stall timeout a minute).  The stall
+is that link's fault from the moment it is declared until the re-armed rotor accepts a command and moves
+toward its target (or is found already there).  A single refused move is the link's fault at once (not yet
+a stall: three in a row are), cleared the same way.
 
 When the backend cannot be reached (its daemon stopped or restarts), the target is sent again at the first
 reading after its return, whether or not it changed meanwhile: a restarted daemon has forgotten it.  A rotor
@@ -37,25 +37,24 @@ log = logging.getLogger("nfwserver.rotor.kct_driver")
 
 #: When a stalled rotor is tried again by itself: after 5 s, doubling up to once a minute.
 STALL_BACKOFF = Backoff(5.0, 60.0)
+#: Axes the stall watch follows: azimuth and elevation.
+_AXES = 2
 
 
 class KctRotorLink:
     """The rotor-facing state and calls of the driver; see the module docstring."""
 
     def __init__(self, clock: Clock, backend: RotorBackend, geometry: RotorGeometry | None,
-                 elevation_installed: bool, stall_timeout_s: float | None, health: LinkHealth | None) -> None:
+                 stall_timeout_s: float | None, health: LinkHealth | None) -> None:
         self.clock = clock
         self.backend = backend
         self.geometry = geometry or RotorGeometry()
-        self.elevation_installed = elevation_installed
         #: the ``rotor`` link: failing from a declared stall until the re-armed rotor moves again
         self.health = health if health is not None else LinkHealth("rotor", clock, STALL_BACKOFF, logger=log)
         self.annunciator = Annunciator(clock.now)
         self.stall = StallWatch(timeout_s=stall_timeout_s)
         self._diagnostics = RateLimitedLog(log, clock)
-        self._slew = (0, 0)  # (el, az)
         self._target: tuple[float, float] | None = None  # (el, az) KCT frame
-        self._enabled = True
         self._rotor_az: float | None = None  # last commanded rotor-frame azimuth (continuity reference)
         self._sent: tuple[float, float] | None = None
         self._card_absent = False
@@ -64,10 +63,6 @@ class KctRotorLink:
         #: the backend could not be reached since the target was last sent: its daemon may have restarted
         #: and forgotten the target (a restarted dummy rotctld sits at 0/0), so it is sent again at once
         self._resend = False
-
-    @property
-    def _axes(self) -> int:
-        return 2 if self.elevation_installed else 1
 
     # -- reading back ---------------------------------------------------------------------
     def read_position(self) -> tuple[float, float] | None:
@@ -80,11 +75,11 @@ class KctRotorLink:
             return None
         except RotorError as exc:
             self._diagnostics.warning("read", "rotor position read failed: %s", exc)
-            self._stalled(self.stall.backend_error(self._axes), f"the rotor refused {self.stall.errors} calls in a row")
+            self._stalled(self.stall.backend_error(_AXES), f"the rotor refused {self.stall.errors} calls in a row")
             return None
         if isinstance(self.backend, StallReporting):
             self._stalled(self.stall.reported(self.backend.stalled_axes()), "the rotor reports it")
-        moving = self.stall.observe(self.clock.monotonic(), self._sent, self._position, self._axes)
+        moving = self.stall.observe(self.clock.monotonic(), self._sent, self._position, _AXES)
         self._stalled(moving, f"no movement toward the target for {self.stall.timeout_s} s")
         if not self.health.ok and not any(self.stall.stalled) and self.stall.errors == 0 and self.stall.progressed:
             self.health.succeeded()  # re-armed, accepted, and moving (or already there): the stall is over
@@ -125,7 +120,7 @@ class KctRotorLink:
     def retry_now(self) -> None:
         """An operator's action (a new satellite, ``TRACK ON``, a flip change): a stalled rotor is re-armed
         and tried at once, whatever its back-off."""
-        if any(self.stall.stalled) and self._enabled:
+        if any(self.stall.stalled):
             self.health.retry_now()
             self._probe("an operator's action")
 
@@ -160,10 +155,8 @@ class KctRotorLink:
         return "off-target" if self.off_target() else "ok"
 
     def off_target(self) -> bool:
-        """An enabled rotor is neither where it was last sent nor moving there (see :meth:`link_state`)."""
-        if not self._enabled:
-            return False
-        return bool(self.stall.idle_axes(self.clock.monotonic(), self._sent, self._position, self._axes))
+        """The rotor is neither where it was last sent nor moving there (see :meth:`link_state`)."""
+        return bool(self.stall.idle_axes(self.clock.monotonic(), self._sent, self._position, _AXES))
 
     def _stop_rotor(self) -> None:
         try:
@@ -175,25 +168,21 @@ class KctRotorLink:
             log.warning("rotor stop failed: %s", exc)
 
     def _command_for(self, el: float, az: float) -> tuple[float, float] | None:
-        """Rotor-frame (az, el) for a KCT target with the slew added, or None if the rotor cannot reach it."""
+        """Rotor-frame (az, el) for a KCT target, or None if the rotor cannot reach it."""
         g = self.geometry
-        rotor_el = el + self._slew[0]
-        sky_az = (az + self._slew[1]) % 360.0
-        if not g.el_min - 1e-9 <= rotor_el <= g.el_max + 1e-9 or not g.rotor_azimuths(sky_az):
+        if not g.el_min - 1e-9 <= el <= g.el_max + 1e-9 or not g.rotor_azimuths(az % 360.0):
             return None
         reference = self._rotor_az if self._rotor_az is not None else (self._position[0] if self._position else None)
-        return g.nearest_rotor_azimuth(sky_az, reference), rotor_el
+        return g.nearest_rotor_azimuth(az % 360.0, reference), el
 
     def _push(self, force: bool = False) -> None:
-        if self._target is None or not self._enabled:
+        if self._target is None:
             return
         command = self._command_for(*self._target)
-        if command is None:  # the slew offsets moved it out of reach
-            self._diagnostics.warning("slewed", "target with slew el %+d az %+d is out of this rotor's reach; "
-                                      "not sent", *self._slew)
+        if command is None:  # set_target takes only targets this rotor can reach
             return
         stalled, pos = self.stall.stalled, self._position
-        if all(stalled[: self._axes]) or (any(stalled) and pos is None):
+        if all(stalled[: _AXES]) or (any(stalled) and pos is None):
             return
         rotor_az = pos[0] if stalled[0] and pos is not None else command[0]
         rotor_el = pos[1] if stalled[1] and pos is not None else command[1]
@@ -212,7 +201,7 @@ class KctRotorLink:
             # Visible at once on the rotor link; three in a row make a stall (held, retried after back-off).
             self.health.failed(f"the rotor refused a move to ({rotor_az:.1f}, {rotor_el:.1f}): {exc}", attempt=False)
             self.stall.forget_progress()
-            self._stalled(self.stall.backend_error(self._axes), f"the rotor refused {self.stall.errors} calls in a row")
+            self._stalled(self.stall.backend_error(_AXES), f"the rotor refused {self.stall.errors} calls in a row")
             return
         self.stall.backend_ok()
         self._card_absent = False

@@ -1,4 +1,4 @@
-"""The KCT driver's status byte and the status call's other values."""
+"""The KCT driver's status byte (function 0)."""
 
 from __future__ import annotations
 
@@ -21,10 +21,6 @@ class KctStatusBit(enum.IntFlag):
 
 @dataclass(frozen=True)
 class DriverStatus:
-    """What function 0 returns."""
+    """What function 0 returns that the station shows."""
 
     bits: KctStatusBit
-    elevation_installed: bool  #: False for an azimuth-only installation
-    utc_offset_hours: int  #: signed: UTC + offset = local time
-    elevation_binary: int  #: raw elevation position 0..255
-    azimuth_binary: int  #: raw azimuth position 0..255

@@ -139,11 +139,6 @@ def _plain_first(element_name: str) -> str:
     return sanitize(name)
 
 
-def dde_name_for(element_name: str, catalog_number: int) -> str:
-    """The preferred DDE name of one satellite, ignoring other satellites."""
-    return name_candidates(element_name, catalog_number)[0]
-
-
 def assign_dde_names(names: dict[int, str], overrides: dict[int, str] | None = None) -> dict[int, str]:
     """Unique DDE names for ``{catalog_number: element_name}``: overrides first, then the
     well-known names, then derived names (module docstring)."""

@@ -4,24 +4,25 @@ The catalog search (:mod:`nfwserver.tracking.passes`) is built for thousands of 
 whose import alone costs more than finding a day of one satellite's passes.  This search finds the same
 passes for a handful of satellites with ``sgp4``'s scalar propagator and :mod:`math` only:
 
+The passes and their events are those :mod:`nfwserver.tracking.pass_events` defines, found to its tolerances
+(as the catalog search finds them):
+
 1. the elevation and the rate of its sine (:meth:`~nfwserver.tracking.scalar_look.ScalarLookAngles.rise_state`)
    are sampled every :data:`STEP_S` seconds (at most a 40th of the orbital period) over the window extended
-   by the look-back of :mod:`nfwserver.tracking.passes` (half a period for near-circular orbits under three
-   hours, else a period, at most a day), so that passes in progress at either end get their true AOS and LOS;
+   by the look-back, so that passes in progress at either end get their true AOS and LOS;
 2. a change of side of the horizon between two samples brackets a crossing; a rate going from rising to
    setting brackets a culmination, and one below the horizon between two samples that are both below
    (a short pass hidden between samples) is refined and, if it rises above, gives two crossings.  An
    elevation has two extrema an orbit, so at most one lies between samples a 40th of a period apart;
-3. crossings are refined to :data:`CROSSING_TOL_S`, culminations (roots of the rate) to :data:`TOP_TOL_S`,
-   by Brent's method; rises and sets are paired into passes and each pass's TCA is its highest culmination
-   (or its highest end), as the catalog search pairs them.
+3. crossings and culminations (roots of the rate) are refined by Brent's method; rises and sets are paired
+   into passes and each pass's TCA is its highest culmination (or its highest end).
 
 Times are seconds after the window start, angles degrees.  A satellite whose position at the start cannot be
-computed or is implausibly far is ``skipped``, as :mod:`nfwserver.tracking.screening` decides; one that stays
-above the horizon over the whole extended search has one pass with neither AOS nor LOS, whose TCA is the
-highest point inside the window (a culmination there, or an end), as :mod:`nfwserver.tracking.pass_always_up`
-gives.  Anything this search does not handle as the catalog search does (SGP4 failing inside the window, an
-unpaired event) raises :class:`NeedsCatalogSearch`, and the caller runs the catalog search instead.
+computed or is implausibly far is ``skipped``; one that stays above the horizon over the whole extended search
+has one pass with neither AOS nor LOS, whose TCA is the highest point inside the window (a culmination there,
+or an end), as :mod:`nfwserver.tracking.pass_always_up` gives.  Anything this search does not handle as the
+catalog search does (SGP4 failing inside the window, an unpaired event) raises :class:`NeedsCatalogSearch`, and
+the caller runs the catalog search instead.
 """
 
 from __future__ import annotations
@@ -33,16 +34,17 @@ from typing import Any
 
 from nfwserver.tracking.constants import SECONDS_PER_DAY
 from nfwserver.tracking.observer import Observer
+from nfwserver.tracking.pass_events import (
+    CROSSING_TOL_S,
+    MAX_LOOK_BACK_S,
+    MAX_PLAUSIBLE_RANGE_KM,
+    TOP_TOL_S,
+    look_back_s,
+)
 from nfwserver.tracking.scalar_look import ScalarLookAngles
 
 #: Largest sampling step (s); the step is also at most a 40th of the orbital period.
 STEP_S = 120.0
-#: Tolerances (s) of crossings (AOS, LOS) and culminations (TCA): tighter than the catalog search's bounds
-#: (0.1 ms and 1 ms), so that both give the same times.
-CROSSING_TOL_S = 1e-6
-TOP_TOL_S = 1e-5
-#: Ranges beyond this (km) are propagation failures (:data:`nfwserver.tracking.screening.MAX_PLAUSIBLE_RANGE_KM`).
-MAX_PLAUSIBLE_RANGE_KM = 1.5e6
 #: A row: catalog number, AOS (s; None when unknown), TCA, LOS (None when unknown), maximum elevation, azimuths
 #: at AOS and LOS (None when unknown).
 Row = tuple[int, "float | None", float, "float | None", float, "float | None", "float | None"]
@@ -85,8 +87,7 @@ def _search(satrec: Any, number: int, look: ScalarLookAngles, jd: float, fr: flo
             h0: float) -> list[Row]:
     """The passes of one satellite overlapping ``[0, window_s]``."""
     period = 2.0 * math.pi / max(satrec.no_kozai, 1e-9) * 60.0
-    look_back = (0.5 if satrec.ecco < 0.05 and period <= 3.0 * 3600.0 else 1.0) * period
-    extension = min(look_back, SECONDS_PER_DAY)
+    extension = min(look_back_s(period, satrec.ecco), MAX_LOOK_BACK_S)
     t_lo, t_hi = -extension, window_s + extension
     n = max(2, math.ceil((t_hi - t_lo) / min(STEP_S, period / 40.0)))
 
@@ -165,7 +166,7 @@ def _passes(number: int, events: list[tuple[float, bool, float, float]], tops: l
         for end in (rise, fall):  # an end is the TCA only if nothing is higher
             if end is not None and end[3] > best_el:
                 best_el, best_t = end[3], end[0]
-        inside = [(el, t) for t, el in tops if lo_c - 1e-3 <= t <= hi_c + 1e-3]
+        inside = [(el, t) for t, el in tops if lo_c - TOP_TOL_S <= t <= hi_c + TOP_TOL_S]
         if inside:
             el, t = max(inside)
             if el > best_el:

@@ -13,7 +13,6 @@ from __future__ import annotations
 import bisect
 import math
 from collections.abc import Iterable
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # numpy is imported by the array methods only: reading a configuration stays light
@@ -130,8 +129,3 @@ def parse_horizon(text: str, source: str = "<horizon>") -> HorizonTable:
         points.append((az, el))
     return HorizonTable(points)
 
-
-def load_horizon(path: str | Path) -> HorizonTable:
-    """Read a horizon file; raises :class:`ValueError` (bad content) or :class:`OSError`."""
-    path = Path(path)
-    return parse_horizon(path.read_text(encoding="utf-8", errors="replace"), source=str(path))

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from nfwserver.tracking.pass_batch import Layout
+from nfwserver.tracking.pass_events import TOP_TOL_S
 from nfwserver.tracking.pass_kinematics import PairEvaluator
 from nfwserver.tracking.pass_refine import CROSSING, F_TOP, TOP, solve
 from nfwserver.tracking.pass_screen import Brackets, Intervals
@@ -186,7 +187,7 @@ def assemble(ev: PairEvaluator, br: Brackets, flat: bool, layout: Layout) -> dic
         cand_t.append(s2.t)
         cand_el.append(s2.el)
     cp, ct, ce = np.concatenate(cand_pass), np.concatenate(cand_t), np.concatenate(cand_el)
-    inside = (ct >= lo_c[cp] - 1e-3) & (ct <= hi_c[cp] + 1e-3) & np.isfinite(ce)
+    inside = (ct >= lo_c[cp] - TOP_TOL_S) & (ct <= hi_c[cp] + TOP_TOL_S) & np.isfinite(ce)
     cp, ct, ce = cp[inside], ct[inside], ce[inside]
     srt = np.lexsort((ce, cp))  # the last entry of each pass is its highest candidate
     cp, ct, ce = cp[srt], ct[srt], ce[srt]

@@ -11,7 +11,8 @@ Each round evaluates every unfinished bracket at once (:class:`PairEvaluator`: o
 SGP4 call per satellite).  A crossing steps to the root of the second-order Taylor polynomial of
 ``f`` (analytic f' and f''; cubic convergence), a maximum takes a Newton step; either falls back
 to bisection when the step would leave the bracket (or, for a maximum, when the curvature has the
-wrong sign).  A bracket is finished when its step is below the tolerance or its width is, or when
+wrong sign).  A bracket is finished when its step is below the tolerance (:mod:`~nfwserver.tracking.pass_events`'
+``CROSSING_TOL_S`` for crossings, ``TOP_TOL_S`` for maxima) or its width is, or when
 the step is small and the error bounded for it is well below the tolerance: for a crossing the
 bounds on the errors of f' (SGP4's velocity is not the exact derivative of its position) and of
 f'' (approximate acceleration), and f''' estimated from two rounds; for a maximum the error that
@@ -30,12 +31,10 @@ from typing import Any
 
 import numpy as np
 
+from nfwserver.tracking.pass_events import CROSSING_TOL_S, TOP_TOL_S
 from nfwserver.tracking.pass_kinematics import Kinematics, PairEvaluator
 
 CROSSING, TOP, F_TOP = 0, 1, 2
-#: Convergence tolerances (s): crossings and maxima.
-CROSSING_TOL_S = 1e-4
-TOP_TOL_S = 1e-3
 _MAX_ROUNDS = 80
 #: A Newton step is taken as final when it is below this (s) and the error its quadratic
 #: convergence predicts for it is below ``_SAFETY`` times the tolerance.

@@ -40,13 +40,14 @@ from typing import Any
 import numpy as np
 
 from nfwserver.forked_children import can_fork
-from nfwserver.tracking.constants import MINUTES_PER_DAY, SECONDS_PER_DAY
+from nfwserver.tracking.constants import MINUTES_PER_DAY
 from nfwserver.tracking.frames import TopocentricFrame
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer
 from nfwserver.tracking.pass_always_up import always_up_columns
 from nfwserver.tracking.pass_assemble import assemble
 from nfwserver.tracking.pass_batch import Batch, Chunk
+from nfwserver.tracking.pass_events import MAX_LOOK_BACK_S, NEAR_CIRCULAR_ECC, SHORT_PERIOD_S, look_back_s
 from nfwserver.tracking.pass_kinematics import PairEvaluator
 from nfwserver.tracking.pass_records import Pass, PassColumns, PassList
 from nfwserver.tracking.pass_screen import screen
@@ -58,8 +59,6 @@ from nfwserver.tracking.timescale import julian_date
 __all__ = ["Pass", "PassList", "SpilledPasses", "find_passes", "find_passes_spilled"]
 
 _FLAT = HorizonTable()
-#: Satellites with periods up to this (s) form the low group.
-_SHORT_PERIOD_S = 3.0 * 3600.0
 #: Mean motion (rev/day) below which a near-circular orbit joins the geosynchronous-like group.
 _SLOW_REV_PER_DAY = 1.5
 #: Coarse grid steps (s) of the three groups: low, geosynchronous-like, the rest.
@@ -171,13 +170,13 @@ def _plan(satellites: Sequence[Any], window_s: float) -> list[_Chunk]:
     no, ecc, catalog_numbers = _orbits(satellites)
     periods = 2.0 * math.pi / np.maximum(no, 1e-9) * 60.0  # s
     rev_per_day = no * MINUTES_PER_DAY / (2.0 * math.pi)
-    short = periods <= _SHORT_PERIOD_S
-    slow = ~short & (rev_per_day < _SLOW_REV_PER_DAY) & (ecc < 0.05)
+    short = periods <= SHORT_PERIOD_S  # the low group
+    slow = ~short & (rev_per_day < _SLOW_REV_PER_DAY) & (ecc < NEAR_CIRCULAR_ECC)
     other = ~short & ~slow
-    look_back = np.where((ecc < 0.05) & short, 0.5, 1.0) * periods  # s
+    look_back = np.array([look_back_s(p, e) for p, e in zip(periods.tolist(), ecc.tolist())])  # s
     # Room for every pass there can be over a flat horizon (one per orbit in the searched span, plus the
     # first); an obstructed horizon can split passes, and then the columns grow.
-    room = np.ceil((window_s + 2.0 * np.minimum(look_back, SECONDS_PER_DAY)) / periods) + 1.0
+    room = np.ceil((window_s + 2.0 * np.minimum(look_back, MAX_LOOK_BACK_S)) / periods) + 1.0
     plan = []
     # The rest is split by period so that each part looks back and ahead only as far as it needs.
     for group, step in ((short, _LOW_STEP_S), (slow, _SLOW_STEP_S), (other & (periods <= 8 * 3600.0), _OTHER_STEP_S),
@@ -188,7 +187,7 @@ def _plan(satellites: Sequence[Any], window_s: float) -> list[_Chunk]:
         members = members[np.argsort(look_back[members], kind="stable")]
         for c0 in range(0, len(members), _CHUNK):
             idx = members[c0 : c0 + _CHUNK]
-            plan.append(_Chunk(idx, catalog_numbers[idx], step, float(min(np.max(look_back[idx]), SECONDS_PER_DAY)),
+            plan.append(_Chunk(idx, catalog_numbers[idx], step, float(min(np.max(look_back[idx]), MAX_LOOK_BACK_S)),
                                int(np.sum(room[idx]))))
     return plan
 

@@ -11,7 +11,6 @@ than ``max_age_days`` (30 by default) before ``at``; stale sets are still used, 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 from datetime import datetime
 from typing import Any
 
@@ -20,33 +19,14 @@ import numpy.typing as npt
 
 from nfwserver.tracking.look_angles import look_angles_array
 from nfwserver.tracking.observer import Observer
+from nfwserver.tracking.pass_events import MAX_PLAUSIBLE_RANGE_KM
 from nfwserver.tracking.staleness import STALE_AFTER_DAYS, stale_satellites
 from nfwserver.tracking.timescale import julian_date
 
-#: Ranges beyond this (km) are treated as propagation failures.
-MAX_PLAUSIBLE_RANGE_KM = 1.5e6
-
-__all__ = ["MAX_PLAUSIBLE_RANGE_KM", "STALE_AFTER_DAYS", "Screened", "screen_satellites", "stale_satellites",
+__all__ = ["MAX_PLAUSIBLE_RANGE_KM", "STALE_AFTER_DAYS", "stale_satellites",
            "usable_mask", "usable_models"]
 #: Satellites propagated at a time by :func:`usable_mask` (bounds the SGP4 models held at once).
 _BLOCK = 512
-
-
-@dataclass
-class Screened:
-    """Satellites split by whether their positions at the screening instant are usable."""
-
-    usable: list[Any] = field(default_factory=list)
-    unusable: list[Any] = field(default_factory=list)
-
-
-def screen_satellites(satellites: Sequence[Any], observer: Observer, at: datetime, ut1_utc: float = 0.0,
-                      max_range_km: float = MAX_PLAUSIBLE_RANGE_KM) -> Screened:
-    """Split ``satellites`` (objects with ``.satrec``, or element sets) into usable and unusable at ``at``."""
-    result = Screened()
-    for sat, ok in zip(satellites, usable_mask(satellites, observer, at, ut1_utc, max_range_km).tolist()):
-        (result.usable if ok else result.unusable).append(sat)
-    return result
 
 
 def usable_mask(satellites: Sequence[Any], observer: Observer, at: datetime, ut1_utc: float = 0.0,

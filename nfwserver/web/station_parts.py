@@ -45,7 +45,7 @@ def rotor_part(rotor: RotorCoupling | None) -> dict[str, object] | None:
     position = driver.rotor_position()
     _, _, target_el, target_az = driver.positions()
     out: dict[str, object] = {"flip_mode": rotor.flip_mode, "flipped": bool(rotor.flip_state),
-                              "suspended": rotor.suspended, "kct_status": f"0x{int(driver.status().bits):02X}"}
+                              "kct_status": f"0x{int(driver.status().bits):02X}"}
     out["state"] = driver.link_state()
     out["actual"] = None
     if position is not None and all(map(math.isfinite, position)):

@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import asyncio
-import time
 from collections.abc import Callable
 
 from textual.app import App
 from textual.widgets import RichLog, Static
 
-from tests.waiting import WaitTimeout
+from tests.waiting import wait_for_async
 
 
 def screen_text(app: App) -> str:
@@ -37,11 +35,7 @@ def static_text(app: App, widget_id: str) -> str:
 async def spin_until(until: Callable[[], object], limit_s: float, what: str) -> None:
     """Yield to the event loop 0.01 s at a time until ``until`` holds, without waiting for the screen to go idle
     (as :func:`settle` does, which a busy worker thread can hold up); fail after ``limit_s`` seconds."""
-    deadline = time.monotonic() + limit_s
-    while not until():
-        if time.monotonic() >= deadline:
-            raise WaitTimeout(f"the console did not reach {what} within {limit_s:g} s")
-        await asyncio.sleep(0.01)
+    await wait_for_async(until, limit_s, f"the console to reach {what}")
 
 
 def searched(app: App) -> bool:
@@ -61,8 +55,5 @@ async def settle(app: App, pilot, until: Callable[[], object], limit_s: float = 
     if workers:
         await app.workers.wait_for_complete()
     await pilot.pause()
-    deadline = time.monotonic() + limit_s
-    while not until():
-        if time.monotonic() >= deadline:
-            raise WaitTimeout(f"the console did not show {what or 'the awaited state'} within {limit_s:g} s")
-        await pilot.pause(0.05)
+    await wait_for_async(until, limit_s, f"the console to show {what or 'the awaited state'}", interval_s=0.05,
+                         pause=pilot.pause)

@@ -9,9 +9,9 @@ from dataclasses import replace
 import pytest
 
 from nfwserver.cli import main
-from nfwserver.config import Config, ConfigError, load_config, parse_config
+from nfwserver.config.loader import ConfigError, load_config, parse_config
 from nfwserver.config.render import template
-from nfwserver.config.schema import DEFAULT_OBSERVER
+from nfwserver.config.schema import DEFAULT_OBSERVER, Config
 from nfwserver.config.tokens import TEMPLATE_TOKEN
 from nfwserver.storage import atomic_write_text
 

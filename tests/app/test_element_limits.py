@@ -17,7 +17,7 @@ from nfwserver.app.element_sources import SourceError, SourceLimits, fetch_all, 
 from nfwserver.app.station import Station
 from nfwserver.cli import main
 from nfwserver.clock import VirtualClock
-from nfwserver.config import parse_config
+from nfwserver.config.loader import parse_config
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tracking.tle import tle_checksum
 from tests.app.element_formats import omm_csv, omm_json

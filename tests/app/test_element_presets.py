@@ -20,8 +20,8 @@ from nfwserver.app.element_sources import read_source
 from nfwserver.app.station import Station
 from nfwserver.cli import main
 from nfwserver.clock import VirtualClock
-from nfwserver.config import parse_config
 from nfwserver.config.element_presets import CELESTRAK_BASE, CELESTRAK_GROUPS, PRESETS, preset_urls
+from nfwserver.config.loader import parse_config
 from nfwserver.config.render import template
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tracking.elements import load_element_file

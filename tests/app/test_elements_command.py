@@ -134,7 +134,7 @@ def test_update_and_list_follow_the_configured_store(tmp_path, capsys) -> None:
     assert "bundled element set is in use" not in err
 
     from nfwserver.app.station_catalog import load_station_catalog
-    from nfwserver.config import load_config
+    from nfwserver.config.loader import load_config
 
     catalog, _ = load_station_catalog(load_config(config))
     assert {s.catalog_number for s in catalog} == {int(line.split()[0]) for line in lines[1:]}
@@ -156,7 +156,7 @@ def test_list_says_when_the_bundled_set_is_in_use(tmp_path, capsys) -> None:
 def test_the_station_starts_from_the_stored_catalog(tmp_path) -> None:
     from nfwserver.app.station import Station
     from nfwserver.clock import SystemClock
-    from nfwserver.config import parse_config
+    from nfwserver.config.loader import parse_config
     from nfwserver.fake_dde import FakeDdeSystem
 
     store = tmp_path / "elements.txt"

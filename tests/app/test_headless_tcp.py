@@ -16,7 +16,7 @@ import pytest
 from nfwserver.app.station import Station
 from nfwserver.cli import main
 from nfwserver.clock import VirtualClock
-from nfwserver.config import load_config
+from nfwserver.config.loader import load_config
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.rotor.coupling import angular_distance
 from nfwserver.tcp.status_line import parse_status

@@ -14,7 +14,7 @@ from textual.widgets import Static
 
 from nfwserver.app.station import Station
 from nfwserver.clock import VirtualClock
-from nfwserver.config import parse_config
+from nfwserver.config.loader import parse_config
 from nfwserver.console.app import NfwConsole
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tracking.observer import parse_observer

@@ -18,7 +18,7 @@ import pytest
 from nfwserver.app.station import Station
 from nfwserver.cli import main
 from nfwserver.clock import VirtualClock
-from nfwserver.config import parse_config
+from nfwserver.config.loader import parse_config
 from nfwserver.fake_dde import FakeDdeSystem
 from tests.conftest import DATA, advance_until
 from tests.dde.conftest import ISS_PASS

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from nfwserver.cli.run_command import RunPlan, serve
 from nfwserver.clock import VirtualClock
-from nfwserver.config import load_config, observer_hint
+from nfwserver.config.loader import load_config, observer_hint
 from nfwserver.console.app import NfwConsole
 from nfwserver.dde.clipboard import CF_TEXT
 from nfwserver.fake_dde import FakeDdeSystem
@@ -123,7 +123,7 @@ def test_the_start_up_line_names_where_the_rotor_daemon_is(tmp_path) -> None:
     from nfwserver.app.station import Station
     from nfwserver.cli.station_runner import enabled_outputs
     from nfwserver.clock import VirtualClock
-    from nfwserver.config import parse_config
+    from nfwserver.config.loader import parse_config
 
     config = parse_config('[rotor]\nbackend = "rotctld"\nhost = "127.0.0.1"\nport = 14533\n'
                           '[radio]\nbackend = "rigctld"\nport = 14532\n[server]\nstate_file = "none"\n')

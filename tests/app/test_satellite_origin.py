@@ -8,7 +8,7 @@ import json
 
 from nfwserver.app.station import Station
 from nfwserver.clock import VirtualClock
-from nfwserver.config import load_config
+from nfwserver.config.loader import load_config
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tcp.protocol import NovaTcpProtocol
 from nfwserver.tcp.status_line import parse_status

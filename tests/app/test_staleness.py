@@ -8,7 +8,7 @@ from datetime import timedelta
 from nfwserver.app.station import Station
 from nfwserver.cli import main
 from nfwserver.clock import VirtualClock
-from nfwserver.config import load_config
+from nfwserver.config.loader import load_config
 from nfwserver.console.pass_view import PassSearch, pass_table
 from nfwserver.console.time_display import TimeDisplay
 from nfwserver.fake_dde import FakeDdeSystem

@@ -10,7 +10,7 @@ from nfwserver.app.element_sources import bundled_elements, fetch_all
 from nfwserver.app.station import Station
 from nfwserver.cli import main
 from nfwserver.clock import SystemClock, VirtualClock
-from nfwserver.config import parse_config
+from nfwserver.config.loader import parse_config
 from nfwserver.config.schema import Config
 from nfwserver.fake_dde import FakeDdeSystem
 from tests.conftest import DATA
@@ -120,7 +120,7 @@ def test_station_with_a_simulated_rotor_reports_the_antenna_position() -> None:
 
 
 def test_rotor_config_errors_name_the_key() -> None:
-    from nfwserver.config import ConfigError
+    from nfwserver.config.loader import ConfigError
 
     with pytest.raises(ConfigError) as info:
         parse_config('[rotor]\nbackend = "serial"\ngeometry = "round"\nthreshold_deg = 90\nafter_los = "sleep"\n')

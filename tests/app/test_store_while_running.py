@@ -9,7 +9,7 @@ from datetime import datetime, timezone
 from nfwserver.app.station import Station
 from nfwserver.cli import main
 from nfwserver.clock import VirtualClock
-from nfwserver.config import parse_config
+from nfwserver.config.loader import parse_config
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tracking.elements import load_element_file
 from tests.conftest import DATA, advance_until

@@ -20,7 +20,7 @@ from nfwserver.cli import main
 from nfwserver.cli.watch_command import StationWatcher
 from nfwserver.cli.watch_view import WatchUpdate, block_lines, plain_line
 from nfwserver.clock import VirtualClock
-from nfwserver.config import load_config
+from nfwserver.config.loader import load_config
 from nfwserver.fake_dde import FakeDdeSystem
 from tests.conftest import DATA, ROOT
 from tests.dde.conftest import ISS_PASS

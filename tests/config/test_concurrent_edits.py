@@ -14,7 +14,7 @@ import threading
 
 from nfwserver.app.element_store import ElementStore
 from nfwserver.cli import main
-from nfwserver.config import load_config
+from nfwserver.config.loader import load_config
 from nfwserver.tracking.elements import load_element_file
 from tests.conftest import DATA, ROOT
 

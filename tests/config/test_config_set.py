@@ -8,7 +8,7 @@ import stat
 import pytest
 
 from nfwserver.cli import main
-from nfwserver.config import load_config
+from nfwserver.config.loader import load_config
 from nfwserver.tracking.observer import parse_observer
 
 

@@ -8,7 +8,8 @@ from collections.abc import Callable
 
 import pytest
 
-from nfwserver.config import MAX_FILE_BYTES, ConfigError, FileRefused, load_config, parse_config, read_regular_file
+from nfwserver.config.files import MAX_FILE_BYTES, FileRefused, read_regular_file
+from nfwserver.config.loader import ConfigError, load_config, parse_config
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
 

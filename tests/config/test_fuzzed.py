@@ -5,7 +5,7 @@ from __future__ import annotations
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from nfwserver.config import ConfigError, parse_config
+from nfwserver.config.loader import ConfigError, parse_config
 from nfwserver.config.render import toml_value
 from nfwserver.config.table import SETTINGS
 

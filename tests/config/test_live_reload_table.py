@@ -6,8 +6,8 @@ from dataclasses import fields
 
 from nfwserver.app.live_config import CONFIG_PARTS
 from nfwserver.clock import VirtualClock
-from nfwserver.config import parse_config
 from nfwserver.config.live_reload import keep_running, restart_needed
+from nfwserver.config.loader import parse_config
 from nfwserver.core.station_core import StationCore
 from nfwserver.tracking.catalog import Catalog
 from tests.dde.conftest import CATALOG, ISS, ISS_PASS

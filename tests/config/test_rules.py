@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from nfwserver.config import ConfigError, load_config, observer_hint, parse_config
+from nfwserver.config.loader import ConfigError, load_config, observer_hint, parse_config
 from nfwserver.config.table import SECTION_NAMES, STANDARD_BAUD_RATES, keys_of
 
 
@@ -181,7 +181,7 @@ def test_a_device_may_be_absent_at_start() -> None:
 
 def test_mode_schedules_are_checked_and_reach_the_config() -> None:
     # InstantTrack: a schedule is three-digit phases (256ths of an orbit) each followed by the mode in force.
-    from nfwserver.config import ConfigError, parse_config
+    from nfwserver.config.loader import ConfigError, parse_config
 
     config = parse_config('[satellites]\nschedules = { 7530 = "000B128A" }\n')
     assert config.schedules == {7530: "000B128A"}

@@ -11,7 +11,7 @@ import pytest
 import nfwserver.config.files
 import nfwserver.config.loader
 from nfwserver.cli.tracking_options import TrackingInputs
-from nfwserver.config import Config
+from nfwserver.config.schema import Config
 from nfwserver.config.table import SETTINGS
 
 

@@ -8,9 +8,10 @@ from dataclasses import fields, replace
 import pytest
 
 from nfwserver.cli import main
-from nfwserver.config import Config, parse_config
+from nfwserver.config.loader import parse_config
 from nfwserver.config.render import show, template
 from nfwserver.config.schema import (
+    Config,
     DialectsConfig,
     EasyCommConfig,
     ElementsConfig,

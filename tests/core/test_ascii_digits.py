@@ -54,7 +54,7 @@ def test_a_dde_poke_is_refused_and_the_feed_goes_on(value: str) -> None:
 
 
 def test_a_tcp_command_is_refused_and_the_connection_keeps_serving() -> None:
-    from nfwserver.tcp import NovaTcpServer
+    from nfwserver.tcp.server import NovaTcpServer
 
     station = make_station()
     server = NovaTcpServer(station.core, LOOPBACK_ONLY)

@@ -197,7 +197,7 @@ def test_station_serves_the_configured_dialects_next_to_nova() -> None:
 
     from nfwserver.app.station import Station
     from nfwserver.clock import VirtualClock
-    from nfwserver.config import parse_config
+    from nfwserver.config.loader import parse_config
     from nfwserver.fake_dde import FakeDdeSystem
 
     config = parse_config('[observer]\nlocation = "52.2053,0.1218,20"\n[dialects]\ndde = ["orbitron", "satpc32"]\n'

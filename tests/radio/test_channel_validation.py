@@ -9,7 +9,7 @@ import pytest
 
 from nfwserver.channels.channel import Channel
 from nfwserver.channels.modes import HAMLIB_MODES
-from nfwserver.config import ConfigError, parse_config
+from nfwserver.config.loader import ConfigError, parse_config
 
 
 @pytest.mark.parametrize("field", ["downlink_correction_hz", "uplink_correction_hz"])

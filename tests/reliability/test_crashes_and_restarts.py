@@ -22,6 +22,7 @@ from nfwserver.rotor.rotctld_backend import RotctldBackend
 from nfwserver.tracking.elements import load_element_file
 from tests.conftest import DATA
 from tests.hamlib_daemons import HamlibDaemon
+from tests.waiting import wait_for
 
 
 def _temporaries(store) -> list:
@@ -43,13 +44,14 @@ def _run_update_and_kill(store, delay: float | None) -> str:
             outcome = "killed" if proc.poll() is None else "finished"
         else:
             prefix = f".{store.name}.{proc.pid}."
-            deadline = time.monotonic() + 60
-            while proc.poll() is None and time.monotonic() < deadline:
-                if any(n.startswith(prefix) for n in os.listdir(store.parent)):
-                    os.kill(proc.pid, signal.SIGSTOP)
-                    writing = any(n.startswith(prefix) for n in os.listdir(store.parent))
-                    outcome = "mid-write" if writing and store.stat().st_ino == old_inode else "killed"
-                    break
+
+            def writing() -> bool:
+                return any(n.startswith(prefix) for n in os.listdir(store.parent))
+
+            if wait_for(lambda: proc.poll() is not None or writing(), 60.0, "the update to write or end",
+                        interval_s=0.0) and proc.poll() is None:
+                os.kill(proc.pid, signal.SIGSTOP)
+                outcome = "mid-write" if writing() and store.stat().st_ino == old_inode else "killed"
     finally:
         if proc.poll() is None:
             os.kill(proc.pid, signal.SIGKILL)
@@ -102,9 +104,7 @@ def _resume_delays(daemon: HamlibDaemon, attempt, cycles: int = 20) -> list[floa
             time.sleep(0.02)
         daemon.start()
         back = time.monotonic()
-        while not attempt():
-            assert time.monotonic() - back < 5.0, "did not resume"
-            time.sleep(0.02)
+        wait_for(attempt, 5.0, "the link to resume", interval_s=0.02)
         delays.append(time.monotonic() - back)
     return delays
 
@@ -144,7 +144,7 @@ def test_rotor_resumes_within_two_seconds_after_each_of_20_rotctld_restarts() ->
 def test_the_dde_feed_never_pauses_while_daemons_die_and_return() -> None:
     """A full station in real time (10 Hz) with rotctld and rigctld killed and restarted under it."""
     from nfwserver.app.station import Station
-    from nfwserver.config import parse_config
+    from nfwserver.config.loader import parse_config
     from nfwserver.fake_dde import FakeDdeSystem
 
     with HamlibDaemon("rotctld") as rot, HamlibDaemon("rigctld") as rig:
@@ -161,14 +161,24 @@ def test_the_dde_feed_never_pauses_while_daemons_die_and_return() -> None:
         try:
             client.poke("NFW_SERVER", "TUNE ON")
             client.poke("NFW_SERVER", "TRACK ON")
+            def rotor_up() -> bool:
+                return not station.rotor.driver.status().bits & KctStatusBit.CARD_ABSENT
+
+            def radio_up() -> bool:
+                return bool(station.radio.tuner.available)
+
+            wait_for(lambda: rotor_up() and radio_up(), 10.0, "the station to reach both daemons")
             for _ in range(3):
-                time.sleep(0.4)
                 rot.kill()
                 rig.kill()
-                time.sleep(0.4)
+                wait_for(lambda: not rotor_up() and not radio_up(), 10.0, "the station to see both daemons gone")
                 rot.start()
                 rig.start()
-            time.sleep(2.0)  # both must be back within 2 s of the daemons' return
+                # both must be back within 2 s of the daemons' return
+                wait_for(lambda: rotor_up() and radio_up(), 2.0, "the station to reach both daemons again")
+            ticks = station.publisher.stats.ticks
+            wait_for(lambda: station.radio.last_result is not None and station.publisher.stats.ticks > ticks + 3,
+                     10.0, "ticks and a tuning after the last return")
         finally:
             station.stop()
         stats = station.publisher.stats

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 from nfwserver.channels.channel import Channel
 from nfwserver.clock import SystemClock
-from nfwserver.config import ConfigError, parse_config
+from nfwserver.config.loader import ConfigError, parse_config
 from nfwserver.fake_dde import DdeError
 from nfwserver.radio.backend import RadioError
 from nfwserver.radio.rigctld_backend import RigctldBackend

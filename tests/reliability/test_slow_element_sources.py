@@ -15,7 +15,7 @@ import pytest
 from nfwserver.app.element_sources import SourceError, fetch_url
 from nfwserver.app.station import Station
 from nfwserver.clock import VirtualClock
-from nfwserver.config import parse_config
+from nfwserver.config.loader import parse_config
 from nfwserver.fake_dde import FakeDdeSystem
 from tests.conftest import advance_until
 

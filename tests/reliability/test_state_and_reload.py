@@ -19,11 +19,12 @@ from nfwserver.app.element_sources import fetch_all
 from nfwserver.app.session_state import SessionState, StateFile
 from nfwserver.app.station import Station
 from nfwserver.clock import VirtualClock
-from nfwserver.config import parse_config
+from nfwserver.config.loader import parse_config
 from nfwserver.core.events import Direction
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tracking.elements import load_elements
 from tests.conftest import DATA, advance_until
+from tests.waiting import wait_for
 
 
 def test_the_selected_satellite_survives_a_restart(tmp_path) -> None:
@@ -104,14 +105,18 @@ def test_sigkill_during_state_saves_leaves_the_last_saved_state_and_no_temporary
         first = int(proc.stdout.readline())  # saving has started (the old test often killed before that)
         if delay is None:  # kill while a save is writing: its temporary exists (checked with the saver stopped)
             prefix = f".{state.name}.{proc.pid}."
-            deadline = time.monotonic() + 30
-            while time.monotonic() < deadline:
+
+            def stopped_mid_write(proc: subprocess.Popen[str] = proc, prefix: str = prefix) -> bool:
+                if not any(n.startswith(prefix) for n in os.listdir(tmp_path)):
+                    return False
+                os.kill(proc.pid, signal.SIGSTOP)
                 if any(n.startswith(prefix) for n in os.listdir(tmp_path)):
-                    os.kill(proc.pid, signal.SIGSTOP)
-                    if any(n.startswith(prefix) for n in os.listdir(tmp_path)):
-                        mid_write += 1
-                        break
-                    os.kill(proc.pid, signal.SIGCONT)
+                    return True
+                os.kill(proc.pid, signal.SIGCONT)
+                return False
+
+            if wait_for(stopped_mid_write, 30.0, "a save caught writing", interval_s=0.0):
+                mid_write += 1
         else:
             time.sleep(delay)
         os.kill(proc.pid, signal.SIGKILL)
@@ -130,7 +135,7 @@ def test_configuration_changed_while_running(tmp_path) -> None:
     """The watcher runs on the station's virtual clock: no real sleeps, only clock steps."""
     path = tmp_path / "c.toml"
     path.write_text('[observer]\nlocation = "JO02ae"\n[server]\nrate_hz = 5\nstate_file = "none"\n')
-    from nfwserver.config import load_config
+    from nfwserver.config.loader import load_config
 
     clock = VirtualClock(datetime(2026, 5, 8, tzinfo=timezone.utc))
     station = Station(load_config(path), clock, transport=FakeDdeSystem().server_transport())
@@ -165,7 +170,7 @@ def test_an_empty_or_half_saved_file_is_refused_and_the_running_configuration_st
     The refusal shows as the ``config`` fault until a whole file is applied, which clears it."""
     path = tmp_path / "c.toml"
     path.write_text('[observer]\nlocation = "QF56od"\n[server]\nrate_hz = 5\nstate_file = "none"\n')
-    from nfwserver.config import load_config
+    from nfwserver.config.loader import load_config
 
     clock = VirtualClock(datetime(2026, 5, 8, tzinfo=timezone.utc))
     station = Station(load_config(path), clock, transport=FakeDdeSystem().server_transport())

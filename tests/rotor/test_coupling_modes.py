@@ -1,4 +1,4 @@
-"""Autotracking against the OrbitDRV and FlipAnts documents: table loads stop it; flip forced on/off or auto."""
+"""Autotracking against the FlipAnts document: flip forced on/off or auto."""
 
 from __future__ import annotations
 
@@ -9,7 +9,6 @@ import pytest
 from nfwserver.core.publisher import run_virtual
 from nfwserver.rotor.coupling import RotorCoupling
 from nfwserver.rotor.geometry import RotorGeometry
-from nfwserver.rotor.kct_table import NormalEntry
 from tests.dde.conftest import ISS_PASS
 from tests.rotor.conftest import pass_crossing_north, rotor_station
 
@@ -18,58 +17,6 @@ def _with_events(start, geometry, **kwargs):
     events: list[str] = []
     clock, server, rotor, driver, coupling, _ = rotor_station(start, geometry, on_event=events.append, **kwargs)
     return clock, server, rotor, driver, coupling, events
-
-
-# -- item 7: OrbitDRV's pass-through rule -------------------------------------------------------------
-
-def test_a_table_load_while_autotracking_disables_autotracking_until_track_on() -> None:
-    # OrbitDRV: "if OrbitDRV passes through a Table Load (AH=7) call to RotorDRV, OrbitDRV disables
-    # itself.  The assumption is that if the user is loading KCT tables, he doesn't want OrbitDRV to
-    # control the antennas anymore."
-    geometry = RotorGeometry.preset("overlap-450")
-    clock, server, rotor, driver, coupling, events = _with_events(ISS_PASS.aos + timedelta(seconds=60), geometry)
-    run_virtual(server, clock, 10)
-    assert rotor.commands and coupling.suspended is None
-    entry_time = clock.now().replace(microsecond=0) + timedelta(seconds=5)
-    driver.add_entry(NormalEntry(entry_time, 10, 10, "TABLE"))
-    assert coupling.suspended is not None
-    assert any(e.startswith("autotracking disabled") for e in events)  # visible to the console
-    before = len(rotor.commands)
-    run_virtual(server, clock, 30)
-    # The only command after the load is the table's own entry (az 10, el 10; on this 0..450 rotor the
-    # branch nearest the antennas may be 370): autotracking sent none.
-    assert [(az % 360.0, el) for az, el in rotor.commands[before:]] == [(10.0, 10.0)]
-    assert server.snapshot().state.tracking  # the Nova side still says TRACK ON; the coupling knows better
-    server.command("TRACK OFF")
-    run_virtual(server, clock, 1)
-    server.command("TRACK ON")  # enabled again
-    run_virtual(server, clock, 5)
-    assert coupling.suspended is None and "autotracking enabled again" in events
-    assert len(rotor.commands) > before + 1 and rotor.commands[-1][1] != 10.0
-
-
-def test_a_table_load_without_autotracking_changes_nothing() -> None:
-    geometry = RotorGeometry.preset("overlap-450")
-    clock, server, rotor, driver, coupling, events = _with_events(ISS_PASS.aos + timedelta(seconds=60), geometry)
-    server.command("TRACK OFF")
-    run_virtual(server, clock, 1)
-    driver.add_entry(NormalEntry(clock.now() + timedelta(minutes=30), 10, 10, "TABLE"))
-    assert coupling.suspended is None and not events
-    server.command("TRACK ON")
-    run_virtual(server, clock, 3)
-    assert rotor.commands
-
-
-def test_resume_is_the_enable_call() -> None:
-    geometry = RotorGeometry.preset("overlap-450")
-    clock, server, rotor, driver, coupling, events = _with_events(ISS_PASS.aos + timedelta(seconds=60), geometry)
-    run_virtual(server, clock, 2)
-    driver.add_entry(b"\x00" * 23)  # refused by the driver (code 1), but the call passed through OrbitDRV
-    assert coupling.suspended is not None
-    coupling.resume()
-    before = len(rotor.commands)
-    run_virtual(server, clock, 10)
-    assert len(rotor.commands) > before
 
 
 # -- item 8: flip forced on / off / auto (FlipAnts functions 7F, 7E) ------------------------------------
@@ -82,7 +29,7 @@ def test_flip_on_inverts_every_target_even_when_the_pass_fits_normally() -> None
     sky = []
     server.subscribe(lambda s: sky.append((s.look_angles.azimuth_deg, s.look_angles.elevation_deg)))
     run_virtual(server, clock, 120)
-    assert coupling.flip_status() == 1 and rotor.commands
+    assert coupling.flip_state and rotor.commands
     assert all(el >= 90.0 for _, el in rotor.commands)
     az, el = rotor.commands[-1]
     sat_az, sat_el = sky[-1]
@@ -96,7 +43,7 @@ def test_flip_off_never_inverts_even_where_auto_would() -> None:
     clock, server, rotor, driver, coupling, _ = _with_events(crossing.aos - timedelta(seconds=30), geometry,
                                                              satellite=catnr, flip_mode="off", after_los="stay")
     run_virtual(server, clock, (crossing.los - crossing.aos).total_seconds() + 30)
-    assert coupling.flip_status() == 0
+    assert not coupling.flip_state
     assert rotor.commands and all(0 <= el <= 90 and 0 <= az <= 360 for az, el in rotor.commands)
 
 
@@ -116,15 +63,14 @@ def test_functions_7f_and_7e_at_run_time() -> None:
     clock, server, rotor, driver, coupling, events = _with_events(ISS_PASS.aos + timedelta(seconds=60), geometry,
                                                                   after_los="stay")
     run_virtual(server, clock, 10)
-    assert coupling.flip_status() == 0 and rotor.commands[-1][1] <= 90  # auto: this pass fits normally
-    assert coupling.set_flip(1)  # "01 for inverted antenna tracking"
+    assert not coupling.flip_state and rotor.commands[-1][1] <= 90  # auto: this pass fits normally
+    coupling.set_flip_mode("on")  # FLIP ON
     run_virtual(server, clock, 10)
-    assert coupling.flip_status() == 1 and rotor.commands[-1][1] > 90  # re-planned mid-pass, as asked
-    assert coupling.set_flip(2) is False  # "Other values of AL are reserved."
+    assert coupling.flip_state and rotor.commands[-1][1] > 90  # re-planned mid-pass, as asked
     assert coupling.flip_mode == "on"
-    assert coupling.set_flip(0)  # "00 for normal antenna tracking"
+    coupling.set_flip_mode("off")  # FLIP OFF
     run_virtual(server, clock, 10)
-    assert coupling.flip_status() == 0 and rotor.commands[-1][1] <= 90
+    assert not coupling.flip_state and rotor.commands[-1][1] <= 90
     coupling.set_flip_mode("auto")
     assert "flip mode auto" in events
     with pytest.raises(ValueError):
@@ -133,12 +79,9 @@ def test_functions_7f_and_7e_at_run_time() -> None:
         RotorCoupling(driver, lambda t: None, lambda t: None, flip_mode="inverted")
 
 
-def test_driver_announcements_reach_the_console_events() -> None:
-    # KCT 10h: "A 0FFh byte will generate the rising warble used for AOS notification."
+def test_driver_alarms_reach_the_console_events() -> None:
     geometry = RotorGeometry.preset("overlap-450")
     clock, server, rotor, driver, coupling, events = _with_events(ISS_PASS.aos + timedelta(seconds=60), geometry)
-    driver.announce(b"QRV\xff")
     rotor.az_stalled = True
     run_virtual(server, clock, 1)
-    assert events[:2] == ["Morse: QRV", "AOS warble"]
     assert any(e.startswith("ALARM: azimuth rotor stalled") for e in events)

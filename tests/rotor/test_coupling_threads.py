@@ -39,7 +39,7 @@ def test_a_flip_change_from_another_thread_never_drives_the_rotor_from_that_thre
     assert driver.stalled
     sent = len(rotor.commands)
     _from_another_thread(lambda: coupling.set_flip_mode("off"))
-    assert coupling.flip_mode == "off" and coupling.flip_status() == 0  # the choice is visible at once
+    assert coupling.flip_mode == "off" and not coupling.flip_state  # the choice is visible at once
     assert len(rotor.commands) == sent  # ... but the rotor was not touched from the caller's thread
     server.tick(clock.now())  # the coupling's next tick, on the thread that owns the rotor
     assert len(rotor.commands) > sent
@@ -64,7 +64,7 @@ def test_a_flip_change_during_a_tick_is_not_overwritten_by_that_tick() -> None:
     coupling.set_flip_mode("auto")  # planned at the next tick
     server.tick(clock.now())
     assert flips == ["on"] and coupling.flip_mode == "on"
-    assert coupling.flip_status() == 1  # what 7E reports follows the newest choice, not the stale plan
+    assert coupling.flip_state  # what 7E reports follows the newest choice, not the stale plan
     run_virtual(server, clock, 5)
-    assert coupling.plan is not None and coupling.plan.flipped and coupling.flip_status() == 1
+    assert coupling.plan is not None and coupling.plan.flipped and coupling.flip_state
     assert rotor.commands[-1][1] > 90.0

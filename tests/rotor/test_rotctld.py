@@ -120,7 +120,7 @@ def test_daemon_killed_and_restarted_mid_pass() -> None:
 def test_park_stops_tracking_and_sends_the_rotor_to_its_park_position_until_track_on() -> None:
     """``PARK`` (TCP and console, through the command table): TRACK OFF, the rotor to the park position,
     and samples computed before TRACK OFF reached the state are not followed."""
-    from nfwserver.tcp import NovaTcpServer
+    from nfwserver.tcp.server import NovaTcpServer
     from tests.tcp.conftest import LOOPBACK_ONLY, LineClient
 
     geometry = RotorGeometry(-180.0, 450.0, 0.0, 90.0)
@@ -158,7 +158,6 @@ def test_an_outage_of_rotctld_is_not_taken_for_a_stall() -> None:
         clock = VirtualClock(CROSSING.aos)
         backend = RotctldBackend(clock, geometry, port=daemon.port, timeout_s=0.5)
         driver = KctDriver(clock, backend, geometry, stall_timeout_s=15.0)
-        driver.enable(True)
         driver.service()
         assert driver.set_target(azimuth_deg=120.0, elevation_deg=30.0)
         driver.service()

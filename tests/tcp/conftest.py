@@ -9,7 +9,7 @@ from collections.abc import Iterator
 import pytest
 
 from nfwserver.config.schema import TcpConfig
-from nfwserver.tcp import NovaTcpServer
+from nfwserver.tcp.server import NovaTcpServer
 from tests.dde.conftest import Station, make_station
 
 LOOPBACK_ONLY = TcpConfig(enabled=True, host="127.0.0.1", port=0, allow=("127.0.0.1/32",))

@@ -10,7 +10,7 @@ import select
 
 import pytest
 
-from nfwserver.tcp import NovaTcpServer
+from nfwserver.tcp.server import NovaTcpServer
 from tests.dde.conftest import make_station
 from tests.tcp.conftest import LOOPBACK_ONLY, LineClient
 from tests.waiting import wait_for

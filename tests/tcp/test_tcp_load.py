@@ -11,7 +11,7 @@ import time
 
 import numpy as np
 
-from nfwserver.tcp import NovaTcpServer
+from nfwserver.tcp.server import NovaTcpServer
 from tests.dde.conftest import ISS, make_station
 from tests.tcp.conftest import LOOPBACK_ONLY, LineClient
 from tests.waiting import wait_for

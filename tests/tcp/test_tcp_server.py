@@ -6,7 +6,7 @@ import pytest
 
 from nfwserver.config.schema import TcpConfig
 from nfwserver.core.events import Direction
-from nfwserver.tcp import NovaTcpServer
+from nfwserver.tcp.server import NovaTcpServer
 from nfwserver.tcp.status_line import parse_status
 from tests.dde.conftest import CATALOG, make_station
 from tests.tcp.conftest import LOOPBACK_ONLY, LineClient

@@ -9,7 +9,7 @@ them).  Here the publisher's tick is made to land exactly inside the drain.
 
 from __future__ import annotations
 
-from nfwserver.tcp import NovaTcpServer
+from nfwserver.tcp.server import NovaTcpServer
 from tests.tcp.conftest import LineClient
 from tests.waiting import wait_for
 

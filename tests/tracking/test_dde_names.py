@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from nfwserver.tracking.dde_names import assign_dde_names, dde_name_for, sanitize, validate_dde_name
+from nfwserver.tracking.dde_names import assign_dde_names, sanitize, validate_dde_name
 
 
 @pytest.mark.parametrize(
@@ -28,7 +28,7 @@ from nfwserver.tracking.dde_names import assign_dde_names, dde_name_for, sanitiz
     ],
 )
 def test_names_operators_recognise(element_name: str, expected: str) -> None:
-    assert dde_name_for(element_name, 12345) == expected
+    assert assign_dde_names({12345: element_name}) == {12345: expected}
 
 
 def test_collisions_resolved_by_catalog_number() -> None:
@@ -41,7 +41,7 @@ def test_collisions_resolved_by_catalog_number() -> None:
 
 @given(st.text(max_size=60), st.integers(1, 339999))
 def test_any_name_gives_a_valid_dde_name(name: str, catnr: int) -> None:
-    assert validate_dde_name(dde_name_for(name, catnr))
+    assert validate_dde_name(assign_dde_names({catnr: name})[catnr])
     assert len(sanitize(name)) <= 12
 
 

@@ -76,17 +76,6 @@ def test_no_pass_found_by_a_dense_scan_is_missed(few: FewPasses) -> None:
     assert checked > 40
 
 
-def test_the_catalog_search_finds_the_same_passes(few: FewPasses) -> None:
-    catalog = find_passes([BY_NUMBER[n] for n in NUMBERS], OBSERVER, START, END, ut1_utc=DUT1).columns
-    assert len(few.rows) == len(catalog["tca_s"])
-    for i, (number, aos, tca, los, max_el, _, _) in enumerate(few.rows):
-        assert number == catalog["catalog_number"][i]
-        for ours, theirs in ((aos, catalog["aos_s"][i]), (los, catalog["los_s"][i])):
-            assert (ours is None and np.isnan(theirs)) or abs(ours - theirs) < 1e-4  # type: ignore[operator]
-        assert abs(tca - catalog["tca_s"][i]) < 1e-2
-        assert abs(max_el - catalog["max_elevation_deg"][i]) < 1e-6
-
-
 class _DecaysAfter:
     """ISS's model, failing (SGP4 error 6: decayed) from ``after_days`` past ``jd + fr`` on."""
 

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from nfwserver.tracking.horizon import HorizonTable, load_horizon, parse_horizon
+from nfwserver.tracking.horizon import HorizonTable, parse_horizon
 from nfwserver.tracking.maidenhead import latlon_to_locator, locator_to_latlon
 from nfwserver.tracking.observer import Observer, parse_observer
 
@@ -85,10 +85,9 @@ def test_empty_and_single_point_tables() -> None:
     assert HorizonTable().is_flat
 
 
-def test_horizon_file(tmp_path) -> None:
-    path = tmp_path / "horizon.txt"
-    path.write_text("# my roof\n0 5\n\n90, 10  # trees\n180 2\n270 8\n")
-    assert load_horizon(path).points == [(0.0, 5.0), (90.0, 10.0), (180.0, 2.0), (270.0, 8.0)]
+def test_horizon_file() -> None:
+    text = "# my roof\n0 5\n\n90, 10  # trees\n180 2\n270 8\n"
+    assert parse_horizon(text).points == [(0.0, 5.0), (90.0, 10.0), (180.0, 2.0), (270.0, 8.0)]
     with pytest.raises(ValueError, match="line 2"):
         parse_horizon("0 5\n90 ninety\n")
     with pytest.raises(ValueError, match="line 1"):

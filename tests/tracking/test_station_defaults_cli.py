@@ -137,7 +137,7 @@ def test_without_an_observer_the_default_is_named_with_the_file_to_edit(tmp_path
 
 def test_after_config_init_and_a_location_the_commands_need_no_arguments(capsys) -> None:
     """The issue's acceptance: `config init`, set `location`, then passes/visible/ephemeris --sat ISS."""
-    from nfwserver.config import default_config_path
+    from nfwserver.config.files import default_config_path
 
     assert main(["config", "init"]) == 0
     path = default_config_path()

@@ -81,7 +81,7 @@ function renderDevices(f) {
   const r = f.rotor;
   const rotor = text("rotor", r ? `rotor ${r.state}: commanded ${r.target ? fixed(r.target.az, 1) + "/" + fixed(r.target.el, 1) : "-"}` +
     `, actual ${r.actual ? fixed(r.actual.az, 1) + "/" + fixed(r.actual.el, 1) : "-"}, flip ${r.flip_mode}` +
-    (r.flipped ? " (inverted)" : "") + (r.suspended ? ", SUSPENDED: " + r.suspended : "") : "rotor: none configured");
+    (r.flipped ? " (inverted)" : "") : "rotor: none configured");
   rotor.className = r && r.state !== "ok" ? "stale" : "muted";
   const d = f.radio;
   const radio = text("radio", d ? `radio ${d.state}, Doppler tuning ${d.tuning ? "on" : "off"}` +
