@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from nfwserver.cli import main
-from nfwserver.config import ConfigError, parse_config
+from nfwserver.config.loader import ConfigError, parse_config
 from nfwserver.config.schema import Config
 
 
