@@ -15,7 +15,7 @@ from :attr:`Control.config` at every request, so a changed ``[web]`` section app
 
 from __future__ import annotations
 
-import logging
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from nfwserver.commands.parsing import parse_request
@@ -24,9 +24,6 @@ from nfwserver.config.schema import WebConfig
 from nfwserver.config.tokens import token_matches, weak_token_reason
 from nfwserver.core.events import Direction
 from nfwserver.core.station_core import StationCore
-from nfwserver.ratelimited_log import RateLimitedLog
-
-log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -59,18 +56,21 @@ def _open(config: WebConfig) -> bool:
 class Control:
     """Checks and runs control requests; called on the HTTP connection threads."""
 
-    def __init__(self, core: StationCore, config: WebConfig) -> None:
+    def __init__(self, core: StationCore, config: WebConfig, note: Callable[[str, str], bool]) -> None:
         self.core = core  #: runs every command; FLIP and PARK act on its rotor (:attr:`StationCore.rotor`)
         self.config = config  #: replaced whole when the configuration changes (read once per request)
-        self._refusals = RateLimitedLog(log, core.clock, 60.0)
+        #: ``note(address, line)`` logs a refusal unless that address had one logged in the last minute
+        #: (:meth:`WebServer._note_refusal`); True when it wrote the line
+        self._note = note
 
     @property
     def enabled(self) -> bool:
         return _open(self.config)
 
     def refuse(self, peer: str, status: int, reason: str, text: str = "") -> ControlReply:
-        """Refuse a request from ``peer``: one log line and one event per burst of the same reason."""
-        if self._refusals.warning(f"{peer}:{reason}", "web control from %s refused: %s", peer, reason):
+        """Refuse a request from ``peer``: one log line and one event per burst of refusals from its address,
+        whatever the reason."""
+        if self._note(peer.removeprefix("web "), f"web control from {peer} refused: {reason}"):
             self.core.events.add(self.core.clock.now(), Direction.IN, "poke", escape_for_log(text), client=peer,
                                  accepted=False, detail=f"web control refused: {reason}")
         return ControlReply(status, False, reason)

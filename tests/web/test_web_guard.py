@@ -180,3 +180,20 @@ def test_host_names_by_the_address_connected_to() -> None:
     assert host_refusal("shack-pc.lan.evil.example", lan, "192.168.1.5") is not None
     assert host_refusal("", lan, "192.168.1.5") is not None and host_refusal(None, lan, "127.0.0.1") is None
     assert host_refusal("station.example", WebConfig(host="station.example"), "10.0.0.2") is None
+
+
+@pytest.mark.parametrize("name", ["localhost.evil.example", "localhost.", "localhostevil.example",
+                                  "127.0.0.1.evil.example", "127.0.0.1.nip.io", "[::1].evil.example",
+                                  "localhost.evil.example:8091", "localhost:8091.evil.example",
+                                  "station.lan.evil.example", "evil.example.localhost.evil"])
+def test_names_that_only_start_or_end_like_the_station_are_refused(name: str) -> None:
+    """Issue 42: a Host check accepting any name *starting with* ``localhost`` passed every test in tests/web;
+    a rebinding attacker owns ``localhost.evil.example`` and ``127.0.0.1.evil.example`` and can point them
+    at the station.  (``localhost.`` is localhost itself, written fully qualified: answered.)"""
+    with running_web(hostnames=("station.lan",)) as (_core, web):
+        reply = exchange(web, _get("/api/state", name))
+        if name == "localhost.":
+            assert status(reply) == 200
+            return
+        assert status(reply) == 421, (name, reply[:300])
+        assert b"observer" not in reply and b"nova" not in body(reply)
