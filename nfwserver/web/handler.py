@@ -103,7 +103,7 @@ class WebHandler(BaseHTTPRequestHandler):
             self._json(421, {"ok": False, "error": why})
             return False
         if self.command != "POST":  # a POST's body is still to come
-            self.web.mark(self.connection, Phase.BUSY)
+            self.web.admission.mark(self.connection, Phase.BUSY)
         return True
 
     def send_error(self, code: int, message: str | None = None, explain: str | None = None) -> None:
@@ -198,7 +198,7 @@ class WebHandler(BaseHTTPRequestHandler):
             return
         try:
             data = self.rfile.read(length)
-            self.web.mark(self.connection, Phase.BUSY)
+            self.web.admission.mark(self.connection, Phase.BUSY)
             request = json.loads(data.decode("utf-8"))
         except (UnicodeDecodeError, ValueError):
             request = None
@@ -224,7 +224,7 @@ class WebHandler(BaseHTTPRequestHandler):
         if refusal is not None:
             self._json(503, {"ok": False, "error": refusal})
             return
-        web.mark(self.connection, Phase.STREAM)
+        web.admission.mark(self.connection, Phase.STREAM)
         reason, dropped = "closed by the browser", False
         try:
             self._stream_headers()

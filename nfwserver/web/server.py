@@ -21,12 +21,12 @@ Bounds: every socket has a timeout (``io_timeout_s``): a browser that stops read
 own thread, for at most that long, and is then dropped (``stats.dropped``); there is no queue, so it
 never costs memory beyond its socket buffer, and no tick ever waits for it.  A request head must arrive
 whole within ``head_deadline_s`` and :data:`~nfwserver.web.request_head.MAX_HEAD_BYTES`
-(:mod:`~nfwserver.web.request_head`).  At most ``max_clients`` connections at once, at most
-``max_per_address`` from one address, and at most ``max_streams`` event streams: a connection over a
-cap is answered 503 naming the cap (without reading it) and closed.  Peers outside ``[web] allow`` are
-closed before a byte is read.  Each kind of refusal is logged, and recorded in the event stream, once
-per burst (a line a minute per address and kind, with the count of the others), so a flood never
-pushes the operator's history off the page.
+(:mod:`~nfwserver.web.request_head`).  Connections are held by :class:`~nfwserver.web.admission.Admission`:
+at a cap (``max_clients``, ``max_per_address``) the one that has done least for longest makes room, and
+``own_reserve`` slots are kept for the station's own address; one that cannot be let in is answered 503
+naming the cap.  At most ``max_streams`` event streams.  Peers outside ``[web] allow`` are closed before a
+byte is read.  Refusals of every kind are logged, and recorded in the event stream, once a minute per peer
+address (with the count of the others), so a flood never pushes the operator's history off the page.
 """
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ from nfwserver.listen_errors import bind_failure
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.rotor.coupling import RotorCoupling
-from nfwserver.web.admission import OWN_RESERVE, Admission, Phase
+from nfwserver.web.admission import OWN_RESERVE, Admission
 from nfwserver.web.control import Control
 from nfwserver.web.handler import WebHandler
 from nfwserver.web.hub import FrameHub
@@ -118,7 +118,7 @@ class _HttpServer(ThreadingHTTPServer):
         try:
             super().process_request_thread(request, client_address)
         finally:
-            self.web._release(request)
+            self.web.admission.release(request)
 
     def handle_error(self, request: Any, client_address: Any) -> None:
         """Whatever escaped a connection's handler: one rate-limited line, never a traceback on stderr."""
@@ -332,13 +332,6 @@ class WebServer:
                 pass
         self._note_refusal(host, f"web connection from {host} refused: {reason}", f"connection refused: {reason}")
         return False
-
-    def _release(self, request: Any) -> None:
-        self.admission.release(request)
-
-    def mark(self, request: Any, phase: Phase) -> None:
-        """What a connection is doing now (:class:`~nfwserver.web.admission.Phase`): which one makes room."""
-        self.admission.mark(request, phase)
 
     def _note_refusal(self, host: str, line: str, event: str | None = None) -> bool:
         """One log line and one event a minute per peer address (``host``), for refusals of any kind: what
