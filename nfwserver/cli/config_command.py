@@ -104,9 +104,6 @@ def run_init(args: argparse.Namespace) -> int:
         print(derived)
     if args.web_control:
         print(f"web control is on; the page's token is {token}")
-    elif args.web:  # the file holds the fresh token commented out: say how to use it
-        print(f"web control is off; to let the page send commands: nfwserver config set web.token {token} "
-              "&& nfwserver config set web.control true")
     return 0
 
 

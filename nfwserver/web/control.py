@@ -50,7 +50,18 @@ def _page_commands() -> list[Command]:
 
 def _open(config: WebConfig) -> bool:
     """Whether ``config`` lets the page send commands: control on, with a token that is not weak."""
-    return bool(config.control and config.token and weak_token_reason(config.token) is None)
+    return _closed_reason(config) is None
+
+
+def _closed_reason(config: WebConfig) -> str | None:
+    """Why ``config`` lets the page send no command, or None.  A weak token in the file turns control off
+    as it is loaded (:mod:`nfwserver.config.loader`): the refusal names the token, not the switch."""
+    weak = weak_token_reason(config.token) if config.token else None
+    if weak is not None:
+        return f"control is off: [web] token {weak}"
+    if not config.control or not config.token:
+        return "control is off ([web] control)"
+    return None
 
 
 class Control:
@@ -77,13 +88,15 @@ class Control:
 
     def closed(self, peer: str) -> ControlReply | None:
         """The refusal when control is off (checked before a request's body is read), else None."""
-        return None if self.enabled else self.refuse(peer, 403, "control is off ([web] control)")
+        why = _closed_reason(self.config)
+        return None if why is None else self.refuse(peer, 403, why)
 
     def run(self, request: object, peer: str) -> ControlReply:
         """Check and run one decoded JSON request from ``peer`` (``"web 192.0.2.1"``)."""
         config = self.config  # one reading for the whole request
-        if not _open(config) or config.token is None:
-            return self.refuse(peer, 403, "control is off ([web] control)")
+        why = _closed_reason(config)
+        if why is not None or config.token is None:
+            return self.refuse(peer, 403, why or "control is off ([web] control)")
         if not isinstance(request, dict):
             return self.refuse(peer, 400, "the request must be a JSON object with command and token")
         token, text = request.get("token"), request.get("command")

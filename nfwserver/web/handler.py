@@ -182,6 +182,7 @@ class WebHandler(BaseHTTPRequestHandler):
         if self.path.split("?", 1)[0] != "/api/command":
             self._json(404, {"ok": False, "error": "not found"})
             return
+        self.web.config_fresh()  # a token or control changed in the file a moment ago applies to this request
         control = self.web.control
         why = cross_site_reason(self.headers, self.headers.get("Host", ""))
         early = control.refuse(self.peer, 403, why) if why is not None else control.closed(self.peer)
