@@ -71,12 +71,13 @@ def _pattern_phrase(estimate: dict[str, object]) -> str:
 
 
 def new_token() -> str:
-    """A fresh random token of 24 URL-safe characters (never weak by :func:`weak_token_reason`)."""
+    """A fresh random token of 24 URL-safe characters (never weak by :func:`weak_token_reason`), never starting
+    with ``-``, so the command line offered with it (``nfwserver config set web.token TOKEN``) takes it."""
     import secrets
 
     while True:
         token = secrets.token_urlsafe(18)
-        if weak_token_reason(token) is None:
+        if not token.startswith("-") and weak_token_reason(token) is None:
             return token
 
 

@@ -81,7 +81,8 @@ class Control:
     def refuse(self, peer: str, status: int, reason: str, text: str = "") -> ControlReply:
         """Refuse a request from ``peer``: one log line and one event per burst of refusals from its address,
         whatever the reason."""
-        if self._note(peer.removeprefix("web "), f"web control from {peer} refused: {reason}"):
+        host = peer.removeprefix("web ")
+        if self._note(host, f"web control from {host} refused: {reason}"):
             self.core.events.add(self.core.clock.now(), Direction.IN, "poke", escape_for_log(text), client=peer,
                                  accepted=False, detail=f"web control refused: {reason}")
         return ControlReply(status, False, reason)

@@ -133,8 +133,9 @@ def test_config_set_refuses_a_weak_token_and_leaves_the_file(tmp_path, capsys, t
 
 
 def test_fresh_tokens_are_strong_and_compared_whole() -> None:
-    tokens = {new_token() for _ in range(50)}
-    assert len(tokens) == 50 and all(len(t) == 24 and weak_token_reason(t) is None for t in tokens)
+    tokens = {new_token() for _ in range(300)}  # one in 64 would start with "-", an option to `config set`
+    assert len(tokens) == 300 and all(len(t) == 24 and weak_token_reason(t) is None for t in tokens)
+    assert not any(t.startswith("-") for t in tokens)
     assert weak_token_reason(TOKEN) is None
     assert token_matches(TOKEN, TOKEN) and not token_matches(TOKEN[:-1], TOKEN)
     assert not token_matches(TOKEN + "x", TOKEN) and not token_matches("", TOKEN)
