@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from bench import web_process
+from bench.campaign import web_attacks
 from bench.realtime_loop import ClientProcess, run_publisher
 from nfwserver.clock import SystemClock, VirtualClock
 from nfwserver.config.schema import WebConfig
@@ -166,6 +167,7 @@ def main() -> None:
           "(p99, max: one or two ticks of 151) follows the machine's load, browsers or not; compare runs on an "
           "idle machine.\n")
     web_process.main()
+    web_attacks.main()
 
 
 if __name__ == "__main__":

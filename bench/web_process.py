@@ -54,7 +54,7 @@ class Station:
     def __init__(self, folder: Path) -> None:
         self.port = _free_port()
         config = _config(folder, self.port)
-        env = {**os.environ, "PYTHONPATH": str(ROOT)}
+        env = {**os.environ, "PYTHONPATH": str(ROOT), "XDG_STATE_HOME": str(folder / "state")}  # not another's
         self.proc = subprocess.Popen([sys.executable, "-m", "nfwserver", "run", "--config", str(config), "--headless",
                                       "--log-file", str(folder / "station.log"), "--web"],
                                      cwd=folder, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)

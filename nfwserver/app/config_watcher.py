@@ -13,6 +13,12 @@ are read, so a FIFO or device put in place of the file never blocks the watcher.
 daemon convention: ``nfwserver run`` calls it through ``Station.reload_config``); the same rules apply.
 With ``interval_s=None`` the watcher reads only on request.
 
+:meth:`ConfigWatcher.catch_up` applies a change at once on the caller's thread, for a check that must see
+the file as it is now (the web face's control switch and token, before each command: ``config set
+web.token`` has taken effect when it returns).  It costs one ``stat`` when nothing changed; a changed file is
+read and applied only when whole and valid (``config set`` replaces the file in one rename), else it is left
+to the watcher's thread, which settles and reports it as above.  Reading and applying are serialised.
+
 Owned by its own thread, ``nfw-config``; it waits on the injected clock, so tests drive it with a
 :class:`~nfwserver.clock.VirtualClock`.
 """
@@ -77,6 +83,7 @@ class ConfigWatcher(ServiceThread):
         self._seen: Signature = None
         self._requested = False
         self._request_lock = threading.Lock()  #: a request is never lost between reading and clearing the flag
+        self._apply_lock = threading.Lock()  #: one reading and applying at a time (the thread, catch_up)
 
     def request(self) -> None:
         """Read the file on the watcher's thread now, changed or not (any thread; only sets flags)."""
@@ -92,8 +99,6 @@ class ConfigWatcher(ServiceThread):
     def check(self, force: bool = False) -> bool:
         """One look at the file (the thread's step; returns True when a change was handled).  With
         ``force`` (a reload request) the file is read even if it looks unchanged, without settling first."""
-        from nfwserver.config.loader import ConfigError, has_settings, parse_config, read_config_text
-
         now = file_signature(self.path)
         if now == self._seen and not force:
             return False
@@ -101,6 +106,35 @@ class ConfigWatcher(ServiceThread):
             now = settled_signature(self.path, now, self.clock, self._stop, self.settle_s)
         if self._stop.is_set():
             return False
+        with self._apply_lock:
+            if now == self._seen and not force:
+                return False  # catch_up read it meanwhile
+            return self._read(now)
+
+    def catch_up(self) -> None:
+        """Apply the file now if it changed since it was last read and is whole and valid (any thread)."""
+        from nfwserver.config.loader import ConfigError, has_settings, parse_config, read_config_text
+
+        if file_signature(self.path) == self._seen:
+            return
+        with self._apply_lock:
+            now = file_signature(self.path)
+            if now is None or now == self._seen:
+                return
+            try:
+                text = read_config_text(self.path)
+                if file_signature(self.path) != now or not has_settings(text):
+                    return
+                new = replace(parse_config(text, str(self.path), self.path.parent), path=str(self.path))
+            except ConfigError:
+                return  # halfway written, or wrong: the watcher's thread settles and reports it
+            self._seen = now
+            self.apply(new)
+
+    def _read(self, now: Signature) -> bool:
+        """Read and apply the file whose signature is ``now`` (under the apply lock); see :meth:`check`."""
+        from nfwserver.config.loader import ConfigError, has_settings, parse_config, read_config_text
+
         if now is None:
             self._seen = now
             self.refused(f"{self.path} is missing or not a regular file; keeping the running configuration")

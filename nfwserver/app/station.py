@@ -106,6 +106,8 @@ class Station:
                                                           favourites=lambda: self.config.favourites))
             if config.web.enabled else None)
         self.watcher: ConfigWatcher | None = None
+        if self.web is not None:  # a command from the page is checked against the file as it is now
+            self.web.config_fresh = self.catch_up_config
         #: follows the stored catalog, which ``nfwserver elements update`` writes while the station runs
         self.store_watcher = StoreWatcher(self.store.path, clock, self.reload_store) if self.store else None
         self._watcher_lock = threading.Lock()
@@ -160,6 +162,13 @@ class Station:
         if self.watcher is None:
             self.watcher = ConfigWatcher(path, self.clock, self._config_changed, self._config_refused, interval_s)
             self.watcher.start()
+
+    def catch_up_config(self) -> None:
+        """Apply a change of the watched file now, on the caller's thread, if it is whole and valid
+        (:meth:`ConfigWatcher.catch_up`); nothing when the station does not follow a file."""
+        watcher = self.watcher
+        if watcher is not None:
+            watcher.catch_up()
 
     def reload_config(self) -> bool:
         """Re-read the configuration file now, changed or not (SIGHUP; any thread): applied only when whole,

@@ -1,7 +1,8 @@
 """Changing one key of the configuration file, keeping the user's comments and layout (``config set``).
 
 The file is edited as a TOML document with ``tomlkit`` (comments, blank lines and key order survive),
-the result is validated as a whole by the configuration table (:func:`parse_config`) before anything is
+the result is validated as a whole by the configuration table (:func:`parse_config`, and each entry's
+further check: a weak ``[web] token`` is refused here, though a file holding one still loads) before anything is
 written, and it is written atomically (:func:`nfwserver.storage.atomic_write_text`, which keeps the
 file's permissions): a refused value leaves the file as it was.
 """
@@ -17,8 +18,9 @@ import tomlkit
 from tomlkit.exceptions import TOMLKitError
 from tomlkit.items import AoT, InlineTable, Table
 
-from nfwserver.config.loader import ConfigError, TomlError, parse_config, toml_document
+from nfwserver.config.loader import ConfigError, TomlError, failed_checks, parse_config, toml_document
 from nfwserver.config.table import SECTIONS, keys_of
+from nfwserver.config.tokens import new_token
 
 __all__ = ["TEXT_KINDS", "parse_value", "set_key", "split_key"]
 
@@ -69,7 +71,12 @@ def set_key(text: str, section: str, key: str, value: Any, source: str, base_dir
     table[key] = value
     new = tomlkit.dumps(doc)
     new = _drop_commented_example(new, section, key)
-    parse_config(new, source, base_dir)  # raises ConfigError with every problem
+    config = parse_config(new, source, base_dir)  # raises ConfigError with every problem
+    failed = failed_checks(config)  # a weak token: a file may be loaded with one, but is never written with one
+    if failed:
+        raise ConfigError(source, [f"{entry.name}: {why}" + (f" (for a fresh one: nfwserver config set web.token "
+                                                             f"{new_token()})" if entry.key == "token" else "")
+                                   for entry, why in failed])
     return new
 
 

@@ -5,7 +5,9 @@ a file with any problem is refused whole: the server never starts half-configure
 key or section is an error that lists the valid ones (a typo would otherwise be silently
 ignored); a section with an unknown key skips its cross-key checks, so a typo is reported alone
 and not also as a missing key.  Accepted settings that expose a listener beyond this machine are
-returned in :attr:`Config.warnings` for the caller to log at start.
+returned in :attr:`Config.warnings` for the caller to log at start, and so is a value that fails its table
+entry's further check (a weak ``[web] token``: the file loads, web control stays off, one warning says why
+and offers a strong token; ``config set`` refuses to write such a value, :mod:`nfwserver.config.edit`).
 """
 
 from __future__ import annotations
@@ -32,8 +34,9 @@ from nfwserver.config.schema import (
     TcpConfig,
     WebConfig,
 )
+from nfwserver.config.setting import Setting
 from nfwserver.config.table import SECTION_NAMES, SETTINGS, keys_of, setting
-from nfwserver.config.tokens import new_token, weak_token_reason
+from nfwserver.config.tokens import new_token
 from nfwserver.tracking.horizon import HorizonTable, parse_horizon
 from nfwserver.tracking.observer import Observer
 
@@ -176,9 +179,6 @@ class _Reading:
         if "web" not in self.dirty and self.get("web", "control") and not token:
             self.problems.append("[web] token: required when control is on (at least 8 characters; for a "
                                  f"fresh one: nfwserver config set web.token {new_token()})")
-        elif "web" not in self.dirty and token is not None and (why := weak_token_reason(token)):
-            self.problems.append(f"[web] token: {why} (for a fresh one: nfwserver config set web.token "
-                                 f"{new_token()})")
 
     def warnings(self, config: Config) -> tuple[str, ...]:
         found = []
@@ -223,8 +223,34 @@ def parse_config(text: str, source: str = "<config>", base_dir: Path | None = No
         horizon_file=reading.get("horizon", "file"), source=source,
         **{name: _RECORDS[name](**values) for name, values in records.items()}, **top,
     )
-    warnings = reading.warnings(config)
+    failed = failed_checks(config)
+    if failed and config.web.control and any(entry.key == "token" for entry, _ in failed):
+        config = replace(config, web=replace(config.web, control=False))
+    warnings = (*(_failed_note(entry, why) for entry, why in failed), *reading.warnings(config))
     return replace(config, warnings=warnings) if warnings else config
+
+
+def failed_checks(config: Config) -> list[tuple[Setting, str]]:
+    """The settings of ``config`` whose value fails its table entry's further check
+    (:attr:`~nfwserver.config.setting.Setting.check`: a weak ``[web] token``), with why."""
+    failed = []
+    for entry in SETTINGS:
+        if entry.check is None:
+            continue
+        value: Any = config
+        for name in entry.where.split("."):
+            value = getattr(value, name)
+        if value is not None and (why := entry.check(value)):
+            failed.append((entry, why))
+    return failed
+
+
+def _failed_note(entry: Setting, why: str) -> str:
+    """The one warning a loaded file gets for a setting that fails its check (the server still starts)."""
+    if (entry.section, entry.key) == ("web", "token"):
+        return (f"[web] token: {why}; web control stays off until the token is strong (for a fresh one: "
+                f"nfwserver config set web.token {new_token()})")
+    return f"{entry.name}: {why}"
 
 
 def load_config(path: str | Path | None = None) -> Config:

@@ -6,6 +6,7 @@ Kept apart from the table (:mod:`nfwserver.config.table`) so that the value conv
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -27,6 +28,9 @@ class Setting:
     choices: tuple[Any, ...] = ()
     example: Any = None  #: shown commented out in the template instead of the default
     initial: Any = None  #: written by ``config init`` instead of the default (a starting choice)
+    #: a further check of a well-formed value: why it is refused, or None.  ``config set`` never writes a file
+    #: whose value fails it; a file that already holds one loads with a warning (:mod:`~nfwserver.config.loader`)
+    check: Callable[[Any], str | None] | None = None
 
     @property
     def name(self) -> str:

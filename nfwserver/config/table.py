@@ -18,6 +18,7 @@ from typing import Any
 from nfwserver.config.element_presets import DEFAULT_PRESET, PRESETS
 from nfwserver.config.kinds import convert
 from nfwserver.config.setting import Section, Setting
+from nfwserver.config.tokens import weak_token_reason
 
 #: Hamlib's standard serial rates (baud).
 STANDARD_BAUD_RATES = (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200)
@@ -197,8 +198,8 @@ SETTINGS: tuple[Setting, ...] = (
     _S("web", "control", "bool", False, "let the page send TUNE, TRACK and SAT (each request needs the token)",
        "web.control"),
     _S("web", "token", "text", None, "the secret every control request must carry (required when control is on; "
-       "at least 8 characters, no spaces, not guessable; `config init` writes a fresh one)", "web.token", 8, 256,
-       example="change-me-0123"),
+       "at least 8 characters, no spaces, hard to guess by zxcvbn's estimate; `config init` writes a fresh one)",
+       "web.token", 8, 256, example="change-me-0123", check=weak_token_reason),
 )
 del _S
 

@@ -13,6 +13,7 @@ only the hand-over of the newest sample.
 - :mod:`~nfwserver.web.control`: who may send a command, and sending it.
 """
 
-from nfwserver.web.server import StationParts, WebServer
+from nfwserver.web.server import WebServer
+from nfwserver.web.station_parts import StationParts
 
 __all__ = ["StationParts", "WebServer"]

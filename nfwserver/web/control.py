@@ -15,7 +15,7 @@ from :attr:`Control.config` at every request, so a changed ``[web]`` section app
 
 from __future__ import annotations
 
-import logging
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from nfwserver.commands.parsing import parse_request
@@ -24,9 +24,6 @@ from nfwserver.config.schema import WebConfig
 from nfwserver.config.tokens import token_matches, weak_token_reason
 from nfwserver.core.events import Direction
 from nfwserver.core.station_core import StationCore
-from nfwserver.ratelimited_log import RateLimitedLog
-
-log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -53,37 +50,54 @@ def _page_commands() -> list[Command]:
 
 def _open(config: WebConfig) -> bool:
     """Whether ``config`` lets the page send commands: control on, with a token that is not weak."""
-    return bool(config.control and config.token and weak_token_reason(config.token) is None)
+    return _closed_reason(config) is None
+
+
+def _closed_reason(config: WebConfig) -> str | None:
+    """Why ``config`` lets the page send no command, or None.  A weak token in the file turns control off
+    as it is loaded (:mod:`nfwserver.config.loader`): the refusal names the token, not the switch."""
+    weak = weak_token_reason(config.token) if config.token else None
+    if weak is not None:
+        return f"control is off: [web] token {weak}"
+    if not config.control or not config.token:
+        return "control is off ([web] control)"
+    return None
 
 
 class Control:
     """Checks and runs control requests; called on the HTTP connection threads."""
 
-    def __init__(self, core: StationCore, config: WebConfig) -> None:
+    def __init__(self, core: StationCore, config: WebConfig, note: Callable[[str, str], bool]) -> None:
         self.core = core  #: runs every command; FLIP and PARK act on its rotor (:attr:`StationCore.rotor`)
         self.config = config  #: replaced whole when the configuration changes (read once per request)
-        self._refusals = RateLimitedLog(log, core.clock, 60.0)
+        #: ``note(address, line)`` logs a refusal unless that address had one logged in the last minute
+        #: (:meth:`WebServer._note_refusal`); True when it wrote the line
+        self._note = note
 
     @property
     def enabled(self) -> bool:
         return _open(self.config)
 
     def refuse(self, peer: str, status: int, reason: str, text: str = "") -> ControlReply:
-        """Refuse a request from ``peer``: one log line and one event per burst of the same reason."""
-        if self._refusals.warning(f"{peer}:{reason}", "web control from %s refused: %s", peer, reason):
+        """Refuse a request from ``peer``: one log line and one event per burst of refusals from its address,
+        whatever the reason."""
+        host = peer.removeprefix("web ")
+        if self._note(host, f"web control from {host} refused: {reason}"):
             self.core.events.add(self.core.clock.now(), Direction.IN, "poke", escape_for_log(text), client=peer,
                                  accepted=False, detail=f"web control refused: {reason}")
         return ControlReply(status, False, reason)
 
     def closed(self, peer: str) -> ControlReply | None:
         """The refusal when control is off (checked before a request's body is read), else None."""
-        return None if self.enabled else self.refuse(peer, 403, "control is off ([web] control)")
+        why = _closed_reason(self.config)
+        return None if why is None else self.refuse(peer, 403, why)
 
     def run(self, request: object, peer: str) -> ControlReply:
         """Check and run one decoded JSON request from ``peer`` (``"web 192.0.2.1"``)."""
         config = self.config  # one reading for the whole request
-        if not _open(config) or config.token is None:
-            return self.refuse(peer, 403, "control is off ([web] control)")
+        why = _closed_reason(config)
+        if why is not None or config.token is None:
+            return self.refuse(peer, 403, why or "control is off ([web] control)")
         if not isinstance(request, dict):
             return self.refuse(peer, 400, "the request must be a JSON object with command and token")
         token, text = request.get("token"), request.get("command")

@@ -16,6 +16,7 @@
 from __future__ import annotations
 
 import ipaddress
+import re
 from typing import Protocol
 
 from nfwserver.config.schema import WebConfig
@@ -23,6 +24,7 @@ from nfwserver.config.schema import WebConfig
 __all__ = ["cross_site_reason", "host_name", "host_refusal"]
 
 _WILDCARDS = ("0.0.0.0", "::", "")
+_HOST_FORM = re.compile(r"(?:\[(?P<bracketed>[^\[\]]*)\]|(?P<name>[^:\[\]]*))(?::[0-9]{1,5})?")
 
 
 class Headers(Protocol):
@@ -32,13 +34,14 @@ class Headers(Protocol):
 
 
 def host_name(header: str) -> str:
-    """The name or address of a ``Host`` header, without its port, brackets, case or final dot."""
+    """The name or address of a ``Host`` header, without its port, brackets, case or final dot.  Only
+    ``name``, ``name:port`` and ``[address]:port`` (the port all digits) are taken apart: anything else
+    (``localhost:8091.evil.example``, ``[::1].evil.example``) is returned whole, so it names no station."""
     host = header.strip().lower()
-    if host.startswith("["):
-        return host[1:host.find("]")] if "]" in host else host
-    if host.count(":") == 1:
-        host = host.split(":", 1)[0]
-    return host.rstrip(".")
+    form = _HOST_FORM.fullmatch(host)
+    if form is None:
+        return host
+    return (form["bracketed"] if form["bracketed"] is not None else form["name"]).rstrip(".")
 
 
 def _ip(text: str) -> ipaddress.IPv4Address | ipaddress.IPv6Address | None:

@@ -31,9 +31,10 @@ from http.server import BaseHTTPRequestHandler
 from importlib import resources
 from typing import Any
 
+from nfwserver.web.admission import Phase
 from nfwserver.web.control import help_entries
 from nfwserver.web.guard import cross_site_reason, host_refusal
-from nfwserver.web.request_head import HeadReader, error_response, linger_close, read_head
+from nfwserver.web.request_head import SECURITY_HEADERS, HeadReader, error_response, linger_close, read_head
 
 log = logging.getLogger(__name__)
 
@@ -43,12 +44,6 @@ _STATIC_NAME = re.compile(r"[a-z0-9][a-z0-9_.-]{0,63}")
 _TYPES = {".html": "text/html; charset=utf-8", ".js": "text/javascript; charset=utf-8",
           ".css": "text/css; charset=utf-8", ".json": "application/json", ".svg": "image/svg+xml",
           ".png": "image/png"}
-SECURITY_HEADERS = (
-    ("Content-Security-Policy", "default-src 'self'; img-src 'self' data:; style-src 'self'; script-src 'self'; "
-                                "connect-src 'self'; frame-ancestors 'none'; base-uri 'none'; form-action 'none'"),
-    ("X-Content-Type-Options", "nosniff"),
-    ("Referrer-Policy", "same-origin"),  # the page's own requests carry their Origin; others learn nothing
-)
 
 
 def static_file(name: str) -> bytes | None:
@@ -91,7 +86,7 @@ class WebHandler(BaseHTTPRequestHandler):
             self.requestline, self.command = head.data.split(b"\n", 1)[0].decode("latin-1").strip()[:200], ""
             web.request_refused(self.client_address[0], head.status, head.message)
             self.connection.settimeout(web.io_timeout_s)
-            self.connection.sendall(error_response(head.status, head.message, headers=SECURITY_HEADERS))
+            self.connection.sendall(error_response(head.status, head.message))
             linger_close(self.connection)
             return
         self.rfile = io.BufferedReader(HeadReader(head.data, self.connection, deadline, web.io_timeout_s))
@@ -107,7 +102,20 @@ class WebHandler(BaseHTTPRequestHandler):
             self.close_connection = True
             self._json(421, {"ok": False, "error": why})
             return False
+        if self.command != "POST":  # a POST's body is still to come
+            self.web.admission.mark(self.connection, Phase.BUSY)
         return True
+
+    def send_error(self, code: int, message: str | None = None, explain: str | None = None) -> None:
+        """The standard library's refusals (400, 414, 431 too many headers, 501 an unsupported method such
+        as ``OPTIONS``) as ours: a small JSON body with the security headers, counted and logged as a
+        refusal of this address."""
+        self.close_connection = True
+        default, _ = self.responses.get(code, ("Error", ""))
+        why = message or default
+        self.web.request_refused(self.client_address[0], code, why)
+        self.wfile.write(error_response(code, why, head_only=getattr(self, "command", None) == "HEAD",
+                                        reason=default))
 
     @property
     def web(self) -> Any:
@@ -149,7 +157,7 @@ class WebHandler(BaseHTTPRequestHandler):
             name = "icon.svg" if path == "/favicon.ico" else path[len("/static/"):]
             body = static_file(name)
             if body is None:
-                self._json(404, {"error": "not found"})
+                self._json(404, {"ok": False, "error": "not found"})
             else:
                 suffix = name[name.rfind("."):] if "." in name else ""
                 self._send(200, body, _TYPES.get(suffix, "application/octet-stream"), cache=suffix == ".json")
@@ -162,7 +170,7 @@ class WebHandler(BaseHTTPRequestHandler):
         elif path == "/api/stream":
             self._stream()
         else:
-            self._json(404, {"error": "not found"})
+            self._json(404, {"ok": False, "error": "not found"})
 
     def do_HEAD(self) -> None:  # noqa: N802
         if self.path.split("?", 1)[0] == "/api/stream":
@@ -172,8 +180,9 @@ class WebHandler(BaseHTTPRequestHandler):
 
     def do_POST(self) -> None:  # noqa: N802
         if self.path.split("?", 1)[0] != "/api/command":
-            self._json(404, {"error": "not found"})
+            self._json(404, {"ok": False, "error": "not found"})
             return
+        self.web.config_fresh()  # a token or control changed in the file a moment ago applies to this request
         control = self.web.control
         why = cross_site_reason(self.headers, self.headers.get("Host", ""))
         early = control.refuse(self.peer, 403, why) if why is not None else control.closed(self.peer)
@@ -189,7 +198,9 @@ class WebHandler(BaseHTTPRequestHandler):
             self._json(413 if length > MAX_BODY_BYTES else 411, {"ok": False, "message": "body of 0..4096 bytes"})
             return
         try:
-            request = json.loads(self.rfile.read(length).decode("utf-8"))
+            data = self.rfile.read(length)
+            self.web.admission.mark(self.connection, Phase.BUSY)
+            request = json.loads(data.decode("utf-8"))
         except (UnicodeDecodeError, ValueError):
             request = None
         except RecursionError:  # "[[[[..." deeper than the interpreter's stack
@@ -214,6 +225,7 @@ class WebHandler(BaseHTTPRequestHandler):
         if refusal is not None:
             self._json(503, {"ok": False, "error": refusal})
             return
+        web.admission.mark(self.connection, Phase.STREAM)
         reason, dropped = "closed by the browser", False
         try:
             self._stream_headers()

@@ -24,11 +24,19 @@ import socket
 import time
 from dataclasses import dataclass
 
-__all__ = ["HEAD_DEADLINE_S", "MAX_HEAD_BYTES", "Head", "HeadReader", "error_response", "linger_close", "read_head"]
+__all__ = ["HEAD_DEADLINE_S", "MAX_HEAD_BYTES", "SECURITY_HEADERS", "Head", "HeadReader", "error_response",
+           "linger_close", "read_head"]
 
 HEAD_DEADLINE_S = 10.0  #: real seconds a request head (and a request body) may take to arrive, all of it
 MAX_HEAD_BYTES = 32 * 1024  #: request line and headers together
 _VERSION = re.compile(rb"HTTP/1\.[01]")
+#: sent with every response, an error's too (docs/WEB.md, "Security model")
+SECURITY_HEADERS = (
+    ("Content-Security-Policy", "default-src 'self'; img-src 'self' data:; style-src 'self'; script-src 'self'; "
+                                "connect-src 'self'; frame-ancestors 'none'; base-uri 'none'; form-action 'none'"),
+    ("X-Content-Type-Options", "nosniff"),
+    ("Referrer-Policy", "same-origin"),  # the page's own requests carry their Origin; others learn nothing
+)
 _REASONS = {400: "Bad Request", 403: "Forbidden", 408: "Request Timeout", 413: "Content Too Large",
             421: "Misdirected Request", 431: "Request Header Fields Too Large", 503: "Service Unavailable",
             505: "HTTP Version Not Supported"}
@@ -115,13 +123,14 @@ class HeadReader(io.RawIOBase):
             self._sock.settimeout(self._io_timeout_s)
 
 
-def error_response(status: int, message: str, head_only: bool = False,
-                   headers: tuple[tuple[str, str], ...] = ()) -> bytes:
-    """A complete HTTP/1.0 answer ``{"error": message}`` with ``status``, closing the connection."""
-    body = json.dumps({"ok": False, "error": message}).encode()
-    lines = [f"HTTP/1.0 {status} {_REASONS.get(status, 'Error')}", "Server: nfwserver",
+def error_response(status: int, message: str, head_only: bool = False, reason: str | None = None) -> bytes:
+    """A complete HTTP/1.0 answer ``{"ok": false, "error": message}`` with ``status`` (``reason`` its phrase,
+    by default the usual one) and the :data:`SECURITY_HEADERS`, closing the connection."""
+    body = json.dumps({"ok": False, "error": message[:300]}).encode()
+    phrase = "".join(ch for ch in (reason or _REASONS.get(status, "Error")) if " " <= ch <= "~")[:60]
+    lines = [f"HTTP/1.0 {status} {phrase}", "Server: nfwserver",
              "Content-Type: application/json", f"Content-Length: {len(body)}", "Cache-Control: no-store",
-             "Connection: close", *(f"{name}: {value}" for name, value in headers)]
+             "Connection: close", *(f"{name}: {value}" for name, value in SECURITY_HEADERS)]
     return ("\r\n".join(lines) + "\r\n\r\n").encode() + (b"" if head_only else body)
 
 

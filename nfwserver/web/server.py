@@ -21,12 +21,12 @@ Bounds: every socket has a timeout (``io_timeout_s``): a browser that stops read
 own thread, for at most that long, and is then dropped (``stats.dropped``); there is no queue, so it
 never costs memory beyond its socket buffer, and no tick ever waits for it.  A request head must arrive
 whole within ``head_deadline_s`` and :data:`~nfwserver.web.request_head.MAX_HEAD_BYTES`
-(:mod:`~nfwserver.web.request_head`).  At most ``max_clients`` connections at once, at most
-``max_per_address`` from one address, and at most ``max_streams`` event streams: a connection over a
-cap is answered 503 naming the cap (without reading it) and closed.  Peers outside ``[web] allow`` are
-closed before a byte is read.  Each kind of refusal is logged, and recorded in the event stream, once
-per burst (a line a minute per address and kind, with the count of the others), so a flood never
-pushes the operator's history off the page.
+(:mod:`~nfwserver.web.request_head`).  Connections are held by :class:`~nfwserver.web.admission.Admission`:
+at a cap (``max_clients``, ``max_per_address``) the one that has done least for longest makes room, and
+``own_reserve`` slots are kept for the station's own address; one that cannot be let in is answered 503
+naming the cap.  At most ``max_streams`` event streams.  Peers outside ``[web] allow`` are closed before a
+byte is read.  Refusals of every kind are logged, and recorded in the event stream, once a minute per peer
+address (with the count of the others), so a flood never pushes the operator's history off the page.
 """
 
 from __future__ import annotations
@@ -36,22 +36,20 @@ import logging
 import socket
 import sys
 import threading
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
 from datetime import datetime
 from http.server import ThreadingHTTPServer
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from nfwserver.config.schema import WebConfig
 from nfwserver.core.events import Direction
-from nfwserver.core.faces import CountsClients, CountsConversations
 from nfwserver.core.sample import TickSample
 from nfwserver.core.station_core import StationCore
-from nfwserver.easycomm.output import EasyCommOutput
 from nfwserver.listen_errors import bind_failure
-from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.ratelimited_log import RateLimitedLog
-from nfwserver.rotor.coupling import RotorCoupling
+from nfwserver.web.admission import OWN_RESERVE, Admission
 from nfwserver.web.control import Control
 from nfwserver.web.handler import WebHandler
 from nfwserver.web.hub import FrameHub
@@ -61,14 +59,12 @@ from nfwserver.web.state_view import now_tracking
 from nfwserver.web.station_parts import (
     EventFollower,
     LogCursor,
+    StationParts,
     clients_part,
     links_part,
     radio_part,
     rotor_part,
 )
-
-if TYPE_CHECKING:
-    from nfwserver.autotrack.schedule import Schedule
 
 log = logging.getLogger(__name__)
 
@@ -81,26 +77,13 @@ HISTORY_EVENTS = 200  #: log lines a new page receives first
 
 
 @dataclass
-class StationParts:
-    """The station's adapters the page shows (None when not configured); read, never driven."""
-
-    rotor: RotorCoupling | None = None
-    radio: RadioCoupling | None = None
-    easycomm: EasyCommOutput | None = None
-    tcp: CountsClients | None = None  #: NovaTcpServer
-    nova: CountsConversations | None = None  #: NovaDdeService
-    favourites: Callable[[], Sequence[int]] = field(default=lambda: ())
-    #: autotrack's newest schedule (AutotrackRuntime.schedule), None without one: the page's timeline
-    autotrack_schedule: Callable[[], Schedule | None] = field(default=lambda: None)
-
-
-@dataclass
 class WebStats:
     accepted: int = 0
-    refused: int = 0  #: outside [web] allow, or over max_clients
+    refused: int = 0  #: connections and requests refused (outside [web] allow, a cap, a check)
     streams: int = 0  #: event streams open now
     dropped: int = 0  #: event streams dropped for not reading (write timeout) or a failed send
     frames: int = 0  #: frames built
+    evicted: int = 0  #: connections closed to make room for a newer one (web/admission.py)
 
 
 class _HttpServer(ThreadingHTTPServer):
@@ -120,7 +103,7 @@ class _HttpServer(ThreadingHTTPServer):
         try:
             super().process_request_thread(request, client_address)
         finally:
-            self.web._release(client_address)
+            self.web.admission.release(request)
 
     def handle_error(self, request: Any, client_address: Any) -> None:
         """Whatever escaped a connection's handler: one rate-limited line, never a traceback on stderr."""
@@ -133,19 +116,27 @@ class WebServer:
     def __init__(self, core: StationCore, config: WebConfig, parts: StationParts | None = None, *,
                  max_clients: int = MAX_CLIENTS, io_timeout_s: float = IO_TIMEOUT_S,
                  send_buffer_bytes: int | None = None, max_per_address: int = MAX_PER_ADDRESS,
-                 max_streams: int = MAX_STREAMS, head_deadline_s: float = HEAD_DEADLINE_S) -> None:
+                 max_streams: int = MAX_STREAMS, head_deadline_s: float = HEAD_DEADLINE_S,
+                 own_reserve: int = OWN_RESERVE) -> None:
         self.core = core
         self.config = config
         self.parts = parts or StationParts()
         self.max_clients = max_clients
         self.max_per_address = max_per_address
         self.max_streams = max_streams
+        self.own_reserve = own_reserve  #: connections only the station's own address may use
         self.head_deadline_s = head_deadline_s  #: real seconds a request head may take to arrive
         self.io_timeout_s = io_timeout_s
         self.send_buffer_bytes = send_buffer_bytes
         self.stats = WebStats()
         self.hub = FrameHub()
-        self.control = Control(core, config)
+        #: refusals of every kind: a line (and an event) a minute per peer address, whatever the request says
+        self._refusals = RateLimitedLog(log, core.clock, 60.0)
+        self.control = Control(core, config, self.command_refused)
+        self.admission = Admission(max_clients, max_per_address, own_reserve)
+        #: brings :attr:`config` up to the configuration file as it is now (the station's
+        #: :meth:`~nfwserver.app.station.Station.catch_up_config`): called before each command is checked
+        self.config_fresh: Callable[[], None] = lambda: None
         self.board = PassBoard(core.state, core.clock, self.parts.favourites, self.parts.rotor,
                                self.parts.autotrack_schedule)
         self.address: tuple[str, int] | None = None
@@ -155,12 +146,9 @@ class WebServer:
         self._ticked = threading.Event()
         self._stop = threading.Event()
         self._lock = threading.Lock()
-        self._active = 0
-        self._per_address: dict[str, int] = {}
         self._httpd: _HttpServer | None = None
         self._threads: list[threading.Thread] = []
         self._unsubscribe: Callable[[], None] | None = None
-        self._refusals = RateLimitedLog(log, core.clock, 60.0)
         self._frame_log = RateLimitedLog(log, core.clock, 60.0)
         self._build_lock = threading.Lock()
 
@@ -307,52 +295,59 @@ class WebServer:
 
     def _admit(self, request: Any, client_address: Any) -> bool:
         host = str(client_address[0])
-        reason = None
-        if not self.config.allows(host):
-            reason = "not in [web] allow"
+        verdict = None
+        if self.config.allows(host):
+            verdict = self.admission.admit(request, host, str(request.getsockname()[0]))
+        reason = "not in [web] allow" if verdict is None else verdict.reason
         with self._lock:
-            if reason is None and self._active >= self.max_clients:
-                reason = f"already {self.max_clients} connections (the web server's cap)"
-            if reason is None and self._per_address.get(host, 0) >= self.max_per_address:
-                reason = f"already {self.max_per_address} connections from {host} (the cap per address)"
             if reason is None:
-                self._active += 1
-                self._per_address[host] = self._per_address.get(host, 0) + 1
                 self.stats.accepted += 1
-                return True
-            self.stats.refused += 1
-        if reason != "not in [web] allow":  # a peer that is let in hears why it is turned away
+            else:
+                self.stats.refused += 1
+        if verdict is not None and verdict.evicted is not None:
+            gone = verdict.evicted
+            with self._lock:
+                self.stats.evicted += 1
+            self._note_refusal(gone.host, f"web connection from {gone.host} closed ({gone.phase.value} for "
+                               f"{time.monotonic() - gone.since:.1f} s) to make room for one from {host}",
+                               "connection closed to make room for another (it had done least for longest)")
+        if reason is None:
+            return True
+        if verdict is not None:  # a peer that is let in hears why it is turned away
             try:
                 request.setblocking(False)
                 request.send(error_response(503, f"connection refused: {reason}"))
             except OSError:
                 pass
-        self._note_refusal(host, "connection", f"web connection from {host} refused: {reason}",
-                           f"connection refused: {reason}")
+        self._note_refusal(host, f"web connection from {host} refused: {reason}", f"connection refused: {reason}")
         return False
 
-    def _release(self, client_address: Any) -> None:
-        host = str(client_address[0])
-        with self._lock:
-            self._active -= 1
-            left = self._per_address.get(host, 1) - 1
-            if left > 0:
-                self._per_address[host] = left
-            else:
-                self._per_address.pop(host, None)
-
-    def _note_refusal(self, host: str, kind: str, line: str, event: str) -> None:
-        """One log line and one event per burst of refusals of ``kind`` from ``host``."""
-        if self._refusals.warning(f"{host}:{kind}", "%s", line):
-            self.core.events.add(self.core.clock.now(), Direction.INFO, "note", event, client=f"web {host}",
-                                 accepted=False)
+    def _note_refusal(self, host: str, line: str, event: str | None = None) -> bool:
+        """One log line and one event a minute per peer address (``host``), for refusals of any kind: what
+        varies from one request to the next (Origin, Host, token, path) is the peer's choice, so it does not
+        make another line.  The line after a quiet minute carries the count of those left out.  True when
+        this one was written (``event``, when given, is then recorded as a note)."""
+        if not self._refusals.warning(host, "%s", line):
+            return False
+        if event is None:
+            return True
+        self.core.events.add(self.core.clock.now(), Direction.INFO, "note", event, client=f"web {host}",
+                             accepted=False)
+        return True
 
     def request_refused(self, host: str, status: int, why: str) -> None:
         """A request answered ``status`` before its route (head too slow or too large, wrong Host, ...)."""
         with self._lock:
             self.stats.refused += 1
-        self._note_refusal(host, f"http {status}", f"web request from {host} refused ({status}): {why}",
+        self._note_refusal(host, f"web request from {host} refused ({status}): {why}",
                            f"request refused ({status}): {why}")
+
+    def command_refused(self, host: str, line: str) -> bool:
+        """A command refused by :class:`~nfwserver.web.control.Control`: counted, and logged as every refusal;
+        True when its line was written (the control then records its own event)."""
+        with self._lock:
+            self.stats.refused += 1
+        return self._note_refusal(host, line)
 
     def connection_failed(self, host: str, exc: BaseException | None) -> None:
         """A connection that ended in an error of the peer's making (reset, timeout): one line per burst."""
@@ -373,7 +368,7 @@ class WebServer:
             self._safe_frame()  # frames were not built while no page was connected: a fresh one now
         if reason is not None:
             host = peer.removeprefix("web ")
-            self._note_refusal(host, "stream", f"web event stream for {host} refused: {reason}",
+            self._note_refusal(host, f"web event stream for {host} refused: {reason}",
                                f"event stream refused: {reason}")
             return reason
         log.info("web page %s connected", peer)

@@ -17,16 +17,36 @@ import json
 import logging
 import math
 from collections import OrderedDict
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from nfwserver.core.events import Event, EventLog
+from nfwserver.core.faces import CountsClients, CountsConversations
+from nfwserver.easycomm.output import EasyCommOutput
 from nfwserver.health.board import HealthBoard
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.rotor.coupling import RotorCoupling, sky_from_rotor
 from nfwserver.web.state_view import iso
 
+if TYPE_CHECKING:
+    from nfwserver.autotrack.schedule import Schedule
+
 log = logging.getLogger(__name__)
+
+
+@dataclass
+class StationParts:
+    """The station's adapters the page shows (None when not configured); read, never driven."""
+
+    rotor: RotorCoupling | None = None
+    radio: RadioCoupling | None = None
+    easycomm: EasyCommOutput | None = None
+    tcp: CountsClients | None = None  #: NovaTcpServer
+    nova: CountsConversations | None = None  #: NovaDdeService
+    favourites: Callable[[], Sequence[int]] = field(default=lambda: ())
+    #: autotrack's newest schedule (AutotrackRuntime.schedule), None without one: the page's timeline
+    autotrack_schedule: Callable[[], Schedule | None] = field(default=lambda: None)
 
 #: Log lines sent to a page in one frame at most (the rest go with its next frames); clients remembered at most.
 MAX_LOG_PER_FRAME = 100

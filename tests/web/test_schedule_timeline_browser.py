@@ -25,7 +25,7 @@ from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.elements import load_element_file
 from nfwserver.tracking.observer import parse_observer
 from nfwserver.web import WebServer
-from nfwserver.web.server import StationParts
+from nfwserver.web.station_parts import StationParts
 from tests.conftest import ROOT
 from tests.waiting import wait_for
 from tests.web.conftest import console_errors

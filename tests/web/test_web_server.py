@@ -155,8 +155,9 @@ def test_web_configuration() -> None:
                                     hostnames=(), control=False, token=None)
     with pytest.raises(ConfigError, match=r"\[web\] token: required when control is on"):
         parse_config("[web]\ncontrol = true\n")
-    with pytest.raises(ConfigError, match=r"\[web\] token: must be at least 8 characters"):
-        parse_config('[web]\ncontrol = true\ntoken = "short"\n')
+    short = parse_config('[web]\ncontrol = true\ntoken = "short"\n')  # loaded, with control off and one warning
+    assert not short.web.control and any(w.startswith("[web] token: must be at least 8 characters")
+                                         for w in short.warnings)
     exposed = parse_config('[web]\nenabled = true\nhost = "0.0.0.0"\nallow = ["192.168.1.0/24"]\n')
     assert any(w.startswith('[web] host = "0.0.0.0"') for w in exposed.warnings)
     assert not parse_config('[web]\nhost = "0.0.0.0"\n').warnings  # off: nothing listens

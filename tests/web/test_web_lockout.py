@@ -1,0 +1,90 @@
+"""The operator is never locked out of the dashboard: slow requests from other loopback addresses (127.0.0.2
+to .9 play other hosts) or from the station's own address fill the caps, and the operator's request is still
+answered at once, by evicting the connection that has done least for longest.  Real sockets, raw HTTP."""
+
+from __future__ import annotations
+
+import socket
+import time
+
+from tests.web.conftest import wait_for
+from tests.web.test_web_bounds import GET_HELP, trickling
+from tests.web.web_helpers import connect, exchange, read_all, running_web, status
+
+OTHERS = tuple(f"127.0.0.{n}" for n in range(2, 10))
+
+
+def _answered_at_once(web, source: str = "127.0.0.1") -> None:
+    began = time.monotonic()
+    reply = exchange(web, GET_HELP, source)
+    assert status(reply) == 200, reply[:300]
+    assert time.monotonic() - began < web.head_deadline_s / 2  # not by waiting for slow heads to time out
+
+
+def _still_open(sock: socket.socket) -> bool:
+    """Whether the server has not closed ``sock`` (what it sent so far is read and dropped)."""
+    sock.settimeout(0.2)
+    try:
+        while sock.recv(65536):
+            pass
+    except TimeoutError:
+        return True
+    except OSError:
+        return False
+    return False
+
+
+def test_slow_heads_from_eight_other_addresses_do_not_lock_the_operator_out() -> None:
+    """Issue 42: 16 slow connections from each of 127.0.0.2-.9 filled the 128-connection cap, and 127.0.0.1
+    got 503 on every check."""
+    with running_web() as (_core, web):
+        slow = [connect(web, source) for source in OTHERS for _ in range(web.max_per_address)]
+        with trickling(slow, every_s=1.0):
+            wait_for(lambda: web.stats.accepted >= len(slow), what="every slow connection taken in")
+            for _ in range(5):
+                _answered_at_once(web)
+            _answered_at_once(web, "127.0.0.10")  # a phone on the network: the oldest slow head makes room
+            assert web.stats.evicted >= 1
+
+
+def test_slow_heads_from_the_operator_own_address_do_not_lock_it_out() -> None:
+    """Issue 42: 16 slow connections from 127.0.0.1 itself locked the operator out through the cap per address."""
+    with running_web() as (_core, web):
+        slow = [connect(web, "127.0.0.1") for _ in range(web.max_per_address)]
+        with trickling(slow, every_s=1.0):
+            wait_for(lambda: web.stats.accepted >= len(slow), what="every slow connection taken in")
+            for _ in range(5):
+                _answered_at_once(web)
+            evicted = read_all(slow[0])  # the oldest slow head made room: closed without an answer
+            assert evicted == b"", evicted
+
+
+def test_the_operator_event_streams_are_never_evicted_for_other_addresses() -> None:
+    with running_web() as (_core, web):
+        streams = [connect(web, "127.0.0.1") for _ in range(4)]
+        for sock in streams:
+            sock.sendall(b"GET /api/stream HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n")
+        wait_for(lambda: web.stats.streams == 4, what="four streams")
+        slow = [connect(web, source) for source in OTHERS for _ in range(2 * web.max_per_address)]
+        with trickling(slow, every_s=1.0):
+            wait_for(lambda: web.stats.accepted >= 4 + len(slow), what="every slow connection taken in")
+            assert web.stats.evicted >= len(slow) - (web.max_clients - web.own_reserve)
+            assert all(_still_open(sock) for sock in streams) and web.stats.streams == 4
+            _answered_at_once(web)
+        for sock in streams:
+            sock.close()
+
+
+def test_other_addresses_cannot_take_the_reserve_of_the_station_own_address() -> None:
+    """Event streams are not evicted for another address, so they are what a crowd would hold on to."""
+    with running_web(max_clients=8, own_reserve=2, max_per_address=4, max_streams=64) as (_core, web):
+        held = [connect(web, source) for source in ("127.0.0.2", "127.0.0.3") for _ in range(4)]
+        for sock in held:
+            sock.sendall(b"GET /api/stream HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n")
+        wait_for(lambda: web.stats.accepted + web.stats.refused >= 8, what="the crowd's streams")
+        assert web.stats.streams == 6  # 8 - 2 reserved: two of them were refused
+        third = exchange(web, GET_HELP, "127.0.0.4")
+        assert status(third) == 503 and b"reserved" in third, third
+        _answered_at_once(web)  # the reserve
+        for sock in held:
+            sock.close()
