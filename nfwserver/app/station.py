@@ -87,6 +87,7 @@ class Station:
         self.core.rotor_configured = self.rotor is not None
         self.core.rotor = self.rotor  # FLIP and PARK, from every face
         self.radio: RadioCoupling | None = make_radio(config.radio, self.core, clock)
+        self.core.radio_configured = self.radio is not None
         configured = config.server.satellite if isinstance(config.server.satellite, int) else None  # a name: at start
         self.saver = (SessionSaver(self.state_file, configured,
                                    self.core.health.link("state-file", Backoff(0.2, 0.4)),
