@@ -97,7 +97,8 @@ def test_the_journey_is_on_the_first_screen_after_the_two_newcomer_commands() ->
     assert "nfwserver watch" in first_screen
     assert [c.split()[:3] for c in _journey()] == [
         ["pip", "install", "."], ["nfwserver", "config", "init"], ["nfwserver", "elements", "update"],
-        ["nfwserver", "passes"], ["nfwserver", "config", "set"], ["nfwserver", "run"], ["nfwserver", "watch"]]
+        ["nfwserver", "passes"], ["nfwserver", "config", "set"], ["nfwserver", "run"], ["nfwserver", "watch"],
+        ["nfwserver", "schedule", "--sat"]]
 
 
 def test_the_journey_runs_as_written(provider, tmp_path, capsys) -> None:  # noqa: F811 - the imported fixture
@@ -133,6 +134,9 @@ def test_the_journey_runs_as_written(provider, tmp_path, capsys) -> None:  # noq
                 assert out.startswith("sat ") and "aos (UTC)" in out.splitlines()[0] and len(out.splitlines()) > 3, out
             if argv[:3] == ["config", "set", "tcp.enabled"]:
                 assert main(["config", "set", "tcp.port", str(free_port())]) == 0  # 8090 may be taken here
+            if argv[0] == "schedule":
+                header = out.splitlines()[0].split()
+                assert header[0] == "sat" and header[-2:] == ["scheduled", "reason"] and len(out.splitlines()) > 3, out
             if argv[0] == "watch":
                 lines = out.splitlines()
                 assert len(lines) == 2 and all("tune=" in line and "status=0x" in line for line in lines), out

@@ -23,6 +23,7 @@ COMMANDS: tuple[tuple[str, str, str], ...] = (
     ("simulate", "simulate_command", "show what a DDE client receives, on virtual time"),
     ("ephemeris", "tracking_commands", "position table of one satellite"),
     ("passes", "tracking_commands", "AOS/TCA/LOS of satellites over a window"),
+    ("schedule", "schedule_command", "the autotrack schedule: which passes the station would work by itself"),
     ("visible", "tracking_commands", "satellites above the horizon table at an instant"),
     ("elements", "elements_command", "update or list the stored element catalog"),
     ("config", "config_command", "configuration file: path, init, show, set, edit"),

@@ -106,6 +106,22 @@ def _satellite(setting: Setting, value: Any, base: Path | None) -> int | str:
     return _catnr(setting, value, base)
 
 
+def _satellites(setting: Setting, value: Any, base: Path | None) -> tuple[int | str, ...]:
+    """Catalog numbers or names, each as ``SAT=`` takes it, in the order given (duplicates and more than
+    ``setting.hi`` entries are refused)."""
+    listed = _list(value, "catalog numbers or names")
+    if setting.hi is not None and len(listed) > setting.hi:
+        raise ValueError(f"lists {len(listed)} satellites, more than {setting.hi:g}")
+    items = tuple(_satellite(setting, v, base) for v in listed)
+    seen: set[int | str] = set()
+    for item in items:
+        key = item.upper() if isinstance(item, str) else item
+        if key in seen:
+            raise ValueError(f"{_show(item)} is listed twice")
+        seen.add(key)
+    return items
+
+
 def _catnrs(setting: Setting, value: Any, base: Path | None) -> tuple[int, ...]:
     return tuple(_catnr(setting, v, base) for v in _list(value, "catalog numbers"))
 
@@ -286,8 +302,8 @@ def _channels(setting: Setting, value: Any, base: Path | None) -> dict[int, Chan
 
 CONVERTERS: dict[str, Converter] = {
     "bool": _bool, "int": _int, "number": _number, "choice": _choice, "text": _text, "texts": _texts,
-    "choices": _choices, "catnr": _catnr, "satellite": _satellite, "catnrs": _catnrs, "host": _host,
-    "networks": _networks,
+    "choices": _choices, "catnr": _catnr, "satellite": _satellite, "catnrs": _catnrs, "satellites": _satellites,
+    "host": _host, "networks": _networks,
     "urls": _urls, "url": _url, "file": _file, "files": _files, "store": _store, "location": _location,
     "points": _points, "names": _names, "schedules": _schedules, "channels": _channels, "device": _text,
 }

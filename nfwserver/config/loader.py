@@ -21,6 +21,7 @@ from nfwserver.config.files import FileRefused, default_config_path, read_regula
 from nfwserver.config.kinds import ManyProblems, convert
 from nfwserver.config.schema import (
     DEFAULT_OBSERVER,
+    AutotrackConfig,
     Config,
     DialectsConfig,
     EasyCommConfig,
@@ -53,7 +54,8 @@ def toml_document(text: str) -> dict[str, Any]:
 
 #: Config fields holding a section record, by field name.
 _RECORDS = {"elements": ElementsConfig, "server": ServerConfig, "radio": RadioConfig, "rotor": RotorConfig,
-            "dialects": DialectsConfig, "tcp": TcpConfig, "easycomm": EasyCommConfig, "web": WebConfig}
+            "dialects": DialectsConfig, "tcp": TcpConfig, "easycomm": EasyCommConfig, "web": WebConfig,
+            "autotrack": AutotrackConfig}
 
 
 class ConfigError(ValueError):

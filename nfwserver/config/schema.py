@@ -149,6 +149,18 @@ class EasyCommConfig:
 
 
 @dataclass(frozen=True)
+class AutotrackConfig:
+    """Unattended operation (:mod:`nfwserver.autotrack`)."""
+
+    enabled: bool = default("autotrack", "enabled")  #: AUTO ON at start
+    #: the satellites to work, highest priority first (catalog numbers, or names as SAT= takes them);
+    #: None: the [satellites] favourites (:meth:`Config.autotrack_satellites`)
+    satellites: tuple[int | str, ...] | None = default("autotrack", "satellites")
+    min_el_deg: float = default("autotrack", "min_el_deg")  #: a pass counts when its highest elevation reaches this
+    min_gap_s: float = default("autotrack", "min_gap_s")  #: passes closer than this (s) count as overlapping
+
+
+@dataclass(frozen=True)
 class Config:
     observer: Observer = DEFAULT_OBSERVER
     observer_configured: bool = False
@@ -170,7 +182,14 @@ class Config:
     tcp: TcpConfig = field(default_factory=TcpConfig)
     easycomm: EasyCommConfig = field(default_factory=EasyCommConfig)
     web: WebConfig = field(default_factory=WebConfig)
+    autotrack: AutotrackConfig = field(default_factory=AutotrackConfig)
     horizon_file: str | None = None  #: the horizon file read, if the horizon came from one
     path: str | None = None  #: the configuration file actually read; None when none was
     #: accepted but worth saying at start (e.g. a listener reachable from other hosts); the caller logs them
     warnings: tuple[str, ...] = ()
+
+    def autotrack_satellites(self) -> tuple[int | str, ...]:
+        """The satellites autotrack works, highest priority first: ``[autotrack] satellites``, else the
+        ``[satellites] favourites``."""
+        listed = self.autotrack.satellites
+        return tuple(self.favourites) if listed is None else listed

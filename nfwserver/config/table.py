@@ -38,6 +38,8 @@ SECTIONS: tuple[Section, ...] = (
     Section("dialects", "Other trackers' interfaces served beside Nova's."),
     Section("tcp", "Nova's TCP server: a greeting, SUMMARY, the Nova pokes as commands, STATUS and WATCH."),
     Section("easycomm", "EasyComm I output on a serial port, for Arduino and K3NG-style rotor controllers."),
+    Section("autotrack", "Unattended operation: the station selects by itself the satellite of the next pass worth "
+                         "working, by priority (docs/AUTOTRACK.md gives the rule; `nfwserver schedule` shows it)."),
     Section("web", "The web dashboard: the station's state live in a browser (phone or PC), nothing from the "
                    "internet; controls only when control is on, each request carrying the token."),
 )
@@ -172,6 +174,16 @@ SETTINGS: tuple[Setting, ...] = (
     _S("easycomm", "uplink", "choice", "range-rate", "\"range-rate\" (Nova: range rate in UP, zeros in DN, "
        "XXX modes) or \"doppler\" (the channel's corrected frequencies and modes)", "easycomm.uplink",
        choices=("range-rate", "doppler")),
+    # [autotrack]
+    _S("autotrack", "enabled", "bool", False, "select the satellite of the schedule by itself from the start "
+       "(AUTO ON); any accepted SAT= switches it off", "autotrack.enabled"),
+    _S("autotrack", "satellites", "satellites", None, "the satellites to work, highest priority first: catalog "
+       "numbers or names as SAT= takes them (default: [satellites] favourites)", "autotrack.satellites",
+       hi=1000, example=[25544, "SO-50", 43017]),
+    _S("autotrack", "min_el_deg", "number", 10, "a pass counts when its highest elevation reaches this, degrees",
+       "autotrack.min_el_deg", 0, 90),
+    _S("autotrack", "min_gap_s", "number", 60, "the rotor's time to turn round: passes closer than this count as "
+       "overlapping, seconds", "autotrack.min_gap_s", 0, 3600),
     # [web]
     _S("web", "enabled", "bool", False, "serve the web dashboard (`nfwserver run --web` for one run)", "web.enabled"),
     _S("web", "host", "host", "127.0.0.1", "address to listen on; anything but loopback is warned about",

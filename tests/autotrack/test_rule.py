@@ -1,0 +1,53 @@
+"""The rule on hand-made passes: gaps, touching passes, unknown AOS or LOS, ties, fixed decisions."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from nfwserver.autotrack.rule import NO_BLOCKER, decide
+
+NAN = math.nan
+
+
+def _decide(passes: list[tuple[float, float, int]], gap: float, fixed: list[int] | None = None):
+    aos, los, priority = (np.array(c, dtype=float) for c in zip(*passes))
+    return decide(aos, los, priority.astype(np.int64), gap, None if fixed is None else np.array(fixed))
+
+
+def test_the_gap_decides_and_touching_passes_are_apart_with_no_gap() -> None:
+    passes = [(0, 600, 0), (660, 1200, 1), (1230, 1800, 1), (1800, 2400, 2)]
+    d = _decide(passes, 60.0)
+    # 660 is 60 s after 600 (apart enough); 1230 is 30 s after 1200 (not); 1800 is 570 s after 1200
+    assert d.scheduled.tolist() == [True, True, False, True]
+    assert d.blocker[2] == 1 and d.separation_s[2] == 30.0
+    assert _decide(passes, 0.0).scheduled.tolist() == [True, True, True, True]  # 1800 touches 1800
+
+
+def test_lower_priority_is_left_out_whole_naming_the_earliest_conflict() -> None:
+    passes = [(1000, 1600, 2), (0, 1100, 0), (1500, 2000, 1), (3000, 3600, 2)]
+    d = _decide(passes, 60.0)
+    assert d.scheduled.tolist() == [False, True, True, True]
+    assert d.blocker[0] == 1 and d.separation_s[0] == -100.0  # runs into both; the earliest is named
+    assert d.blocker[1] == d.blocker[2] == NO_BLOCKER
+
+
+def test_priority_beats_time_order() -> None:
+    d = _decide([(0, 600, 1), (500, 1000, 0), (900, 1500, 1)], 60.0)
+    assert d.scheduled.tolist() == [False, True, False]
+
+
+def test_unknown_aos_or_los_reach_to_infinity() -> None:
+    # an always-up satellite (neither known) of top priority leaves out everything else
+    d = _decide([(NAN, NAN, 0), (100, 700, 1)], 60.0)
+    assert d.scheduled.tolist() == [True, False] and d.blocker[1] == 0
+    d = _decide([(NAN, 500, 1), (540, 900, 0), (5000, NAN, 1), (2000, 4960, 0)], 60.0)
+    assert d.scheduled.tolist() == [False, True, False, True]
+
+
+def test_fixed_decisions_are_kept_and_taken_first() -> None:
+    passes = [(0, 600, 1), (500, 1000, 0), (1500, 2000, 2)]
+    d = _decide(passes, 60.0, fixed=[1, -1, 0])
+    assert d.scheduled.tolist() == [True, False, False]
+    assert d.blocker[1] == 0 and d.blocker[2] == NO_BLOCKER  # kept out, with no pass of this plan named
