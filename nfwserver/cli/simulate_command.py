@@ -21,6 +21,7 @@ import argparse
 import logging
 import sys
 
+from nfwserver.app.autotrack_link import StationAutotrack
 from nfwserver.cli.arguments import number_in, satellite_value, time_value
 from nfwserver.cli.errors import CliError, say
 from nfwserver.cli.simulate_pokes import MAX_DURATION_S, commands_of, observe_poke, poke_value
@@ -121,7 +122,10 @@ def run(args: argparse.Namespace) -> int:
     server = StationCore(inputs.catalog, inputs.observer, clock, horizon=inputs.horizon, ut1_utc=inputs.ut1_utc,
                          rate_hz=args.rate, satellite=sat.catalog_number if sat is not None else None)
     previews = [(offset, commands_of(command)) for offset, command in pokes]  # read once, before any is sent
-    if sat is None:
+    autotrack = StationAutotrack(server, clock, inputs.config)  # [autotrack] of the configuration; AUTO ON|OFF
+    if inputs.config().autotrack.enabled:
+        say(autotrack.restore(None, None, None, "no state file") + ": it selects the satellites of its schedule")
+    elif sat is None:
         sat_poke = _first_sat(previews)
         if sat_poke is None:
             say("no --sat given and no [server] satellite in the catalog: no AutoTracking satellite, so nothing is "
@@ -129,11 +133,11 @@ def run(args: argparse.Namespace) -> int:
         elif sat_poke > 0:
             say(f"no satellite until the SAT= poke at {sat_poke:g} s: nothing is published before it")
     auto_feed = not _pokes_decide_feed(previews)
-    return _simulate(args, server, clock, pokes, auto_feed)
+    return _simulate(args, server, clock, pokes, auto_feed, autotrack)
 
 
 def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock,
-              pokes: list[tuple[float, str]], auto_feed: bool) -> int:
+              pokes: list[tuple[float, str]], auto_feed: bool, autotrack: StationAutotrack) -> int:
     # Refusals are reported below with their time; keep the core's own warning out of the way
     # (restored on the way out: the logger is shared with anything else in this process).
     core_log = logging.getLogger("nfwserver.core.station_core")
@@ -201,6 +205,7 @@ def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock
             outcome = observe_poke(server, round(max(at, offset), 3), command, send)
             if report:  # what the poke did, among the diagnostics (stdout carries only what the client sees)
                 print(outcome.line(), file=sys.stderr)
+        autotrack.follow(clock.now())  # its satellite of this instant, before the tick computes it
         if not started:
             started = True
             try:

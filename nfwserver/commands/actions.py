@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from typing import Protocol
 
 __all__ = ["DONE", "DOPPLER_WITHOUT_RADIO", "NO_ROTOR", "TRACK_WITHOUT_ROTOR", "Action", "Check", "DisplayPort",
-           "Outcome", "Refused", "RotorControl", "SessionPort", "StationPort", "Targets"]
+           "Outcome", "Refused", "RotorControl", "SessionPort", "StationPort", "Targets", "AutotrackSwitch"]
 
 #: Why a rotor command is refused on a station with no rotor (every face says it in these words).
 NO_ROTOR = "no rotor is configured"
@@ -51,6 +51,17 @@ class Outcome:
 DONE = Outcome()
 
 
+class AutotrackSwitch(Protocol):
+    """The station's autotrack as the commands switch it (:class:`nfwserver.autotrack.AutotrackRuntime`)."""
+
+    @property
+    def on(self) -> bool: ...
+
+    def switch_on(self) -> bool: ...
+
+    def switch_off(self, reason: str) -> bool: ...
+
+
 class StationPort(Protocol):
     """What Nova's station commands need of the station core."""
 
@@ -63,6 +74,14 @@ class StationPort(Protocol):
         """Catalog number and DDE name of each satellite ``value`` names (a catalog number, or a name)."""
 
     def why_not_computable(self, catalog_number: int) -> str | None: ...
+
+    #: the station's autotrack (None: this station has none)
+    autotrack: AutotrackSwitch | None
+
+    def set_autotrack(self, on: bool, source: str) -> None: ...
+
+    def choose_satellite(self, catalog_number: int, source: str) -> str | None:
+        """``SAT=``: select it; a sentence when that switched autotrack off, else None."""
 
     def set_doppler(self, on: bool, source: str = ...) -> None: ...
 
@@ -156,7 +175,13 @@ def satellite(targets: Targets, value: object, source: str) -> Outcome:
     """``SAT=``: ``value`` is the catalog number its check resolved (names are resolved there)."""
     if not isinstance(value, int) or isinstance(value, bool):
         raise AssertionError(f"SAT= reached its action unresolved: {value!r}")
-    targets.station.select_satellite(value, source)
+    switched_off = targets.station.choose_satellite(value, source)
+    return Outcome(warning=switched_off) if switched_off else DONE
+
+
+def autotrack(targets: Targets, value: object, source: str) -> Outcome:
+    """AUTO ON/OFF: the station selects the satellite of its schedule by itself, or leaves the choice to people."""
+    targets.station.set_autotrack(value is True, source)
     return DONE
 
 

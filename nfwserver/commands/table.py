@@ -149,6 +149,13 @@ def _check_satellite(station: StationPort, value: object) -> int:
     return number
 
 
+def _check_autotrack(station: StationPort, value: object) -> object:
+    """``AUTO``'s check: the station has an autotrack to switch."""
+    if station.autotrack is None:
+        raise Refused("this station has no autotrack (it runs with `nfwserver run` or `simulate --config`)")
+    return value
+
+
 def _degrees(word: str, low: float, high: float) -> Callable[[re.Match[str], Face], float]:
     def convert(match: re.Match[str], face: Face) -> float:
         value = match.group(1)
@@ -186,7 +193,8 @@ COMMANDS: tuple[Command, ...] = (
     Command("SAT", r"SAT\s*=\s*(.*?)", "SAT=<catalog number>", "SAT=n", "=<catalog number>",
             "select the satellite by catalog number (TCP, console, web: or by a name only one has); refused when "
             "unknown or not computable now",
-            _STATION_REPLY, Face.ALL, Target.STATION, _satellite, action=actions.satellite, check=_check_satellite),
+            _STATION_REPLY + " (OK warning: autotrack switched off, when it was on)", Face.ALL, Target.STATION,
+            _satellite, action=actions.satellite, check=_check_satellite),
     Command("ANTAZ", r"ANTAZ\s*=\s*(\S*)", "ANTAZ=<degrees>", "ANTAZ=deg", "=<degrees>",
             "report the antenna azimuth (-360..720 degrees), as a client with its own rotor read-back does",
             _STATION_REPLY, Face.ALL, Target.STATION, _degrees("ANTAZ", -360.0, 720.0),
@@ -199,6 +207,9 @@ COMMANDS: tuple[Command, ...] = (
             "the radio's Doppler tuning on or off (OrbitDRV's tuning, not TUNE); without a radio it warns",
             _STATION_REPLY + " (OK warning: <why nothing is tuned> when the station has no radio)",
             Face.ALL, Target.STATION, _on, action=actions.doppler),
+    Command("AUTO", r"AUTO\s+(ON|OFF)", "AUTO ON|OFF", "AUTO ON|OFF", "ON or OFF",
+            "autotrack: follow the [autotrack] schedule; any accepted SAT= switches it off", _STATION_REPLY,
+            Face.ALL, Target.STATION, _on, action=actions.autotrack, check=_check_autotrack),
     Command("SUMMARY", r"SUMMARY", "SUMMARY", "SUMMARY", "nothing after it",
             "the Nova string being published (an empty line while the feed is off or nothing can be computed)",
             "one line", Face.TCP, Target.SESSION, action=actions.summary),

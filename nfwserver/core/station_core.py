@@ -20,13 +20,22 @@ nothing, and the reason is logged, recorded in the event stream and returned in
 from __future__ import annotations
 
 import logging
+import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from datetime import datetime
 
 from nfwserver.channels.channel import Channel
 from nfwserver.clock import Clock
-from nfwserver.commands.actions import NO_ROTOR, DisplayPort, Refused, RotorControl, SessionPort, Targets
+from nfwserver.commands.actions import (
+    NO_ROTOR,
+    AutotrackSwitch,
+    DisplayPort,
+    Refused,
+    RotorControl,
+    SessionPort,
+    Targets,
+)
 from nfwserver.commands.parsing import Parsed, Request, parse_request
 from nfwserver.commands.table import Face, Target, escape_for_log
 from nfwserver.core.events import Direction, EventLog
@@ -100,6 +109,10 @@ class StationCore:
         self.rotor_configured: bool | None = None
         #: whether the station drives a radio itself (set by the station; None: not known, no warning)
         self.radio_configured: bool | None = None
+        #: the station's autotrack, switched by AUTO ON/OFF and off by any accepted SAT= (set by the station)
+        self.autotrack: AutotrackSwitch | None = None
+        #: one choice of the satellite at a time: a client's SAT= (which switches autotrack off) or autotrack's
+        self._choosing = threading.Lock()
         #: the rotor's command port for FLIP and PARK (set by the station; None: no rotor)
         self.rotor: RotorControl | None = None
         if satellite is not None:
@@ -171,6 +184,39 @@ class StationCore:
             self.tracker.selection_changed()
             self._note(f"satellite {catalog_number} {sat.dde_name} selected", source)
         return True
+
+    def choose_satellite(self, catalog_number: int, source: str) -> str | None:
+        """A client's or the operator's accepted ``SAT=``: select ``catalog_number`` and switch autotrack off (the
+        person or program that chose wins); returns the sentence saying so when autotrack was on, else None."""
+        reason = f"SAT={catalog_number} from {escape_for_log(source, 60)} chose the satellite; AUTO ON resumes it"
+        with self._choosing:
+            switched = self.autotrack is not None and self.autotrack.on and self.autotrack.switch_off(reason)
+            self.select_satellite(catalog_number, source)
+        if not switched:
+            return None
+        self._note(f"autotrack off: {reason}", source)
+        return f"autotrack switched off: {reason}"
+
+    def select_scheduled(self, catalog_number: int) -> str | None:
+        """Autotrack's selection of its schedule's satellite: None when selected, else why not (autotrack was
+        switched off meanwhile -- a SAT= on its way wins --, or the satellite cannot be computed now)."""
+        with self._choosing:
+            if self.autotrack is None or not self.autotrack.on:
+                return "autotrack is off"
+            why = self.why_not_computable(catalog_number)
+            if why is None:
+                self.select_satellite(catalog_number, source="autotrack")
+        return why
+
+    def set_autotrack(self, on: bool, source: str) -> None:
+        """AUTO ON/OFF (the station checked that it has an autotrack)."""
+        if self.autotrack is None:
+            return
+        with self._choosing:
+            changed = self.autotrack.switch_on() if on else self.autotrack.switch_off(
+                f"AUTO OFF from {escape_for_log(source, 60)}")
+        if changed:
+            self._note(f"AUTO {'ON' if on else 'OFF'}", source)
 
     @property
     def selected_by(self) -> str:

@@ -26,7 +26,7 @@ REPLIES = [
     ("SAT=\u0662", "ERROR SAT needs a catalog number, got '\\u0662'"),
     ("TUNE", "ERROR TUNE needs ON or OFF"),
     ("BOGUS", "ERROR not a Nova command (TUNE ON|OFF, TRACK ON|OFF, SAT=n, ANTAZ=deg, ANTEL=deg, "
-              "DOPPLER ON|OFF)"),
+              "DOPPLER ON|OFF, AUTO ON|OFF)"),
     ("TRACK ON", "OK warning: TRACK ON with no rotor configured: nothing turns here ([rotor] backend); DDE "
                  "clients that drive their own rotor still follow the feed"),
     ("ANTAZ=721", "ERROR ANTAZ 721.0 is outside -360..720 degrees"),

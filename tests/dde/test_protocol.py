@@ -73,7 +73,7 @@ def test_pokes(text: str, expected: list[tuple[str, object]]) -> None:
     assert _read(request.commands) == expected
 
 
-_NOT_NOVA = "not a Nova command (TUNE ON|OFF, TRACK ON|OFF, SAT=n, ANTAZ=deg, ANTEL=deg, DOPPLER ON|OFF)"
+_NOT_NOVA = "not a Nova command (TUNE ON|OFF, TRACK ON|OFF, SAT=n, ANTAZ=deg, ANTEL=deg, DOPPLER ON|OFF, AUTO ON|OFF)"
 
 
 @pytest.mark.parametrize(("text", "reason"), [

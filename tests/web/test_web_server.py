@@ -116,7 +116,7 @@ def test_control_requests_are_checked_whole_before_the_core_sees_them() -> None:
         help_ = web.get("/api/help")
         assert [c["usage"] for c in help_["commands"]] == ["TUNE ON|OFF", "TRACK ON|OFF", "SAT=<catalog number>",
                                                            "ANTAZ=<degrees>", "ANTEL=<degrees>", "DOPPLER ON|OFF",
-                                                           "FLIP AUTO|ON|OFF", "PARK"]
+                                                           "AUTO ON|OFF", "FLIP AUTO|ON|OFF", "PARK"]
     finally:
         web.station.stop()
 
