@@ -49,17 +49,27 @@ class StationAutotrack:
             raise ValueError("no observer is configured ([observer] location)")
         return snap.observer, snap.horizon, snap.ut1_utc_s
 
-    def _notice_changes(self, sample: TickSample | None = None) -> None:
+    def _notice_changes(self) -> None:
         """Plan again when the elements, the sky or the settings changed (cheap: on the publish thread)."""
         settings, sky = AutotrackSettings.of(self.config()), self.core.state.sky_generation
         if settings != self._settings or sky != self._sky:
             self._settings, self._sky = settings, sky
             self.runtime.replan()
 
+    def _wanted(self) -> bool:
+        """Whether to follow the ticks: while on, or while there is a schedule to show (a list and an observer);
+        a station that does not use autotrack plans nothing."""
+        return self.runtime.on or (bool(self._settings.satellites) and self.core.state.observer is not None)
+
+    def _on_tick(self, sample: TickSample) -> None:
+        self._notice_changes()
+        if self._wanted():
+            self.worker.on_tick(sample)
+
     def follow(self, now: datetime) -> int | None:
         """One step at ``now`` on the caller's thread (virtual time): returns the catalog number selected, if any."""
         self._notice_changes()
-        return self.runtime.tick(now)
+        return self.runtime.tick(now) if self._wanted() else None
 
     def restore(self, saved_on: bool | None, saved_off: str | None, saved_enabled: bool | None, where: str) -> str:
         """Switch on or off at start: as it was when the station stopped (``saved_*``, from the state file at
@@ -95,7 +105,7 @@ class StationAutotrack:
 
     def start(self) -> None:
         """Follow the station's ticks on the runtime's own thread."""
-        self._unsubscribe = [self.core.subscribe(self._notice_changes), self.core.subscribe(self.worker.on_tick)]
+        self._unsubscribe = [self.core.subscribe(self._on_tick)]
         self.worker.start()
 
     def stop(self) -> None:
