@@ -83,6 +83,8 @@ def plan_schedule(catalog: Catalog, observer: Observer, horizon: HorizonTable | 
     from nfwserver.tracking.passes import find_passes
 
     sats, problems = resolve_satellites(settings.satellites, catalog)
+    if not settings.satellites:
+        problems.append("no satellites to work: list them in [autotrack] satellites or [satellites] favourites")
     found = find_passes(sats, observer, start, end, horizon=horizon, ut1_utc=ut1_utc, workers=workers)
     problems += [f"{catalog.dde_names_of([n])[0]} has no usable position at the start (decayed, or elements far "
                  "outside their validity)" for n in found.skipped]

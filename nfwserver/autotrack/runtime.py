@@ -72,6 +72,7 @@ class AutotrackRuntime:
         self._schedule: Schedule | None = None
         self._planned_at: datetime | None = None
         self._plan_due = True
+        self._plan_asks = 0  #: plans asked for (switching on, replan()): one asked during a plan is not lost
         self._plan_retry: datetime | None = None  #: a failed plan is tried again from then on
         self._plan_fault: str | None = None
         self._selected: int | None = None  #: the satellite this runtime last selected (None after switching on)
@@ -89,6 +90,7 @@ class AutotrackRuntime:
             was_on, self._on = self._on, True
             self._off_reason = ""
             self._plan_due, self._selected = True, None
+            self._plan_asks += 1
             self._plan_retry = self._select_retry = None
         if not was_on:
             log.info("autotrack on")
@@ -108,6 +110,7 @@ class AutotrackRuntime:
         """The elements or the configuration changed: plan again at the next tick."""
         with self._lock:
             self._plan_due, self._plan_retry = True, None
+            self._plan_asks += 1
 
     # -- reading -----------------------------------------------------------------------------------------------
     @property
@@ -170,6 +173,7 @@ class AutotrackRuntime:
                    or (now - planned_at).total_seconds() >= REPLAN_S or now < schedule.start)
             if not due or (self._plan_retry is not None and now < self._plan_retry):
                 return
+            asks = self._plan_asks
         try:
             new = self._planner(now, schedule)
         except Exception as exc:  # a plan that fails must not stop the station: shown, retried
@@ -184,6 +188,7 @@ class AutotrackRuntime:
                 log.info("autotrack plans again")
             old_problems = schedule.problems if schedule is not None else ()
             self._schedule, self._planned_at = new, now
-            self._plan_due, self._plan_retry, self._plan_fault = False, None, None
+            self._plan_due = self._plan_asks != asks  # asked again while planning: plan again
+            self._plan_retry, self._plan_fault = None, None
         if new.problems and new.problems != old_problems:
             log.warning("autotrack leaves out: %s", "; ".join(new.problems))

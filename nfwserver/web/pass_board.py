@@ -11,13 +11,15 @@ What it computes, for the instant of the computation (``docs/WEB.md`` gives the 
   a satellite that is up now and never sets (geostationary) gets ``always_up`` and its one point;
 - the selected satellite's ground track (geodetic latitude, east longitude in degrees) from
   :data:`GROUND_BEFORE_S` before to :data:`GROUND_AFTER_S` after the instant, for the map;
-- the horizon table as azimuth/elevation points every 5 degrees (the polar plot's mask).
+- the horizon table as azimuth/elevation points every 5 degrees (the polar plot's mask);
+- the autotrack schedule of the next :data:`LIST_HOURS` hours as a timeline
+  (:mod:`~nfwserver.web.schedule_view`), when the station has one.
 
-It recomputes when the live state changes (its generation), when the first listed pass is over, and
-at least every :data:`REFRESH_S` seconds of the station's clock.  Readers get the newest result whole
-(:meth:`PassBoard.result`): its version, the result and its encoding are published as one reference, so
-a frame never carries a version whose result is not yet served.  The frame carries ``version`` so a page
-fetches ``/api/passes`` again only when it changed.
+It recomputes when the live state changes (its generation), when the first listed pass is over, when
+autotrack has a new schedule, and at least every :data:`REFRESH_S` seconds of the station's clock.  Readers
+get the newest result whole (:meth:`PassBoard.result`): its version, the result and its encoding are
+published as one reference, so a frame never carries a version whose result is not yet served.  The frame
+carries ``version`` so a page fetches ``/api/passes`` again only when it changed.
 
 A computation that fails is retried after :data:`RETRY_FIRST_S`, doubling up to :data:`REFRESH_S`
 (station clock), whatever else would make it due; the failure is logged once per episode (the
@@ -44,10 +46,13 @@ from nfwserver.tracking.derived import sub_satellite_point
 from nfwserver.tracking.look_angles import LookAngleCalculator, PropagationError
 from nfwserver.tracking.observer import Observer
 from nfwserver.tracking.passes import Pass, find_passes
+from nfwserver.web.schedule_view import timeline_part
 from nfwserver.web.state_view import iso
 
 if TYPE_CHECKING:
     from sgp4.api import Satrec
+
+    from nfwserver.autotrack.schedule import Schedule
 
 log = logging.getLogger(__name__)
 
@@ -84,16 +89,20 @@ def _point(calc: LookAngleCalculator, satrec: Satrec, when: datetime | None) -> 
 
 
 class PassBoard:
-    """See the module docstring.  ``favourites`` is read at each computation (the live configuration)."""
+    """See the module docstring.  ``favourites`` is read at each computation (the live configuration),
+    ``schedule`` (autotrack's newest schedule, None without one) at each computation and each check."""
 
     def __init__(self, state: StationState, clock: Clock, favourites: Callable[[], Sequence[int]],
-                 rotor: RotorCoupling | None = None) -> None:
+                 rotor: RotorCoupling | None = None, schedule: Callable[[], Schedule | None] = lambda: None) -> None:
         self.state = state
         self.clock = clock
         self.favourites = favourites
         self.rotor = rotor
+        self.schedule = schedule
+        self._done_schedule: Schedule | None = None
         empty: dict[str, object] = {"version": 0, "computed_at": None, "passes": [], "left_out": [],
-                                    "track": None, "ground_track": [], "horizon": [], "error": None}
+                                    "track": None, "ground_track": [], "horizon": [], "schedule": None,
+                                    "error": None}
         #: (version, result, its JSON): replaced whole, so readers on other threads see one of them
         self._published: tuple[int, dict[str, object], bytes] = (0, empty, json.dumps(empty).encode())
         self._error: str | None = None  #: the failing computation's error while an episode lasts
@@ -155,6 +164,7 @@ class PassBoard:
         return (self.state.generation != self._done_generation
                 or self.clock.monotonic() - self._done_at >= REFRESH_S
                 or (self._first_los is not None and now >= self._first_los)
+                or self.schedule() is not self._done_schedule
                 or self._error is not None)
 
     def _run(self) -> None:
@@ -192,10 +202,12 @@ class PassBoard:
         generation = self.state.generation
         snap = self.state.snapshot()
         now = self.clock.now()
+        schedule = self.schedule()
         result: dict[str, object] = {"computed_at": iso(now), "passes": [], "left_out": [], "track": None,
                                      "ground_track": [],
                                      "horizon": [[az, round(snap.horizon.min_elevation(float(az)), 2)]
-                                                 for az in range(0, 361, 5)]}
+                                                 for az in range(0, 361, 5)],
+                                     "schedule": timeline_part(schedule, now, LIST_HOURS)}
         observer, selected = snap.observer, snap.satellite
         if observer is not None:
             numbers = list(dict.fromkeys([*self.favourites(), *([selected.catalog_number] if selected else [])]))
@@ -220,6 +232,7 @@ class PassBoard:
         result["version"], result["error"] = version, None
         self._published = (version, result, json.dumps(result).encode())  # one step: version and result
         self._done_generation, self._done_at = generation, self.clock.monotonic()
+        self._done_schedule = schedule
         if self._error is not None:
             log.info("web: the pass search works again")
             self._error, self._retry_s = None, 0.0

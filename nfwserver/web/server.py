@@ -40,7 +40,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from datetime import datetime
 from http.server import ThreadingHTTPServer
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from nfwserver.config.schema import WebConfig
 from nfwserver.core.events import Direction
@@ -67,6 +67,9 @@ from nfwserver.web.station_parts import (
     rotor_part,
 )
 
+if TYPE_CHECKING:
+    from nfwserver.autotrack.schedule import Schedule
+
 log = logging.getLogger(__name__)
 
 MAX_FRAME_HZ = 10.0  #: frames built per second at most, whatever the feed's rate
@@ -87,6 +90,8 @@ class StationParts:
     tcp: CountsClients | None = None  #: NovaTcpServer
     nova: CountsConversations | None = None  #: NovaDdeService
     favourites: Callable[[], Sequence[int]] = field(default=lambda: ())
+    #: autotrack's newest schedule (AutotrackRuntime.schedule), None without one: the page's timeline
+    autotrack_schedule: Callable[[], Schedule | None] = field(default=lambda: None)
 
 
 @dataclass
@@ -141,7 +146,8 @@ class WebServer:
         self.stats = WebStats()
         self.hub = FrameHub()
         self.control = Control(core, config)
-        self.board = PassBoard(core.state, core.clock, self.parts.favourites, self.parts.rotor)
+        self.board = PassBoard(core.state, core.clock, self.parts.favourites, self.parts.rotor,
+                               self.parts.autotrack_schedule)
         self.address: tuple[str, int] | None = None
         self._follower = EventFollower(core.events)
         self._latest: dict[str, object] = {}

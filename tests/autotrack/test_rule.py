@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from hypothesis import given
+from hypothesis import strategies as st
 
 from nfwserver.autotrack.rule import NO_BLOCKER, decide
 
@@ -51,3 +53,31 @@ def test_fixed_decisions_are_kept_and_taken_first() -> None:
     d = _decide(passes, 60.0, fixed=[1, -1, 0])
     assert d.scheduled.tolist() == [True, False, False]
     assert d.blocker[1] == 0 and d.blocker[2] == NO_BLOCKER  # kept out, with no pass of this plan named
+
+
+def _plain_rule(passes: list[tuple[float, float, int]], gap: float) -> list[tuple[bool, int]]:
+    """The rule as docs/AUTOTRACK.md words it, by brute force: (scheduled, blocker index or -1) per pass."""
+    order = sorted(range(len(passes)), key=lambda i: (passes[i][2], passes[i][0], i))
+    taken: list[int] = []
+    out = [(False, -1)] * len(passes)
+    for i in order:
+        a, b, _ = passes[i]
+        clashes = [k for k in taken if max(passes[k][0] - b, a - passes[k][1]) < gap]
+        if clashes:
+            out[i] = (False, min(clashes, key=lambda k: passes[k][0]))
+        else:
+            taken.append(i)
+            out[i] = (True, -1)
+    return out
+
+
+@given(st.lists(st.tuples(st.integers(0, 20_000), st.integers(60, 3_000), st.integers(0, 5)), max_size=60),
+       st.sampled_from([0.0, 30.0, 60.0, 600.0]))
+def test_the_rule_matches_a_brute_force_reading_of_its_words(raw, gap) -> None:
+    passes = [(float(a), float(a + d), p) for a, d, p in raw]
+    if not passes:
+        return
+    d = _decide(passes, gap)
+    assert list(zip(d.scheduled.tolist(), d.blocker.tolist())) == _plain_rule(passes, gap)
+    chosen = [passes[i] for i in np.flatnonzero(d.scheduled)]
+    assert all(max(q[0] - p[1], p[0] - q[1]) >= gap for p in chosen for q in chosen if p is not q)

@@ -232,3 +232,48 @@ def test_the_clock_going_back_plans_again() -> None:
     planned = runtime.schedule
     runtime.tick(START)
     assert runtime.schedule is not planned and runtime.schedule.start < START
+
+
+def test_a_replan_asked_while_planning_is_not_lost() -> None:
+    station = Station(_catalog())
+    runtime = station.runtime()
+    real = runtime._planner
+    plans = []
+
+    def asking(now, previous):  # new elements arrive while the plan is being made
+        plans.append(now)
+        if len(plans) == 1:
+            runtime.replan()
+        return real(now, previous)
+
+    runtime._planner = asking
+    runtime.tick(START)
+    runtime.tick(START + timedelta(seconds=1))
+    assert len(plans) == 2
+    runtime.tick(START + timedelta(seconds=2))
+    assert len(plans) == 2
+
+
+def test_the_status_names_the_next_scheduled_pass() -> None:
+    station = Station(_catalog())
+    runtime = station.runtime(on=False)
+    assert runtime.status(START).next_pass_text() == "none"  # no plan yet
+    assert runtime.status(START).off_reason == runtime_module.NOT_SWITCHED_ON
+    runtime.tick(START)
+    status = runtime.status(START + timedelta(hours=2, minutes=20))  # after ISS's 02:03-02:14 pass
+    assert status.next_pass_text() == "SO-50 02:31-02:43" and status.planned_at == START
+    assert not status.on and status.fault is None and status.problems == ()
+    settings = AutotrackSettings(("ISS", "NOSUCH", 25544))
+    runtime = station.runtime(settings=settings)
+    runtime.tick(START)
+    assert runtime.status(START).problems == ("NOSUCH is not in the catalog",)
+
+
+def test_an_empty_list_says_why_nothing_is_planned() -> None:
+    station = Station(_catalog())
+    runtime = station.runtime(settings=AutotrackSettings(()))
+    runtime.tick(START)
+    status = runtime.status(START)
+    assert status.next_pass is None and station.calls == []
+    assert status.problems == ("no satellites to work: list them in [autotrack] satellites or [satellites] "
+                               "favourites",)

@@ -145,6 +145,8 @@ function renderPasses() {
   const failed = T("passes-error");
   failed.textContent = passes.error || "";
   failed.classList.toggle("hidden", !passes.error);
+  T("schedule-note").classList.toggle("hidden", !!passes.schedule);
+  Timeline.render($("timeline"), passes.schedule || null);
   const selected = frame && frame.now.satellite ? frame.now.satellite.catalog_number : null;
   if (!passes.passes.length) { row(["none in the next 12 h", "", "", "", "", "", ""], body); return; }
   for (const p of passes.passes) {
