@@ -57,9 +57,10 @@ class StationAutotrack:
             self.runtime.replan()
 
     def _wanted(self) -> bool:
-        """Whether to follow the ticks: while on, or while there is a schedule to show (a list and an observer);
-        a station that does not use autotrack plans nothing."""
-        return self.runtime.on or (bool(self._settings.satellites) and self.core.state.observer is not None)
+        """Whether to follow the ticks: while on, or while off with an ``[autotrack] satellites`` list of its own
+        and an observer (its schedule is shown); a station that does not use autotrack plans nothing."""
+        listed = self.config().autotrack.satellites is not None
+        return self.runtime.on or (listed and self.core.state.observer is not None)
 
     def _on_tick(self, sample: TickSample) -> None:
         self._notice_changes()
@@ -94,13 +95,16 @@ class StationAutotrack:
 
     def status_fields(self) -> dict[str, object]:
         """STATUS fields: ``auto`` (on/off), ``auto_next`` (the scheduled pass in progress or next, UTC),
-        ``auto_off`` (why off) and ``autotrack_fault`` while planning or selecting fails."""
+        ``auto_off`` (why off), ``auto_problems`` (listed satellites it cannot use, and why) and
+        ``autotrack_fault`` while planning or selecting fails."""
         status = self.runtime.status(self.core.clock.now())
         fields: dict[str, object] = {"auto": status.on, "auto_next": status.next_pass_text()}
         if not status.on:
             fields["auto_off"] = status.off_reason
         if status.fault is not None:
             fields["autotrack_fault"] = status.fault
+        if status.problems:
+            fields["auto_problems"] = "; ".join(status.problems)
         return fields
 
     def start(self) -> None:

@@ -108,7 +108,8 @@ class Station:
             if config.tcp.enabled else None)
         self.web: WebServer | None = (
             WebServer(self.core, config.web, StationParts(self.rotor, self.radio, self.easycomm, self.tcp, self.nova,
-                                                          favourites=lambda: self.config.favourites))
+                                                          favourites=lambda: self.config.favourites,
+                                                          autotrack_schedule=lambda: self.autotrack.runtime.schedule))
             if config.web.enabled else None)
         self.watcher: ConfigWatcher | None = None
         #: follows the stored catalog, which ``nfwserver elements update`` writes while the station runs

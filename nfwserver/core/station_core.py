@@ -204,8 +204,10 @@ class StationCore:
             if self.autotrack is None or not self.autotrack.on:
                 return "autotrack is off"
             why = self.why_not_computable(catalog_number)
+            if why is None and not self.select_satellite(catalog_number, source="autotrack"):
+                why = "not in the catalog"
             if why is None:
-                self.select_satellite(catalog_number, source="autotrack")
+                self.state.set_selected_by("autotrack")  # also when it was selected already (by the configuration)
         return why
 
     def set_autotrack(self, on: bool, source: str) -> None:

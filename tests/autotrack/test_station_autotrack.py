@@ -208,3 +208,21 @@ def test_watch_shows_autotrack_and_why_it_is_off() -> None:
     assert "Autotrack  OFF  (AUTO OFF from tcp 127.0.0.1:5)  next pass SO-50 04:09-04:23" in block_lines(update)
     assert " auto=off " in plain_line(update) + " "
     assert update.to_json()["auto"] is False
+
+
+def test_the_dashboard_gets_the_running_stations_schedule_and_its_auto_command() -> None:
+    from tests.waiting import wait_for
+    from tests.web.conftest import TOKEN, config_text, start_station
+
+    web = start_station(config_text() + "[autotrack]\nenabled = true\n")
+    try:
+        def scheduled() -> bool:
+            web.advance(0.2)
+            return web.get("/api/passes").get("schedule") is not None
+
+        wait_for(scheduled, 20.0, "the schedule on /api/passes")
+        wait_for(lambda: web.station.core.selected_by == "autotrack", 10.0, "autotrack's selection")
+        status, body = web.post({"command": "AUTO OFF", "token": TOKEN})
+        assert (status, body["ok"]) == (200, True) and not web.station.autotrack.runtime.on
+    finally:
+        web.station.stop()
