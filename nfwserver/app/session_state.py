@@ -1,10 +1,13 @@
-"""The session state kept across restarts: the AutoTracking satellite.
+"""The session state kept across restarts: the AutoTracking satellite, and autotrack on or off.
 
 Saved as a small JSON file, atomically (:mod:`nfwserver.storage`, keeping the file's permissions),
 whenever it changes, and at stop from the live state; a missing, unreadable or malformed file just means
 "no saved state".  Temporaries left by a process killed mid-save are removed when the state file is
 opened.  The file also records which ``[server] satellite`` was configured when the choice was made, so an
-edit of the configuration wins over a choice saved before it (the station says so in its log).
+edit of the configuration wins over a choice saved before it (the station says so in its log); likewise for
+autotrack, on or off (and why off) with the ``[autotrack] enabled`` of the time.  Writes are atomic and made
+under the file's lock (:func:`nfwserver.file_lock.locked`), so two stations given one state file cannot
+interleave theirs.
 
 :class:`SessionSaver` follows the ticks on its own worker thread: saving (an fsync) never runs on
 the publisher.  A file that cannot be written (read-only, full disk, a removed directory) is the
@@ -22,16 +25,29 @@ from pathlib import Path
 
 from nfwserver.core.sample import TickSample
 from nfwserver.core.tick_worker import TickWorker
+from nfwserver.file_lock import locked
 from nfwserver.health import LinkHealth
 from nfwserver.storage import atomic_write_text, remove_stale_temporaries
 
 log = logging.getLogger(__name__)
+
+#: Longest wait for the state file's lock (real seconds); a longer hold is a failed save, tried again.
+LOCK_WAIT_S = 2.0
 
 
 @dataclass(frozen=True)
 class SessionState:
     satellite: int | None = None  #: the AutoTracking satellite chosen while running
     configured: int | None = None  #: ``[server] satellite`` at the time of that choice
+    autotrack: bool | None = None  #: autotrack on or off (None: not recorded)
+    autotrack_off: str | None = None  #: why it was off
+    autotrack_enabled: bool | None = None  #: ``[autotrack] enabled`` at that time
+
+    def with_autotrack(self, mode: tuple[bool, str | None] | None, enabled: bool | None) -> SessionState:
+        """This state with autotrack's ``mode`` (on, why off) recorded, when there is one."""
+        if mode is None:
+            return self
+        return SessionState(self.satellite, self.configured, mode[0], mode[1], enabled)
 
 
 def default_state_path() -> Path:
@@ -54,7 +70,10 @@ class StateFile:
             for number in numbers:
                 if number is not None and (isinstance(number, bool) or not isinstance(number, int)):
                     raise ValueError("satellite is not a catalog number")
-            state = SessionState(*numbers)
+            auto = [doc.get("autotrack"), doc.get("autotrack_off"), doc.get("autotrack_enabled")]
+            if not all(v is None or isinstance(v, t) for v, t in zip(auto, (bool, str, bool), strict=True)):
+                raise ValueError("autotrack is not on/off with a reason")
+            state = SessionState(*numbers, *auto)
         except FileNotFoundError:
             state = SessionState()
         except (OSError, ValueError, AttributeError) as exc:
@@ -71,12 +90,13 @@ class StateFile:
         """Write ``state`` if it differs from what was last loaded or saved; raises :class:`OSError`."""
         if state == self._last:
             return
-        atomic_write_text(self.path, json.dumps(asdict(state)) + "\n")
+        with locked(self.path, timeout_s=LOCK_WAIT_S):
+            atomic_write_text(self.path, json.dumps(asdict(state)) + "\n")
         self._last = state
 
 
 class SessionSaver(TickWorker):
-    """Saves the AutoTracking satellite when it changes, on the worker thread ``nfw-session``.
+    """Saves the AutoTracking satellite and autotrack's mode when they change, on the worker thread ``nfw-session``.
 
     ``health`` is the ``state-file`` link: failures back off on its schedule.  When the saver stops, the
     state is saved once more, whatever the back-off says: the live selection read from ``current`` (a
@@ -85,22 +105,30 @@ class SessionSaver(TickWorker):
     thread_name = "nfw-session"
 
     def __init__(self, state_file: StateFile, configured: int | None, health: LinkHealth,
-                 current: Callable[[], int | None] | None = None) -> None:
+                 current: Callable[[], int | None] | None = None,
+                 autotrack: Callable[[], tuple[bool, str | None]] | None = None,
+                 autotrack_enabled: bool | None = None) -> None:
         super().__init__(health.clock)
         self.state_file = state_file
         self.configured = configured
         self.health = health
         self.current = current
+        self.autotrack = autotrack  #: autotrack's mode (on, why off), read at each save
+        self.autotrack_enabled = autotrack_enabled  #: ``[autotrack] enabled`` of the running configuration
         self._wanted: SessionState | None = None
 
+    def _state(self, satellite: int | None) -> SessionState:
+        mode = self.autotrack() if self.autotrack is not None else None
+        return SessionState(satellite, self.configured).with_autotrack(mode, self.autotrack_enabled)
+
     def process(self, sample: TickSample) -> None:
-        self._wanted = SessionState(sample.catalog_number, self.configured)
+        self._wanted = self._state(sample.catalog_number)
         self._write(self._wanted, forced=False)
 
     def stop(self) -> None:
         super().stop()
         if self.current is not None:
-            self._wanted = SessionState(self.current(), self.configured)
+            self._wanted = self._state(self.current())
         if self._wanted is not None:
             self._write(self._wanted, forced=True)
 

@@ -20,6 +20,7 @@ import logging
 import threading
 from collections.abc import Callable
 
+from nfwserver.app.autotrack_link import StationAutotrack
 from nfwserver.app.config_watcher import ConfigWatcher
 from nfwserver.app.devices import make_radio, make_rotor
 from nfwserver.app.element_refresher import ElementRefresher
@@ -87,10 +88,13 @@ class Station:
         self.core.rotor_configured = self.rotor is not None
         self.core.rotor = self.rotor  # FLIP and PARK, from every face
         self.radio: RadioCoupling | None = make_radio(config.radio, self.core, clock)
+        self.core.radio_configured = self.radio is not None
+        self.autotrack = StationAutotrack(self.core, clock, lambda: self.config)  # AUTO ON|OFF, SAT= switches off
         configured = config.server.satellite if isinstance(config.server.satellite, int) else None  # a name: at start
         self.saver = (SessionSaver(self.state_file, configured,
                                    self.core.health.link("state-file", Backoff(0.2, 0.4)),
-                                   current=lambda: self.core.state.catalog_number)
+                                   current=lambda: self.core.state.catalog_number, autotrack=self.autotrack.mode,
+                                   autotrack_enabled=config.autotrack.enabled)
                       if self.state_file else None)
         self.easycomm: EasyCommOutput | None = (
             EasyCommOutput(config.easycomm, self.core.state, clock,
@@ -99,11 +103,13 @@ class Station:
         self.tcp: NovaTcpServer | None = (
             NovaTcpServer(self.core, config.tcp,
                           combined(device_status(self.rotor, self.radio, self.easycomm),
-                                   elements_status(self.core.state, clock, config.elements.stale_days)))
+                                   elements_status(self.core.state, clock, config.elements.stale_days),
+                                   self.autotrack.status_fields))
             if config.tcp.enabled else None)
         self.web: WebServer | None = (
             WebServer(self.core, config.web, StationParts(self.rotor, self.radio, self.easycomm, self.tcp, self.nova,
-                                                          favourites=lambda: self.config.favourites))
+                                                          favourites=lambda: self.config.favourites,
+                                                          autotrack_schedule=lambda: self.autotrack.runtime.schedule))
             if config.web.enabled else None)
         self.watcher: ConfigWatcher | None = None
         if self.web is not None:  # a command from the page is checked against the file as it is now
@@ -278,6 +284,8 @@ class Station:
             self.core.set_track(True, source="config")
         if self.config.radio.enabled:
             self.core.set_doppler(True, source="config")
+        where = str(self.state_file.path) if self.state_file is not None else "no state file"
+        log.info("%s", self.autotrack.restore(saved.autotrack, saved.autotrack_off, saved.autotrack_enabled, where))
 
     # -- life cycle ----------------------------------------------------------------------------------
     def start(self) -> None:
@@ -310,6 +318,7 @@ class Station:
             if worker is not None:
                 self._unsubscribe.append(self.core.subscribe(worker.on_tick))
                 worker.start()
+        self.autotrack.start()
         self.publisher.start()
         cfg = self.config.elements
         if configured_urls(cfg) or (cfg.refresh_hours > 0 and cfg.files) or self.predict is not None:
@@ -337,7 +346,7 @@ class Station:
                 listener.stop()
         for dialect_server in self.dialect_servers:
             dialect_server.detach()
-        for worker in (self.radio, self.rotor, self.easycomm):
+        for worker in (self.radio, self.rotor, self.easycomm, self.autotrack):
             if worker is not None:
                 worker.stop()
         self.nova.detach()

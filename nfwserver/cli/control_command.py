@@ -60,18 +60,20 @@ def _ask(args: argparse.Namespace, line: str, until: str | None = None) -> str:
 def poke(args: argparse.Namespace) -> int:
     import sys
 
+    from nfwserver.commands.parsing import parse_request
+    from nfwserver.commands.table import Face
 
     text = args.text.strip()
     if not text or not text.isascii() or not text.isprintable() or len(text) > 256:
         print("nfwserver poke: the command must be one line of printable ASCII (at most 256 characters)",
               file=sys.stderr)
         return 2
-    word = text.split()[0].upper()
-    if word == "WATCH":
-        print("nfwserver poke: WATCH streams until stopped: `nfwserver watch` shows the station live "
-              "(`nfwserver watch --json` for scripts)", file=sys.stderr)
+    entry = next(iter(parse_request(text, Face.TCP).commands), None)  # as the station will read it
+    if entry is not None and entry.command.streams:
+        print(f"nfwserver poke: {entry.command.usage} streams until stopped: `nfwserver watch` shows the station "
+              "live (`nfwserver watch --json` for scripts)", file=sys.stderr)
         return 2
-    reply = _ask(args, text, until="OK" if word == "HELP" else None)
+    reply = _ask(args, text, until="OK" if entry is not None and entry.command.reply_until_ok else None)
     if reply.startswith("ERROR"):
         raise CliError(f"the station refused {text!r}: {reply[5:].strip()}")
     print(reply)

@@ -10,8 +10,9 @@ included.  Pokes are scheduled with ``--poke 120:SAT=25544`` (sent 120 s in); ``
 at the start unless the first TUNE command among the ``--poke`` options is ``TUNE ON`` or is sent at
 0 s (so ``--poke 60:"TUNE OFF"`` shows the feed stopping, and ``--poke 30:"TUNE ON"`` what a client
 gets before it).  Each ``--poke`` is sent as given, whatever it holds, and what the server did with
-it is said on stderr (:mod:`nfwserver.cli.simulate_pokes`).  The dialects take no pokes (their
-clients never send any), so on a dialect link the commands go to the server directly.
+it is said on stderr (:mod:`nfwserver.cli.simulate_pokes`).  A poke takes the path of a DDE client's:
+through Nova's DDE service on the in-process transport to the station core.  The dialects take no pokes
+(their clients never send any), so on a dialect link the pokes go to Nova's item on a second conversation.
 """
 
 from __future__ import annotations
@@ -20,13 +21,15 @@ import argparse
 import logging
 import sys
 
+from nfwserver.app.autotrack_link import StationAutotrack
 from nfwserver.cli.arguments import number_in, satellite_value, time_value
 from nfwserver.cli.errors import CliError, say
 from nfwserver.cli.simulate_pokes import MAX_DURATION_S, commands_of, observe_poke, poke_value
 from nfwserver.cli.simulated_clients import CLIENTS, Link, SimulatedClient, parse_link
 from nfwserver.cli.tracking_options import add_tracking_options, format_time, load_tracking_inputs
 from nfwserver.clock import VirtualClock
-from nfwserver.commands.table import Face
+from nfwserver.commands.parsing import Parsed
+from nfwserver.commands.table import FEED_SWITCH, SATELLITE_CHOICE
 from nfwserver.core.publisher import run_virtual
 from nfwserver.core.state import MAX_RATE_HZ, MIN_RATE_HZ
 from nfwserver.core.station_core import StationCore
@@ -84,19 +87,19 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     p.set_defaults(func=run, usage_error=p.error)
 
 
-def _pokes_decide_feed(pokes: list[tuple[float, str]]) -> bool:
-    """True when the first TUNE command among ``pokes`` (sorted by offset) is TUNE ON or is sent at the start:
-    the user then decides when the feed starts, and no TUNE ON is poked for them.  The pokes are read as the
-    server reads them (a poke it refuses switches nothing)."""
-    switches = [(offset, parsed.value) for offset, command in pokes for parsed in commands_of(command)
-                if parsed.command.word == "TUNE"]
+def _pokes_decide_feed(previews: list[tuple[float, tuple[Parsed, ...]]]) -> bool:
+    """True when the first feed switch among the pokes (sorted by offset) switches it on or is sent at the start:
+    the user then decides when the feed starts, and no automatic one is poked for them.  ``previews`` are the
+    pokes as the DDE face parses them (a poke it refuses switches nothing)."""
+    switches = [(offset, parsed.value) for offset, commands in previews for parsed in commands
+                if parsed.command is FEED_SWITCH]
     return bool(switches) and (switches[0][1] is True or switches[0][0] == 0)
 
 
-def _first_sat(pokes: list[tuple[float, str]]) -> float | None:
-    """The offset of the first poke holding a ``SAT=`` the server parses."""
-    return next((offset for offset, command in pokes
-                 if any(parsed.command.word == "SAT" for parsed in commands_of(command))), None)
+def _first_sat(previews: list[tuple[float, tuple[Parsed, ...]]]) -> float | None:
+    """The offset of the first poke that chooses a satellite, as the DDE face parses it."""
+    return next((offset for offset, commands in previews
+                 if any(parsed.command is SATELLITE_CHOICE for parsed in commands)), None)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -109,30 +112,32 @@ def run(args: argparse.Namespace) -> int:
         args.usage_error("--poll 0 (a request per notification) is WiSP's mode: use it with --client wisp")
     inputs = load_tracking_inputs(args)
     clock = VirtualClock(args.start)
-    server = StationCore(inputs.catalog, inputs.observer, clock, horizon=inputs.horizon,
-                         ut1_utc=inputs.ut1_utc, rate_hz=args.rate)
     wanted = str(args.sat) if args.sat is not None else (str(inputs.satellite) if inputs.satellite else None)
     sat = inputs.catalog.find(wanted) if wanted is not None else None
     if wanted is not None and sat is None:
-        origin = "--sat" if args.sat is not None else "[server] satellite"
         if args.sat is not None:
             raise CliError(f"satellite {wanted} is not in the catalog")
-        say(f"{origin} {wanted} is not in the catalog")
-    if sat is not None:
-        server.select_satellite(sat.catalog_number, source="simulate")
-    else:
-        sat_poke = _first_sat(pokes)
+        say(f"[server] satellite {wanted} is not in the catalog")
+    # the station's start-up selection, as ``run`` makes it from [server] satellite
+    server = StationCore(inputs.catalog, inputs.observer, clock, horizon=inputs.horizon, ut1_utc=inputs.ut1_utc,
+                         rate_hz=args.rate, satellite=sat.catalog_number if sat is not None else None)
+    previews = [(offset, commands_of(command)) for offset, command in pokes]  # read once, before any is sent
+    autotrack = StationAutotrack(server, clock, inputs.config)  # [autotrack] of the configuration; AUTO ON|OFF
+    if inputs.config().autotrack.enabled:
+        say(autotrack.restore(None, None, None, "no state file") + ": it selects the satellites of its schedule")
+    elif sat is None:
+        sat_poke = _first_sat(previews)
         if sat_poke is None:
             say("no --sat given and no [server] satellite in the catalog: no AutoTracking satellite, so nothing is "
                 "published")
         elif sat_poke > 0:
             say(f"no satellite until the SAT= poke at {sat_poke:g} s: nothing is published before it")
-    auto_feed = not _pokes_decide_feed(pokes)
-    return _simulate(args, server, clock, pokes, auto_feed)
+    auto_feed = not _pokes_decide_feed(previews)
+    return _simulate(args, server, clock, pokes, auto_feed, autotrack)
 
 
 def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock,
-              pokes: list[tuple[float, str]], auto_feed: bool) -> int:
+              pokes: list[tuple[float, str]], auto_feed: bool, autotrack: StationAutotrack) -> int:
     # Refusals are reported below with their time; keep the core's own warning out of the way
     # (restored on the way out: the logger is shared with anything else in this process).
     core_log = logging.getLogger("nfwserver.core.station_core")
@@ -141,8 +146,12 @@ def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock
     system = FakeDdeSystem(received_capacity=16)
     link: Link = args.link
     dialect = DIALECTS.get(link.service.upper())
-    service = DialectServer(dialect, server) if dialect is not None else NovaDdeService(server)
-    service.attach(system.server_transport())
+    nova = NovaDdeService(server)  # pokes go to Nova's item, as a client's do, whichever item is watched
+    nova.attach(system.server_transport())
+    services: list[NovaDdeService | DialectServer] = [nova]
+    if dialect is not None:
+        services.append(DialectServer(dialect, server))
+        services[-1].attach(system.server_transport())
     lines: list[str] = []
     marked = args.client != "hot"
 
@@ -157,14 +166,17 @@ def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock
 
     try:
         conversation = system.connect(link.service, link.topic, client_name="simulate")
+        pokes_to = conversation if dialect is None else system.connect(NOVA_LINK.service, NOVA_LINK.topic,
+                                                                       client_name="simulate")
     except DdeError:
-        service.detach()
+        for service in services:
+            service.detach()
         core_log.setLevel(saved_level)
         served = "NFW32|NFW_DATA or NFW_SERVER|NFW_DATA, " + ", ".join(f"{d.service}|{d.topic}"
                                                                         for d in DIALECTS.values())
         args.usage_error(f"--link {link}: nothing serves that service and topic here (served: {served})")
     client = SimulatedClient(args.client, conversation, link.item, emit, args.poll)
-    pending = [(0.0, "TUNE ON", False)] if auto_feed else []  # the automatic TUNE ON is not reported
+    pending = [(0.0, FEED_SWITCH.spell(True), False)] if auto_feed else []  # the automatic one is not reported
     pending += [(offset, command, True) for offset, command in pokes]
     started = False
     previous: list[float] = []  # the offset of the tick published last
@@ -172,9 +184,13 @@ def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock
     def send(command: str) -> None:
         if dialect is None:
             client.poke(command)
-        else:  # the dialects take no pokes: their clients never send any; Nova's commands go to the core
-            result = server.command(command, source="simulate", face=Face.DDE)
-            emit("poke", f"{command} (to the server{'' if result.accepted else ', refused'})")
+            return
+        try:  # the dialects take no pokes (their clients never send any): a poke on Nova's item, as a client's
+            pokes_to.poke(NOVA_LINK.item, command)
+            verdict = ""
+        except DdeError:
+            verdict = ", refused"
+        emit("poke", f"{command} (on {NOVA_LINK}{verdict})")
 
     def before_tick(offset: float) -> None:
         nonlocal started
@@ -189,6 +205,7 @@ def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock
             outcome = observe_poke(server, round(max(at, offset), 3), command, send)
             if report:  # what the poke did, among the diagnostics (stdout carries only what the client sees)
                 print(outcome.line(), file=sys.stderr)
+        autotrack.follow(clock.now())  # its satellite of this instant, before the tick computes it
         if not started:
             started = True
             try:
@@ -206,6 +223,7 @@ def _simulate(args: argparse.Namespace, server: StationCore, clock: VirtualClock
         sys.stderr.close()
         return 0
     finally:
-        service.detach()
+        for service in services:
+            service.detach()
         core_log.setLevel(saved_level)
     return 0

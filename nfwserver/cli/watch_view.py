@@ -18,7 +18,7 @@ from nfwserver.tcp.status_line import parse_status as parse_status  # the one ST
 #: STATUS fields turned into JSON numbers and booleans (the rest stay strings).
 _FLOATS = ("az", "el", "rr", "elements_age_d", "rotor_az", "rotor_el")
 _INTS = ("satellite", "interface", "radio_rx", "radio_tx")
-_SWITCHES = ("tune", "track", "radio_tuning")
+_SWITCHES = ("tune", "track", "radio_tuning", "auto")
 
 
 @dataclass(frozen=True)
@@ -127,6 +127,9 @@ def block_lines(update: WatchUpdate) -> list[str]:
         lines.append(radio)
     if "easycomm" in f:
         lines.append(f"EasyComm   {f['easycomm']}")
+    if "auto" in f:
+        why = f"  ({f['auto_off']})" if f.get("auto_off", "-") != "-" else ""
+        lines.append(f"Autotrack  {f['auto'].upper()}{why}  next pass {f.get('auto_next', '-')}")
     if "elements_age_d" in f:
         stale = "  STALE: `nfwserver elements update`" if f.get("elements_stale") == "yes" else ""
         lines.append(f"Elements   {f['elements_age_d']} days old{stale}")
@@ -139,5 +142,5 @@ def plain_line(update: WatchUpdate) -> str:
         return f"{_time(update.time)}  {down_text(update)}"
     f = update.fields
     text = update.nova or f"{f.get('name', '-')} (feed off)"
-    keys = ("tune", "track", "status", "faults", "rotor", "radio", "easycomm", "elements_age_d")
+    keys = ("tune", "track", "auto", "status", "faults", "rotor", "radio", "easycomm", "elements_age_d")
     return f"{_time(update.time)}  {text}  " + " ".join(f"{k}={f[k]}" for k in keys if k in f)

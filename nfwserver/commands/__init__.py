@@ -1,7 +1,6 @@
 """The station's commands: one table (:mod:`.table`), one parser (:mod:`.parsing`), help generated from them."""
 
-from nfwserver.commands.parsing import Parsed, parse_line, parse_poke
-from nfwserver.commands.table import COMMANDS, Command, CommandError, Face, Poke, PokeKind, Target
+from nfwserver.commands.parsing import Parsed, Request, parse_line, parse_request
+from nfwserver.commands.table import COMMANDS, Command, CommandError, Face, Target
 
-__all__ = ["COMMANDS", "Command", "CommandError", "Face", "Parsed", "Poke", "PokeKind", "Target", "parse_line",
-           "parse_poke"]
+__all__ = ["COMMANDS", "Command", "CommandError", "Face", "Parsed", "Request", "Target", "parse_line", "parse_request"]

@@ -5,8 +5,12 @@ Every entry of :data:`nfwserver.commands.table.COMMANDS` names one of the action
 display), the entry's checked argument and the sender, and returns an :class:`Outcome`.  The targets are
 typed by what the actions call on them (protocols), so this package imports none of them.
 
-The station core runs the actions (:meth:`nfwserver.core.station_core.StationCore.execute`); a face only
-parses the text it received (:func:`nfwserver.commands.parsing.parse_request`) and renders the outcome.
+An entry may also name a check step (Hamlib checks and converts an argument before its ``ACTION``): it
+runs on the station before any command of a poke takes effect, turns the parsed argument into the one the
+action takes (``SAT=`` by name into a catalog number) and raises :class:`Refused` when the station cannot do
+it now.  The station core runs the checks and the actions and records every command
+(:meth:`nfwserver.core.station_core.StationCore.execute`); a face only hands over the text it received
+(or, for a key, the entry and its argument) and renders the outcome.
 """
 
 from __future__ import annotations
@@ -15,8 +19,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
-__all__ = ["DONE", "NO_ROTOR", "TRACK_WITHOUT_ROTOR", "Action", "DisplayPort", "Outcome", "RotorControl",
-           "SessionPort", "StationPort", "Targets"]
+__all__ = ["DONE", "DOPPLER_WITHOUT_RADIO", "NO_ROTOR", "TRACK_WITHOUT_ROTOR", "Action", "Check", "DisplayPort",
+           "Outcome", "Refused", "RotorControl", "SessionPort", "StationPort", "Targets", "AutotrackSwitch"]
 
 #: Why a rotor command is refused on a station with no rotor (every face says it in these words).
 NO_ROTOR = "no rotor is configured"
@@ -24,6 +28,15 @@ NO_ROTOR = "no rotor is configured"
 #: The warning that comes with an accepted ``TRACK ON`` on a station that drives no rotor itself.
 TRACK_WITHOUT_ROTOR = ("TRACK ON with no rotor configured: nothing turns here ([rotor] backend); "
                        "DDE clients that drive their own rotor still follow the feed")
+
+#: The warning that comes with an accepted ``DOPPLER ON`` on a station that drives no radio.
+DOPPLER_WITHOUT_RADIO = ("DOPPLER ON with no radio configured: nothing is tuned (set [radio] backend = \"rigctld\" "
+                         "with the host and port of a running rigctld, and give the satellite a channel in "
+                         "[satellites] channels)")
+
+
+class Refused(Exception):
+    """A check step's refusal: the command cannot be done now; the message says why in one sentence."""
 
 
 @dataclass(frozen=True)
@@ -38,17 +51,43 @@ class Outcome:
 DONE = Outcome()
 
 
+class AutotrackSwitch(Protocol):
+    """The station's autotrack as the commands switch it (:class:`nfwserver.autotrack.AutotrackRuntime`)."""
+
+    @property
+    def on(self) -> bool: ...
+
+    def switch_on(self) -> bool: ...
+
+    def switch_off(self, reason: str) -> bool: ...
+
+
 class StationPort(Protocol):
     """What Nova's station commands need of the station core."""
 
     #: whether the station drives a rotor itself (None: not known, then no warning)
     rotor_configured: bool | None
+    #: whether the station drives a radio itself (None: not known, then no warning)
+    radio_configured: bool | None
+
+    def satellites(self, value: int | str) -> list[tuple[int, str]]:
+        """Catalog number and DDE name of each satellite ``value`` names (a catalog number, or a name)."""
+
+    def why_not_computable(self, catalog_number: int) -> str | None: ...
+
+    #: the station's autotrack (None: this station has none)
+    autotrack: AutotrackSwitch | None
+
+    def set_autotrack(self, on: bool, source: str) -> None: ...
+
+    def choose_satellite(self, catalog_number: int, source: str) -> str | None:
+        """``SAT=``: select it; a sentence when that switched autotrack off, else None."""
+
+    def set_doppler(self, on: bool, source: str = ...) -> None: ...
 
     def set_feed(self, on: bool, source: str = ...) -> None: ...
 
     def set_track(self, on: bool, source: str = ...) -> str | None: ...
-
-    def select_satellite(self, catalog_number: int, source: str = ...) -> bool: ...
 
     def report_antenna_position(self, azimuth_deg: float | None, elevation_deg: float | None,
                                 source: str = ...) -> None: ...
@@ -104,6 +143,8 @@ class Targets:
 
 #: An entry's action: (targets, checked argument, sender) -> outcome.
 Action = Callable[[Targets, object, str], Outcome]
+#: An entry's check step: (station, parsed argument) -> the argument its action takes; raises :class:`Refused`.
+Check = Callable[[StationPort, object], object]
 
 
 def _degrees(value: object) -> float:
@@ -129,10 +170,25 @@ def track(targets: Targets, value: object, source: str) -> Outcome:
 
 
 def satellite(targets: Targets, value: object, source: str) -> Outcome:
-    """``SAT=``: ``value`` is the catalog number the station resolved (names are resolved before)."""
+    """``SAT=``: ``value`` is the catalog number its check resolved (names are resolved there)."""
     if not isinstance(value, int) or isinstance(value, bool):
         raise AssertionError(f"SAT= reached its action unresolved: {value!r}")
-    targets.station.select_satellite(value, source)
+    switched_off = targets.station.choose_satellite(value, source)
+    return Outcome(warning=switched_off) if switched_off else DONE
+
+
+def autotrack(targets: Targets, value: object, source: str) -> Outcome:
+    """AUTO ON/OFF: the station selects the satellite of its schedule by itself, or leaves the choice to people."""
+    targets.station.set_autotrack(value is True, source)
+    return DONE
+
+
+def doppler(targets: Targets, value: object, source: str) -> Outcome:
+    """DOPPLER ON/OFF: frequency updates to the radio (OrbitDRV's Enable/Disable Tuning; not Nova's TUNE)."""
+    on = value is True
+    targets.station.set_doppler(on, source)
+    if on and targets.station.radio_configured is False:
+        return Outcome(warning=DOPPLER_WITHOUT_RADIO)
     return DONE
 
 

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import textwrap
 
-from nfwserver.commands.table import Face, Target, commands_for
+from nfwserver.commands.table import Face, Target, command, commands_for
 
-__all__ = ["help_lines", "markdown", "poke_epilog"]
+__all__ = ["help_lines", "input_hint", "markdown", "poke_epilog"]
 
 _FACE_NAMES = ((Face.DDE, "DDE"), (Face.TCP, "TCP"), (Face.CONSOLE, "console"), (Face.WEB, "web"))
 _TARGET_NAMES = {Target.STATION: "station", Target.SESSION: "connection", Target.ROTOR: "rotor",
@@ -23,6 +23,14 @@ def help_lines(face: Face) -> tuple[str, ...]:
     entries = commands_for(face)
     width = max(len(c.usage) for c in entries)
     return tuple(f"{c.usage:<{width}}  {c.summary}" for c in entries)
+
+
+def input_hint(face: Face) -> str:
+    """The hint of an input line of ``face``: a few of its commands' usages, and how to list them all."""
+    entries = commands_for(face, Target.STATION)[:3]
+    listed = " | ".join(c.short for c in entries)
+    listing = command("HELP")
+    return f"command: {listed} ..." + (f" ({listing.usage} lists them all)" if face & listing.faces else "")
 
 
 def poke_epilog(width: int = 79) -> str:

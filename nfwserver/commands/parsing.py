@@ -1,9 +1,9 @@
 """Parsing command text through the table (:mod:`nfwserver.commands.table`), for every face.
 
-:func:`parse_line` reads one command as a given face may send it; :func:`parse_poke` reads Nova's
-station commands from a DDE poke or execute, which may hold several, one per line: every line must
-parse before any is returned, so a half-understood poke changes nothing.  Surrounding NULs, CR/LF and
-blanks are stripped, keywords are matched in any case.
+:func:`parse_request` reads what a face received: one command, or from a DDE poke or execute Nova's
+station commands, several, one per line: every line must parse before any is taken, so a half-understood
+poke changes nothing.  :meth:`Request.of` is a command a console key gives as its entry and argument,
+with no text to parse.  Surrounding NULs, CR/LF and blanks are stripped, keywords are matched in any case.
 """
 
 from __future__ import annotations
@@ -16,13 +16,11 @@ from nfwserver.commands.table import (
     Command,
     CommandError,
     Face,
-    Poke,
-    PokeKind,
     Target,
     commands_for,
 )
 
-__all__ = ["Parsed", "Request", "clean_command_text", "parse_line", "parse_poke", "parse_poke_line", "parse_request"]
+__all__ = ["Parsed", "Request", "clean_command_text", "parse_line", "parse_request"]
 
 
 @dataclass(frozen=True)
@@ -31,11 +29,6 @@ class Parsed:
 
     command: Command
     value: object
-
-    def poke(self) -> Poke:
-        """The station command (only for entries whose target is the station)."""
-        # the entry's grammar checked the value, of the type Poke takes for that kind
-        return Poke(PokeKind(self.command.word), self.value)  # type: ignore[arg-type]
 
 
 @dataclass(frozen=True)
@@ -46,6 +39,12 @@ class Request:
     face: Face
     commands: tuple[Parsed, ...]  #: empty when refused
     error: CommandError | None = None
+
+    @classmethod
+    def of(cls, entry: Command, value: object, face: Face) -> Request:
+        """The command ``entry`` with the argument ``value`` (of the type its converter gives), as a key of
+        ``face`` sends it: no text is parsed; the record shows it as a client would write it."""
+        return cls(entry.spell(value), face, (Parsed(entry, value),))
 
     @property
     def target(self) -> Target:
@@ -85,16 +84,6 @@ def parse_line(text: str, face: Face, target: Target | None = None) -> Parsed:
         if word and word.group(0).upper() == entry.word:
             raise CommandError(f"{entry.word} needs {entry.needs}", bad_argument=True, command=entry)
     raise CommandError(_unknown(face))
-
-
-def parse_poke_line(line: str, face: Face = Face.DDE) -> Poke:
-    """One of Nova's station commands; raises :class:`CommandError`."""
-    return parse_line(line, face, Target.STATION).poke()
-
-
-def parse_poke(text: str, face: Face = Face.DDE) -> list[Poke]:
-    """Nova's station commands in ``text``, one per line; raises :class:`CommandError` unless all parse."""
-    return [parse_poke_line(line, face) for line in _station_lines(text)]
 
 
 def _station_lines(text: str) -> list[str]:

@@ -5,8 +5,9 @@ track, clients), InstantTrack's realtime values for the selected satellite (look
 sub-satellite point and locator, orbit number, phase, mode, sunlit, and Doppler and path loss at the
 satellite's own downlink channel), the antenna, rotor (flip state, suspension) and radio, the outgoing
 strings (F1) and the incoming strings with the conversation that sent them (F3), the passes of the
-favourites with a sky plot.  The input line at the bottom takes the commands a client pokes
-(``TUNE ON``, ``SAT=27607`` ...) plus the console's own ``Z`` (UTC/local time) and ``FLIP AUTO|ON|OFF``.
+favourites with a sky plot.  The input line at the bottom takes the commands the table lets the console
+send (a client's, plus the console's own: ``HELP`` lists them); the keys (F2's picker, F4, Ctrl+T, Ctrl+D,
+Ctrl+F) act through the same table entries, handing the core the entry and its argument with no text.
 
 Threads: events arrive on the server's threads and are queued, then drained on the UI thread by a
 timer, so a flood of strings at 50 Hz never blocks the publisher.  Pass searches and the sky track
@@ -35,9 +36,18 @@ from textual.containers import Horizontal, Vertical
 from textual.css.query import NoMatches
 from textual.widgets import Footer, Input, RichLog, Static
 
-from nfwserver.commands.actions import NO_ROTOR
-from nfwserver.commands.parsing import parse_request
-from nfwserver.commands.table import Face, Target, escape_for_log
+from nfwserver.commands.help_text import input_hint
+from nfwserver.commands.parsing import Request
+from nfwserver.commands.table import (
+    DOPPLER_SWITCH,
+    FEED_SWITCH,
+    FLIP_MODE,
+    SATELLITE_CHOICE,
+    ZONE_TOGGLE,
+    Command,
+    Face,
+    escape_for_log,
+)
 from nfwserver.console.command_port import ConsolePort
 from nfwserver.console.help_screen import HelpScreen
 from nfwserver.console.pass_view import LEGEND, STALE_DAYS, PassSearch, next_pass_text, pass_table, search_passes
@@ -60,7 +70,7 @@ from nfwserver.console.state_view import (
 from nfwserver.console.time_display import TimeDisplay
 from nfwserver.core.events import Direction, Event
 from nfwserver.core.faces import CountsClients, WritesLines
-from nfwserver.core.station_core import StationCore
+from nfwserver.core.station_core import CommandResult, StationCore
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.rotor.coupling import FLIP_MODES, RotorCoupling
 
@@ -121,7 +131,7 @@ class NfwConsole(App[None]):
         self.failure: BaseException | None = None  #: the exception that stopped the console, if one did
         self._queue: collections.deque[Event] = collections.deque(maxlen=2000)
         self._lock = threading.Lock()
-        self._port = ConsolePort(self._show_help, self.action_toggle_zone)  #: HELP's and Z's target
+        self._port = ConsolePort(self._show_help, self._toggle_zone)  #: the help and zone entries' target
         self._unsubscribe: Callable[[], None] | None = None
         self._search: PassSearch | None = None
         self._search_key: tuple[Any, ...] | None = None
@@ -138,8 +148,7 @@ class NfwConsole(App[None]):
             with Vertical(id="side"):
                 yield Static(id="passes")
                 yield Static(id="sky")
-        yield Input(placeholder="command: TUNE ON | TRACK ON | SAT=25544 or a name | Z (UTC/local) | HELP",
-                    id="poke")
+        yield Input(placeholder=input_hint(Face.CONSOLE), id="poke")
         yield Footer()
 
     def on_mount(self) -> None:
@@ -285,21 +294,21 @@ class NfwConsole(App[None]):
     def on_input_submitted(self, message: Input.Submitted) -> None:
         text = message.value.strip()
         message.input.value = ""
-        if text:
-            self._run(text)
+        if text:  # the core parses it as the console's, runs it through the command table and records it
+            self._answered(self.core.command(text, source="console", face=Face.CONSOLE, session=self._port,
+                                             display=self._port))
 
-    def _run(self, text: str) -> None:
-        """Parse ``text`` as the console's and hand it to the core, which runs it through the command table
-        (the core records and explains station commands' refusals; the console notes the others')."""
-        request = parse_request(text, Face.CONSOLE)
-        result = self.core.execute(request, source="console", session=self._port, display=self._port)
-        if request.target is Target.STATION:
-            if result.warning and result.note:
-                self._note(f"warning: {result.note}")
-        elif result.note == NO_ROTOR:
-            self._note(f"{NO_ROTOR} ([rotor] backend), so there is no rotor to command")
-        elif not result.accepted:
-            self._note(result.note or "refused", "red")
+    def _key(self, entry: Command, value: object) -> None:
+        """A key's command: its table entry and argument, run as the typed command would be, with no text."""
+        self._answered(self.core.execute(Request.of(entry, value, Face.CONSOLE), source="console",
+                                         session=self._port, display=self._port))
+
+    def _answered(self, result: CommandResult) -> None:
+        """The incoming pane shows the core's record of the command (refused with the reason); a warning of an
+        accepted command is noted too."""
+        if result.warning and result.note:
+            where = f" (configuration: {self.config_file})" if self.config_file else ""
+            self._note(f"warning: {result.note}{where}")
         self._drain()
         self._refresh_state()
 
@@ -319,10 +328,8 @@ class NfwConsole(App[None]):
 
     def _picked(self, catalog_number: int | None) -> None:
         if catalog_number is not None:
-            self._run(f"SAT={catalog_number}")
+            self._key(SATELLITE_CHOICE, catalog_number)
         self.query_one("#poke", Input).focus()
-        self._drain()
-        self._refresh_state()
 
     def _show_log(self, which: str) -> None:
         """Show (on a narrow terminal) the ``which`` log; Page Up/Down scroll it.  The command line keeps
@@ -346,28 +353,22 @@ class NfwConsole(App[None]):
         self._show_log("incoming")
 
     def action_toggle_zone(self) -> None:
+        self._key(ZONE_TOGGLE, None)
+
+    def _toggle_zone(self) -> None:
+        """The display's side of the zone entry: times in UTC or in the local zone."""
         self.times.toggle()
         self._note(f"times now in {self.times.zone(self.core.clock.now())}", "dim")
         self._refresh_state()
 
     def action_toggle_doppler(self) -> None:
-        on = not self.core.state.doppler_on
-        self.core.set_doppler(on, source="console")
-        if self.radio is None:
-            where = self.config_file or "the configuration file"
-            text = (f"Doppler tuning {'on' if on else 'off'}, but no radio is configured, so nothing is tuned: "
-                    f"set [radio] backend = \"rigctld\" (with host and port of a running rigctld) in {where} and "
-                    "give the satellite a channel in [satellites] channels.")
-            self._note(text)
-            self.notify(text, title="No radio", severity="warning", markup=False)
-        self._drain()
-        self._refresh_state()
+        self._key(DOPPLER_SWITCH, not self.core.state.doppler_on)
 
     def action_toggle_feed(self) -> None:
-        self._run("TUNE OFF" if self.core.snapshot().state.feed_on else "TUNE ON")
+        self._key(FEED_SWITCH, not self.core.snapshot().state.feed_on)
 
     def action_cycle_flip(self) -> None:
-        """The next flip mode (auto, on, off), as the command ``FLIP <mode>`` typed on the input line."""
+        """The next flip mode (auto, on, off), through the flip entry as if typed on the input line."""
         order = list(FLIP_MODES)
         current = self.rotor.flip_mode if self.rotor is not None else order[-1]
-        self._run(f"FLIP {order[(order.index(current) + 1) % len(order)]}")
+        self._key(FLIP_MODE, order[(order.index(current) + 1) % len(order)])

@@ -29,17 +29,8 @@ class ConsolePort:
     def toggle_zone(self) -> None:
         self._toggle_zone()
 
-    def _not_the_consoles(self, word: str) -> None:
-        raise AssertionError(f"{word} reached the console, which the command table does not let send it")
+    def _not_the_consoles(self) -> None:
+        raise AssertionError("a TCP session's command reached the console, which the command table does not let "
+                             "send it")
 
-    def summary(self) -> None:
-        self._not_the_consoles("SUMMARY")
-
-    def status(self) -> None:
-        self._not_the_consoles("STATUS")
-
-    def watch(self) -> None:
-        self._not_the_consoles("WATCH")
-
-    def quit(self) -> None:
-        self._not_the_consoles("QUIT")
+    summary = status = watch = quit = _not_the_consoles

@@ -82,6 +82,8 @@ class StationState:
         self._doppler_on = False
         self._antenna = AntennaPosition(None, None, "", None)
         self.generation = 0
+        #: bumped when what passes depend on changes (elements, observer, horizon): a schedule is planned again
+        self.sky_generation = 0
 
     # -- reading -----------------------------------------------------------------------------
     @property
@@ -153,6 +155,7 @@ class StationState:
             self._rate_hz = rate
             self._channels = MappingProxyType(dict(channels))
             self.generation += 1
+            self.sky_generation += 1
 
     def select(self, catalog_number: int | None, by: str | None = None) -> bool:
         """Select ``catalog_number``; when that changes the selection, ``by`` (when given) records who chose it in
@@ -183,6 +186,7 @@ class StationState:
         """Tell readers the catalog's contents changed (an element refresh updated it in place)."""
         with self._lock:
             self.generation += 1
+            self.sky_generation += 1
 
     def report_antenna(self, azimuth_deg: float | None, elevation_deg: float | None, source: str,
                        when: datetime) -> None:

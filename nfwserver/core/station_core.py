@@ -2,15 +2,15 @@
 
 :class:`StationCore` is what every output adapter is given.  Adapters read the state
 (:attr:`StationCore.state`), subscribe to ticks (:meth:`StationCore.subscribe`) and talk back
-through narrow ports: :meth:`execute` (every command, as a face parsed it:
-:func:`nfwserver.commands.parsing.parse_request`; :meth:`command` parses text for a caller that has
-only text), :meth:`select_satellite`, :meth:`report_antenna_position`, :meth:`set_doppler`.  No
-adapter keeps its own copy of the station.
+through narrow ports: :meth:`command` (the text a face received, parsed once) or :meth:`execute` (a
+parsed request, or a console key's entry and argument), :meth:`report_antenna_position` for the rotor's
+read-back.  No adapter keeps its own copy of the station, and none records a command itself.
 
-Every command is run through its entry's action in the command table (:mod:`nfwserver.commands`):
-Nova's ``TUNE ON|OFF`` (the DDE output), ``TRACK ON|OFF`` (autotracking), ``SAT=<catalog number>``,
-``ANTAZ=<deg>``, ``ANTEL=<deg>`` on the station; ``FLIP``/``PARK`` on the rotor; the TCP session's and
-the console's own commands on the session or display the face passes.
+Every command is run through its entry's check and action in the command table
+(:mod:`nfwserver.commands`) and recorded here as one event: Nova's ``TUNE ON|OFF`` (the DDE output),
+``TRACK ON|OFF`` (autotracking), ``SAT=<catalog number>``, ``ANTAZ=<deg>``, ``ANTEL=<deg>`` and the radio's
+``DOPPLER ON|OFF`` on the station; ``FLIP``/``PARK`` on the rotor; the TCP session's and the console's own
+commands on the session or display the face passes.
 ``TRACK ON`` is an OrbitDRV enable call: "ignored if the station or satellite parameters have not
 been set".  It is then acknowledged (a client without error handling must not die on it) but does
 nothing, and the reason is logged, recorded in the event stream and returned in
@@ -20,13 +20,22 @@ nothing, and the reason is logged, recorded in the event stream and returned in
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable, Iterable, Mapping
+import threading
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from datetime import datetime
 
 from nfwserver.channels.channel import Channel
 from nfwserver.clock import Clock
-from nfwserver.commands.actions import NO_ROTOR, DisplayPort, RotorControl, SessionPort, Targets
+from nfwserver.commands.actions import (
+    NO_ROTOR,
+    AutotrackSwitch,
+    DisplayPort,
+    Refused,
+    RotorControl,
+    SessionPort,
+    Targets,
+)
 from nfwserver.commands.parsing import Parsed, Request, parse_request
 from nfwserver.commands.table import Face, Target, escape_for_log
 from nfwserver.core.events import Direction, EventLog
@@ -36,7 +45,7 @@ from nfwserver.core.status import INTERFACE_VERSION, StatusBit
 from nfwserver.core.tracker import TickListener, Tracker
 from nfwserver.health.board import HealthBoard
 from nfwserver.ratelimited_log import RateLimitedLog
-from nfwserver.tracking.catalog import Catalog, Satellite
+from nfwserver.tracking.catalog import Catalog
 from nfwserver.tracking.horizon import HorizonTable
 from nfwserver.tracking.observer import Observer
 
@@ -98,6 +107,12 @@ class StationCore:
         self._refusals = RateLimitedLog(log, clock, 60.0)
         #: whether the station drives a rotor itself (set by the station; None: not known, no warning)
         self.rotor_configured: bool | None = None
+        #: whether the station drives a radio itself (set by the station; None: not known, no warning)
+        self.radio_configured: bool | None = None
+        #: the station's autotrack, switched by AUTO ON/OFF and off by any accepted SAT= (set by the station)
+        self.autotrack: AutotrackSwitch | None = None
+        #: one choice of the satellite at a time: a client's SAT= (which switches autotrack off) or autotrack's
+        self._choosing = threading.Lock()
         #: the rotor's command port for FLIP and PARK (set by the station; None: no rotor)
         self.rotor: RotorControl | None = None
         if satellite is not None:
@@ -170,6 +185,41 @@ class StationCore:
             self._note(f"satellite {catalog_number} {sat.dde_name} selected", source)
         return True
 
+    def choose_satellite(self, catalog_number: int, source: str) -> str | None:
+        """A client's or the operator's accepted ``SAT=``: select ``catalog_number`` and switch autotrack off (the
+        person or program that chose wins); returns the sentence saying so when autotrack was on, else None."""
+        reason = f"SAT={catalog_number} from {escape_for_log(source, 60)} chose the satellite; AUTO ON resumes it"
+        with self._choosing:
+            switched = self.autotrack is not None and self.autotrack.on and self.autotrack.switch_off(reason)
+            self.select_satellite(catalog_number, source)
+        if not switched:
+            return None
+        self._note(f"autotrack off: {reason}", source)
+        return f"autotrack switched off: {reason}"
+
+    def select_scheduled(self, catalog_number: int) -> str | None:
+        """Autotrack's selection of its schedule's satellite: None when selected, else why not (autotrack was
+        switched off meanwhile -- a SAT= on its way wins --, or the satellite cannot be computed now)."""
+        with self._choosing:
+            if self.autotrack is None or not self.autotrack.on:
+                return "autotrack is off"
+            why = self.why_not_computable(catalog_number)
+            if why is None and not self.select_satellite(catalog_number, source="autotrack"):
+                why = "not in the catalog"
+            if why is None:
+                self.state.set_selected_by("autotrack")  # also when it was selected already (by the configuration)
+        return why
+
+    def set_autotrack(self, on: bool, source: str) -> None:
+        """AUTO ON/OFF (the station checked that it has an autotrack)."""
+        if self.autotrack is None:
+            return
+        with self._choosing:
+            changed = self.autotrack.switch_on() if on else self.autotrack.switch_off(
+                f"AUTO OFF from {escape_for_log(source, 60)}")
+        if changed:
+            self._note(f"AUTO {'ON' if on else 'OFF'}", source)
+
     @property
     def selected_by(self) -> str:
         """Who chose the selected satellite: "config", "saved-state", or the source of the command (read with
@@ -189,94 +239,64 @@ class StationCore:
         """Record where the antennas point (sky degrees; a rotor read-back, or ANTAZ/ANTEL)."""
         self.state.report_antenna(azimuth_deg, elevation_deg, source, self.clock.now())
 
-    def _satellite_for(self, value: int | str) -> tuple[Satellite | None, str | None]:
-        """The satellite ``SAT=value`` names (a catalog number, or a name matching one satellite only),
-        or None and why not."""
-        catalog = self.state.catalog
-        if isinstance(value, int):
-            sat = catalog.get(value)
-            return (sat, None) if sat is not None else (None, f"satellite {value} is not in the catalog")
-        found = catalog.named(value)
-        if len(found) == 1:
-            return found[0], None
-        shown = escape_for_log(value, 40)
-        if not found:
-            return None, f"no satellite is named '{shown}'"
-        numbers = ", ".join(str(s.catalog_number) for s in found[:5]) + (", ..." if len(found) > 5 else "")
-        return None, f"{len(found)} satellites are named '{shown}' ({numbers}); use the catalog number"
+    def satellites(self, value: int | str) -> list[tuple[int, str]]:
+        """Catalog number and DDE name of each satellite ``SAT=value`` names (a catalog number, or a name)."""
+        found = [self.state.catalog.get(value)] if isinstance(value, int) else self.state.catalog.named(value)
+        return [(sat.catalog_number, sat.dde_name) for sat in found if sat is not None]
 
-    def check(self, commands: Iterable[Parsed]) -> tuple[list[Parsed], str | None]:
-        """Validate station commands as a whole before any takes effect: each ``SAT=`` resolved to a catalog
-        number of a satellite that can be computed now; returns the resolved commands, or the refusal reason."""
-        resolved = []
-        for parsed in commands:
-            if parsed.command.word == "SAT":
-                value = parsed.value
-                sat, why = self._satellite_for(value if isinstance(value, (int, str)) else str(value))
-                if sat is None:
-                    return [], f"{why}; keeping the current one"
-                problem = self.tracker.why_not_computable(sat)
-                if problem is not None:
-                    return [], (f"satellite {sat.catalog_number} {sat.dde_name} cannot be computed now ({problem}); "
-                                "keeping the current one")
-                parsed = Parsed(parsed.command, sat.catalog_number)
-            resolved.append(parsed)
-        return resolved, None
+    def why_not_computable(self, catalog_number: int) -> str | None:
+        """Why the satellite ``catalog_number`` cannot be computed now (``SAT=``'s check), or None if it can."""
+        sat = self.state.catalog.get(catalog_number)
+        return "not in the catalog" if sat is None else self.tracker.why_not_computable(sat)
 
     def command(self, text: str, source: str = "console", conversation: int | None = None,
-                face: Face = Face.DDE, rate_key: str | None = None) -> CommandResult:
-        """Parse ``text`` as ``face`` sends it and run it (:meth:`execute`): for a caller that holds only text."""
-        return self.execute(parse_request(text, face), source, conversation=conversation, rate_key=rate_key)
+                face: Face = Face.DDE, rate_key: str | None = None, session: SessionPort | None = None,
+                display: DisplayPort | None = None) -> CommandResult:
+        """Parse ``text`` as ``face`` sends it, once, and run it (:meth:`execute`)."""
+        return self.execute(parse_request(text, face), source, conversation=conversation, rate_key=rate_key,
+                            session=session, display=display)
 
     def execute(self, request: Request, source: str = "console", conversation: int | None = None,
                 rate_key: str | None = None, session: SessionPort | None = None,
                 display: DisplayPort | None = None) -> CommandResult:
-        """Run a parsed request from ``source`` through its entries' actions (the command table's).
+        """Run a parsed request from ``source`` through its entries' checks and actions (the command table's),
+        and record it, whatever face it came from.
 
-        Station commands are atomic: all are checked (:meth:`check`) before the first takes effect, so a
-        refused poke changes nothing; each is an event, sets the bad function/subfunction bits when refused,
-        and a refusal is logged once a minute at most per ``rate_key`` (default: ``source``; a network face
-        passes the peer's address, so reconnecting does not start the count afresh).  The other commands act
-        on the rotor (:attr:`rotor`), the sender's ``session`` or the console's ``display``; their face
-        records them."""
+        All commands of a request are checked (their entries' check steps) before the first takes effect, so a
+        refused poke changes nothing.  Each request is one event (``poke`` for the station's and the rotor's commands,
+        ``request`` for a session's or the display's); a refused one is logged once a minute at most per
+        ``rate_key`` (default: ``source``; a network face passes the peer's address, so reconnecting does not
+        start the count afresh).  Nova's station commands also set the status word's bad function/subfunction
+        bits (cleared by the next accepted one).  Rotor commands act on :attr:`rotor` (refused without one),
+        session commands on the sender's ``session``, display commands on the console's ``display``."""
         targets = Targets(self, self.rotor, session, display)
-        if request.target is not Target.STATION:
-            return self._run_other(request, targets, source)
+        target = request.target
         reason = note = warning = None
         bits = 0
-        if request.error is not None:
-            reason = str(request.error)
-            bits = StatusBit.BAD_SUBFUNCTION if request.error.bad_argument else StatusBit.BAD_FUNCTION
-        else:
-            resolved, reason = self.check(request.commands)
-            if reason is not None:
-                bits = StatusBit.BAD_SUBFUNCTION
-            for parsed in resolved:
-                outcome = parsed.command.action(targets, parsed.value, source)
-                note = outcome.note or note
-                warning = outcome.warning or warning
-        self.tracker.note_command(int(bits))
-        accepted = reason is None
-        text = request.text
-        self.events.add(self.clock.now(), Direction.IN, "poke", text, conversation=conversation, client=source,
-                        accepted=accepted, detail=reason or note or warning or "")
-        if not accepted:
-            self._refusals.warning(f"refused:{rate_key or source}", "refused command %s from %s: %s",
-                                   escape_for_log(text), escape_for_log(source), reason)
-        if accepted and note is None and warning is not None:
-            return CommandResult(True, warning, self.tracker.status_word(), warning=True)
-        return CommandResult(accepted, reason or note, self.tracker.status_word())
-
-    def _run_other(self, request: Request, targets: Targets, source: str) -> CommandResult:
-        """A rotor, session or display command: refused without a rotor for a rotor command, or with the
-        parser's reason; else its action's outcome."""
         error = request.error
         if error is not None:
             no_rotor = error.command is not None and error.command.target is Target.ROTOR and self.rotor is None
-            return CommandResult(False, NO_ROTOR if no_rotor else str(error), self.tracker.status_word())
-        parsed = request.commands[0]
-        outcome = parsed.command.action(targets, parsed.value, source)
-        if outcome.refused is not None:
-            return CommandResult(False, outcome.refused, self.tracker.status_word())
-        return CommandResult(True, outcome.note or outcome.warning, self.tracker.status_word(),
-                             warning=outcome.note is None and outcome.warning is not None)
+            reason = NO_ROTOR if no_rotor else str(error)
+            bits = StatusBit.BAD_SUBFUNCTION if error.bad_argument else StatusBit.BAD_FUNCTION
+        else:
+            try:  # every entry's check step (SAT= by name: to a catalog number) before any action
+                resolved = [Parsed(p.command, p.command.check(self, p.value)) for p in request.commands]
+            except Refused as refusal:
+                reason, resolved, bits = str(refusal), [], StatusBit.BAD_SUBFUNCTION
+            for parsed in resolved:
+                outcome = parsed.command.action(targets, parsed.value, source)
+                reason = outcome.refused or reason
+                note = outcome.note or note
+                warning = outcome.warning or warning
+        if target is Target.STATION:
+            self.tracker.note_command(int(bits))
+        accepted = reason is None
+        kind = "poke" if target in (Target.STATION, Target.ROTOR) else "request"
+        self.events.add(self.clock.now(), Direction.IN, kind, request.text, conversation=conversation, client=source,
+                        accepted=accepted, detail=reason or note or warning or "")
+        if not accepted:
+            self._refusals.warning(f"refused:{rate_key or source}", "refused command %s from %s: %s",
+                                   escape_for_log(request.text), escape_for_log(source), reason)
+        if accepted and note is None and warning is not None:
+            return CommandResult(True, warning, self.tracker.status_word(), warning=True)
+        return CommandResult(accepted, reason or note, self.tracker.status_word())

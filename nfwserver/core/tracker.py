@@ -53,6 +53,16 @@ log = logging.getLogger(__name__)
 TickListener = Callable[[TickSample], None]
 
 
+def _nova_string(snap: StateSnapshot, angles: LookAngles | None) -> tuple[str, bool]:
+    """The Nova string for ``angles`` of the selected satellite in ``snap`` ("" while the feed is off or nothing
+    is computed) and whether the satellite is above the horizon table (Nova's ``AH``)."""
+    above = angles is not None and snap.horizon.is_above(angles.azimuth_deg, angles.elevation_deg)
+    if angles is None or snap.satellite is None or not snap.feed_on:
+        return "", above
+    return format_nova(snap.satellite.dde_name, angles.azimuth_deg, angles.elevation_deg, angles.range_rate_km_s,
+                       above), above
+
+
 class Tracker:
     """Computes ticks from ``state``; see the module docstring."""
 
@@ -114,17 +124,14 @@ class Tracker:
         or the old one's.  No tick: subscribers are not called, the status word and the sample stay the
         tick's; a satellite that cannot be computed gives "" (its tick reports why)."""
         snap = self.state.snapshot()
-        text = ""
+        angles = None
         calc = self._calculator_for(snap)
         if snap.feed_on and snap.satellite is not None and calc is not None:
             try:
                 angles = calc.compute(snap.satellite.satrec, self.clock.now())
             except (PropagationError, ArithmeticError, ValueError):
                 angles = None
-            if angles is not None:
-                above = snap.horizon.is_above(angles.azimuth_deg, angles.elevation_deg)
-                text = format_nova(snap.satellite.dde_name, angles.azimuth_deg, angles.elevation_deg,
-                                   angles.range_rate_km_s, above)
+        text, _ = _nova_string(snap, angles)
         with self._lock:
             if self._still_current(snap):  # else a newer command refreshes after us
                 self._text = text
@@ -219,10 +226,7 @@ class Tracker:
             self._error = error
         if not error and self.health is not None and not self.health.ok:
             self.health.succeeded()
-        above = angles is not None and snap.horizon.is_above(angles.azimuth_deg, angles.elevation_deg)
-        text = ""
-        if angles is not None and sat is not None and snap.feed_on:
-            text = format_nova(sat.dde_name, angles.azimuth_deg, angles.elevation_deg, angles.range_rate_km_s, above)
+        text, above = _nova_string(snap, angles)
         with self._lock:
             if self.state.generation == snap.generation:
                 self._computed_generation = snap.generation

@@ -24,7 +24,6 @@ import logging
 import threading
 from collections.abc import Callable, Iterable
 
-from nfwserver.commands.parsing import parse_request
 from nfwserver.commands.table import Face
 from nfwserver.core.events import Direction
 from nfwserver.core.sample import TickSample
@@ -144,7 +143,7 @@ class NovaDdeService:
         return data
 
     def _command(self, conv: ConversationId, text: str) -> PokeResult:
-        result = self.core.execute(parse_request(text, Face.DDE), source=self._label(conv), conversation=conv)
+        result = self.core.command(text, source=self._label(conv), conversation=conv, face=Face.DDE)
         return PokeResult.FACK if result.accepted else PokeResult.FNOTPROCESSED
 
     def on_poke(self, conv: ConversationId, topic: str, item: str, fmt: int, data: bytes) -> PokeResult:

@@ -4,36 +4,17 @@ Nova for Windows' TCP server (Setup/TCP) greets each client with ``Hello, this i
 Windows.`` and answers ``SUMMARY`` with the same string its DDE item carries.  We keep that and add
 a few commands; every reply line ends with CR LF (added by the server).
 
-=================  ==========================================================================
-line               reply
-=================  ==========================================================================
-``SUMMARY``        the current Nova string (:meth:`StationCore.current_text`); an empty line
-                   before ``TUNE ON``, after ``TUNE OFF`` and while nothing can be computed
-Nova's commands    ``TUNE ON|OFF``, ``TRACK ON|OFF``, ``SAT=n``, ``ANTAZ=deg``, ``ANTEL=deg``
-                   through :meth:`StationCore.command`: ``OK`` when the command was accepted and
-                   took effect, else ``ERROR <reason>``.  Decision: an accepted command that had
-                   no effect (``TRACK ON`` without a station or satellite, which OrbitDRV ignores)
-                   also answers ``ERROR <why it was ignored>``, because a script that asked for
-                   tracking needs to know it is not happening.  DDE clients still get an
-                   acknowledgement for it; only this protocol reports it.
-``STATUS``         one line of ``key=value`` pairs separated by single blanks (values never
-                   contain blanks; :mod:`nfwserver.tcp.status_line` writes and reads it):
-                   satellite, name, satellite_from (who chose it: config,
-                   saved-state, or the client that sent SAT=), tune, track, radio_tuning, status (the
-                   status word, hex), interface (version), az/el/rr/ah of the last tick when
-                   there is a position, then the fields of the ``extra`` callable (rotor and
-                   radio state, given by the station).
-``WATCH``          ``OK``, then every string the station publishes, one per line, until the client
-                   sends any line (an empty one too); a non-empty line is then handled as usual.
-``QUIT``           ``OK``, then the server closes the connection.
-``FLIP AUTO|ON|OFF`` FlipAnts' inverted tracking forced on (function 7F), off (7E) or chosen per
-                   pass; ``ERROR`` when the station has no rotor.
-``PARK``           ``TRACK OFF`` and the rotor to its park position; ``ERROR`` without a rotor.
-=================  ==========================================================================
+The commands and their replies are the command table's (docs/COMMANDS.md, generated from it).  Replies:
+``OK`` when a command was accepted and took effect, ``OK warning: ...`` when it took effect with a warning,
+else ``ERROR <reason>`` -- also for an accepted command that had no effect (``TRACK ON`` without a station or
+satellite, which OrbitDRV ignores: a script that asked for tracking needs to know it is not happening; DDE
+clients still get an acknowledgement).  ``STATUS`` is one line of ``key=value`` pairs
+(:mod:`nfwserver.tcp.status_line`), with the fields of the ``extra`` callable (rotor and radio) at the end.
 
 Keywords are accepted in any case with blanks around them.  A blank line outside ``WATCH`` (empty, or only
-blanks, tabs, VT, FF or the 0x1C-0x1F separators) gets no reply.  Every command is recorded in the event
-stream with the peer as ``client``.
+blanks, tabs, VT, FF or the 0x1C-0x1F separators) gets no reply.  Every line is handed to the station core
+(:meth:`StationCore.command`), which parses it through the command table, runs it and records it in the
+event stream with the peer as ``client``; this module only turns the outcome into reply lines.
 """
 
 from __future__ import annotations
@@ -44,9 +25,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 from nfwserver.commands.help_text import help_lines
-from nfwserver.commands.parsing import clean_command_text, parse_request
-from nfwserver.commands.table import Face, Target
-from nfwserver.core.events import Direction
+from nfwserver.commands.table import Face
 from nfwserver.core.nova_protocol import format_azimuth, format_elevation, format_range_rate
 from nfwserver.core.station_core import StationCore
 from nfwserver.ratelimited_log import RateLimitedLog
@@ -76,32 +55,25 @@ def _one_line(text: str) -> str:
 
 
 class _Session:
-    """The session commands' target for one line from ``peer``: each action leaves its reply here."""
+    """The session commands' target for one line: each action leaves its reply here (the core records them)."""
 
-    def __init__(self, protocol: NovaTcpProtocol, peer: str) -> None:
+    def __init__(self, protocol: NovaTcpProtocol) -> None:
         self.protocol = protocol
-        self.peer = peer
         self.reply: Reply | None = None
 
     def summary(self) -> None:
-        text = self.protocol.core.current_text()
-        self.protocol.record(self.peer, "SUMMARY", text)
-        self.reply = Reply((text,))
+        self.reply = Reply((self.protocol.core.current_text(),))
 
     def status(self) -> None:
-        self.protocol.record(self.peer, "STATUS")
         self.reply = Reply((self.protocol.status_line(),))
 
     def watch(self) -> None:
-        self.protocol.record(self.peer, "WATCH")
         self.reply = Reply(("OK",), Action.WATCH)
 
     def help(self) -> None:
-        self.protocol.record(self.peer, "HELP")
         self.reply = Reply(help_lines(Face.TCP) + ("OK",))
 
     def quit(self) -> None:
-        self.protocol.record(self.peer, "QUIT")
         self.reply = Reply(("OK",), Action.QUIT)
 
 
@@ -113,26 +85,15 @@ class NovaTcpProtocol:
         self.extra = extra
         self._extra_failures = RateLimitedLog(log, core.clock, 60.0)  #: a broken STATUS field: logged whole
 
-    def record(self, peer: str, text: str, detail: str = "") -> None:
-        """An event for a line that is not a station command (the core records those)."""
-        self.core.events.add(self.core.clock.now(), Direction.IN, "request", text, client=peer, accepted=True,
-                             detail=detail)
-
     def handle(self, line: str, peer: str, rate_key: str | None = None) -> Reply | None:
         """The reply to ``line`` (without its terminator) from ``peer``; None for a blank line.
 
-        The line is parsed once and run by the core through the command table; ``rate_key`` groups the
-        refusal log lines of one client across its connections (its address)."""
+        The core parses the line once, runs it through the command table and records it; ``rate_key`` groups
+        the refusal log lines of one client across its connections (its address)."""
         if not line.strip():  # blank, including lines of only VT, FF or the 0x1C-0x1F separators
             return None
-        request = parse_request(line, Face.TCP)
-        target = request.target
-        if target is Target.ROTOR or (target is Target.SESSION and request.error is not None):
-            no_rotor = target is Target.ROTOR and self.core.rotor is None
-            detail = str(request.error) if request.error is not None and not no_rotor else ""
-            self.record(peer, clean_command_text(line), detail)  # the session's actions record their own
-        session = _Session(self, peer)
-        result = self.core.execute(request, source=peer, rate_key=rate_key, session=session)
+        session = _Session(self)
+        result = self.core.command(line, source=peer, face=Face.TCP, rate_key=rate_key, session=session)
         if session.reply is not None:
             return session.reply
         if result.ok:

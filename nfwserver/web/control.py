@@ -5,7 +5,7 @@ A control request is a JSON object ``{"command": "TRACK ON", "token": "..."}`` p
 station's stream) when ``[web] control`` is off or its token is weak (checked before the body is read),
 when the token is missing or wrong (:func:`~nfwserver.config.tokens.token_matches`, constant time), or
 when the line is not one of the commands the table lets the web face send (:attr:`Face.WEB`: ``TUNE``,
-``TRACK``, ``SAT``, ``ANTAZ``/``ANTEL``, ``FLIP``, ``PARK``).  The line is parsed by the command table
+``TRACK``, ``SAT``, ``ANTAZ``/``ANTEL``, ``DOPPLER``, ``FLIP``, ``PARK``).  The line is parsed by the command table
 (:func:`~nfwserver.commands.parsing.parse_request`, once, which also bounds its length) and run through
 the table's actions by :meth:`~nfwserver.core.station_core.StationCore.execute`, as every face's commands
 are, with the browser's address as the source; the reply is the station's answer (a rotor command acts on
@@ -19,7 +19,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from nfwserver.commands.parsing import parse_request
-from nfwserver.commands.table import Command, Face, Target, commands_for, escape_for_log
+from nfwserver.commands.table import Face, commands_for, escape_for_log
 from nfwserver.config.schema import WebConfig
 from nfwserver.config.tokens import token_matches, weak_token_reason
 from nfwserver.core.events import Direction
@@ -40,12 +40,7 @@ class ControlReply:
 
 def help_entries() -> list[dict[str, str]]:
     """The commands the page may send, from the command table (usage and summary)."""
-    return [{"usage": c.usage, "summary": c.summary} for c in _page_commands()]
-
-
-def _page_commands() -> list[Command]:
-    """The commands the page may send: the station's and the rotor's, as the table gives them to the web."""
-    return list(commands_for(Face.WEB))
+    return [{"usage": c.usage, "summary": c.summary} for c in commands_for(Face.WEB)]
 
 
 def _open(config: WebConfig) -> bool:
@@ -109,10 +104,7 @@ class Control:
         parsed = parse_request(text, Face.WEB)
         error = parsed.error
         if error is not None and error.command is None and not error.bad_argument:
-            usages = ", ".join(c.short for c in _page_commands())
+            usages = ", ".join(c.short for c in commands_for(Face.WEB))
             return self.refuse(peer, 400, f"not a station command ({usages}): {error}", text)
-        result = self.core.execute(parsed, source=peer)  # station commands are recorded there, like any face's
-        if parsed.target is not Target.STATION:  # FLIP, PARK: the face records them, as TCP and the console do
-            self.core.events.add(self.core.clock.now(), Direction.IN, "poke", escape_for_log(text), client=peer,
-                                 accepted=result.accepted, detail="" if result.accepted else result.note or "")
+        result = self.core.execute(parsed, source=peer)  # run and recorded there, as every face's commands are
         return ControlReply(200 if result.accepted else 409, result.accepted, result.note or "OK")

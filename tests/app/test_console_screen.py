@@ -57,6 +57,7 @@ def test_80x24_notes_wrap_footer_shows_ctrl_d_and_every_pane_is_there() -> None:
 
 def test_ctrl_d_without_a_radio_explains_itself() -> None:
     station = make_station()
+    station.core.radio_configured = False  # as the station sets it from [radio]
 
     async def scenario() -> None:
         app = NfwConsole(station.core, config_file="/etc/nfw/station.toml")
@@ -66,7 +67,7 @@ def test_ctrl_d_without_a_radio_explains_itself() -> None:
             await pilot.pause()
             assert station.core.state.doppler_on
             note = " ".join(log_text(app, "incoming").split())
-            assert "no radio is configured, so nothing is tuned" in note
+            assert "no radio configured: nothing is tuned" in note
             assert 'backend = "rigctld"' in note and "/etc/nfw/station.toml" in note
             assert "tuning ON" in static_text(app, "state")
 

@@ -82,7 +82,8 @@ def test_a_choice_made_after_the_last_tick_is_saved_at_stop_and_restored(tmp_pat
             client.close()
     finally:
         station.stop()
-    assert json.loads(state.read_text()) == {"satellite": 7530, "configured": 25544}
+    saved = json.loads(state.read_text())
+    assert (saved["satellite"], saved["configured"], saved["autotrack"]) == (7530, 25544, False)
     again = Station(config, VirtualClock(ISS_PASS.aos), transport=FakeDdeSystem().server_transport())
     again.start()
     try:

@@ -40,8 +40,8 @@ def test_help_over_tcp_is_one_line_per_command_then_ok(tcp_station, client) -> N
     lines = [client.text() for _ in range(len(help_lines(Face.TCP)) + 1)]
     assert lines[-1] == "OK"
     words = [line.split()[0].split("=")[0] for line in lines[:-1]]
-    assert words == ["TUNE", "TRACK", "SAT", "ANTAZ", "ANTEL", "SUMMARY", "STATUS", "WATCH", "HELP", "QUIT",
-                     "FLIP", "PARK"]
+    assert words == ["TUNE", "TRACK", "SAT", "ANTAZ", "ANTEL", "DOPPLER", "AUTO", "SUMMARY", "STATUS", "WATCH",
+                     "HELP", "QUIT", "FLIP", "PARK"]
 
 
 def test_poke_help_lists_the_tcp_commands() -> None:
@@ -123,7 +123,7 @@ def test_the_line_that_ends_watch_is_not_executed(tcp_station, client) -> None:
 
 def test_an_unknown_line_lists_the_station_commands(tcp_station, client) -> None:
     assert client.ask("HELLO") == ("ERROR not a Nova command (TUNE ON|OFF, TRACK ON|OFF, SAT=n, ANTAZ=deg, "
-                                   "ANTEL=deg)")
+                                   "ANTEL=deg, DOPPLER ON|OFF, AUTO ON|OFF)")
 
 
 def test_a_line_client_reads_replies(tcp_station) -> None:

@@ -25,7 +25,8 @@ REPLIES = [
     ("SAT=99999", "ERROR satellite 99999 is not in the catalog; keeping the current one"),
     ("SAT=\u0662", "ERROR SAT needs a catalog number, got '\\u0662'"),
     ("TUNE", "ERROR TUNE needs ON or OFF"),
-    ("BOGUS", "ERROR not a Nova command (TUNE ON|OFF, TRACK ON|OFF, SAT=n, ANTAZ=deg, ANTEL=deg)"),
+    ("BOGUS", "ERROR not a Nova command (TUNE ON|OFF, TRACK ON|OFF, SAT=n, ANTAZ=deg, ANTEL=deg, "
+              "DOPPLER ON|OFF, AUTO ON|OFF)"),
     ("TRACK ON", "OK warning: TRACK ON with no rotor configured: nothing turns here ([rotor] backend); DDE "
                  "clients that drive their own rotor still follow the feed"),
     ("ANTAZ=721", "ERROR ANTAZ 721.0 is outside -360..720 degrees"),
@@ -69,36 +70,43 @@ def test_a_tcp_line_is_parsed_once(monkeypatch) -> None:
     assert tried and max(tried.values()) == 1, [key for key, n in tried.items() if n > 1]
 
 
-def test_the_console_sends_every_command_as_the_console_through_the_core(monkeypatch) -> None:
-    """Its TUNE key and its FLIP key go the way a typed command goes (6ca6bee sent TUNE as a DDE poke and set
-    the flip mode on the rotor behind the table's back)."""
+def test_the_console_keys_act_through_their_table_entries_without_text(monkeypatch) -> None:
+    """Ctrl+T, Ctrl+D, Ctrl+F, F4 and F2's picker hand the core their table entry and argument as the console's:
+    no grammar is tried (before, the keys built ``TUNE``/``FLIP``/``SAT=`` text to parse again, F4 and z toggled
+    the zone behind the ``Z`` entry, and Ctrl+D had no entry at all); every one is recorded by the core."""
     station = make_station()
     core = station.core
-    sent: list[tuple[str, Face]] = []
-    execute, command = core.execute if hasattr(core, "execute") else None, core.command
+    sent: list[tuple[str, object, Face]] = []
+    tried: list[str] = []
+    execute, match = core.execute, Command.match
 
     def record_execute(request: Request, *args, **kwargs):
-        sent.append((request.text, request.face))
+        sent.extend((p.command.word, p.value, request.face) for p in request.commands)
         return execute(request, *args, **kwargs)
 
-    def record_command(text: str, *args, face: Face = Face.DDE, **kwargs):
-        sent.append((text, face))
-        return command(text, *args, face=face, **kwargs)
+    def counting(self: Command, text: str):
+        tried.append(text)
+        return match(self, text)
 
-    monkeypatch.setattr(core, "execute", record_execute, raising=False)
-    monkeypatch.setattr(core, "command", record_command)
+    monkeypatch.setattr(core, "execute", record_execute)
+    monkeypatch.setattr(Command, "match", counting)
 
     async def scenario() -> None:
         app = NfwConsole(core)
         async with app.run_test(size=(120, 40)) as pilot:
             await settle(app, pilot, until=lambda: searched(app), what="the first pass search")
-            await pilot.press("ctrl+t")
-            await pilot.press("ctrl+f")
-            await pilot.press(*"TUNE OFF", "enter")
-            await settle(app, pilot, until=lambda: len(sent) >= 3)
+            for key in ("ctrl+t", "ctrl+d", "ctrl+f", "f4"):
+                await pilot.press(key)
+            app._picked(3597)
+            await settle(app, pilot, until=lambda: len(sent) >= 5)
 
     asyncio.run(scenario())
-    assert sent == [("TUNE ON", Face.CONSOLE), ("FLIP auto", Face.CONSOLE), ("TUNE OFF", Face.CONSOLE)]
+    assert sent == [("TUNE", True, Face.CONSOLE), ("DOPPLER", True, Face.CONSOLE), ("FLIP", "auto", Face.CONSOLE),
+                    ("Z", None, Face.CONSOLE), ("SAT", 3597, Face.CONSOLE)]
+    assert tried == []
+    assert core.state.feed_on and core.state.doppler_on and core.state.catalog_number == 3597
+    recorded = [(e.text, e.accepted) for e in core.events.recent() if e.client == "console" and e.kind != "note"]
+    assert recorded == [("TUNE ON", True), ("DOPPLER ON", True), ("FLIP AUTO", False), ("Z", True), ("SAT=3597", True)]
 
 
 def test_the_no_rotor_reason_is_written_once() -> None:

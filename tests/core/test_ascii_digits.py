@@ -13,8 +13,8 @@ import asyncio
 import pytest
 
 from nfwserver.cli.arguments import time_value
-from nfwserver.commands.parsing import parse_poke
-from nfwserver.commands.table import CommandError
+from nfwserver.commands.parsing import parse_request
+from nfwserver.commands.table import Face
 from nfwserver.console.app import NfwConsole
 from nfwserver.dialects.predict_listing import atol
 from nfwserver.fake_dde import DdeError
@@ -31,10 +31,9 @@ NOT_ASCII = ["²", "٣", "５", "१", "①", "٢٥٥٤٤", "2554٤"]
 @pytest.mark.parametrize("value", NOT_ASCII)
 @pytest.mark.parametrize("command", ["SAT", "ANTAZ", "ANTEL"])
 def test_the_grammar_refuses_digits_other_than_ascii(command: str, value: str) -> None:
-    with pytest.raises(CommandError) as refused:
-        parse_poke(f"{command}={value}")
-    assert refused.value.bad_argument
-    assert ("catalog number" if command == "SAT" else "number of degrees") in str(refused.value)
+    refused = parse_request(f"{command}={value}", Face.DDE).error
+    assert refused is not None and refused.bad_argument
+    assert ("catalog number" if command == "SAT" else "number of degrees") in str(refused)
 
 
 @pytest.mark.parametrize("value", ["²", "٢٥٥٤٤"])

@@ -8,8 +8,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from nfwserver.commands.parsing import parse_poke
-from nfwserver.commands.table import CommandError, Poke, PokeKind, escape_for_log
+from nfwserver.commands.parsing import Parsed, parse_request
+from nfwserver.commands.table import Face, escape_for_log
 from nfwserver.core.nova_protocol import (
     format_azimuth,
     format_elevation,
@@ -48,25 +48,32 @@ def test_every_string_matches_the_grammar(name, az, el, rr, ah) -> None:
     assert NOVA.match(format_nova(name, az, el, rr, ah))
 
 
+def _read(parsed: tuple[Parsed, ...]) -> list[tuple[str, object]]:
+    return [(p.command.word, p.value) for p in parsed]
+
+
 @pytest.mark.parametrize(
     ("text", "expected"),
     [
-        ("TUNE ON", [Poke(PokeKind.TUNE, True)]),
-        ("TUNE OFF\x00", [Poke(PokeKind.TUNE, False)]),
-        ("track on\r\n", [Poke(PokeKind.TRACK, True)]),
-        ("  TRACK   OFF  ", [Poke(PokeKind.TRACK, False)]),
-        ("SAT=25544", [Poke(PokeKind.SAT, 25544)]),
-        ("SAT = 7530\x00\x00", [Poke(PokeKind.SAT, 7530)]),
-        ("ANTAZ=123.45", [Poke(PokeKind.ANTAZ, 123.45)]),
-        ("ANTEL=-0", [Poke(PokeKind.ANTEL, 0.0)]),
-        ("TUNE ON\r\nSAT=25544\r\n", [Poke(PokeKind.TUNE, True), Poke(PokeKind.SAT, 25544)]),
+        ("TUNE ON", [("TUNE", True)]),
+        ("TUNE OFF\x00", [("TUNE", False)]),
+        ("track on\r\n", [("TRACK", True)]),
+        ("  TRACK   OFF  ", [("TRACK", False)]),
+        ("SAT=25544", [("SAT", 25544)]),
+        ("SAT = 7530\x00\x00", [("SAT", 7530)]),
+        ("ANTAZ=123.45", [("ANTAZ", 123.45)]),
+        ("ANTEL=-0", [("ANTEL", 0.0)]),
+        ("doppler on", [("DOPPLER", True)]),
+        ("TUNE ON\r\nSAT=25544\r\n", [("TUNE", True), ("SAT", 25544)]),
     ],
 )
-def test_pokes(text: str, expected: list[Poke]) -> None:
-    assert parse_poke(text) == expected
+def test_pokes(text: str, expected: list[tuple[str, object]]) -> None:
+    request = parse_request(text, Face.DDE)  # as Nova's DDE service reads a poke
+    assert request.error is None
+    assert _read(request.commands) == expected
 
 
-_NOT_NOVA = "not a Nova command (TUNE ON|OFF, TRACK ON|OFF, SAT=n, ANTAZ=deg, ANTEL=deg)"
+_NOT_NOVA = "not a Nova command (TUNE ON|OFF, TRACK ON|OFF, SAT=n, ANTAZ=deg, ANTEL=deg, DOPPLER ON|OFF, AUTO ON|OFF)"
 
 
 @pytest.mark.parametrize(("text", "reason"), [
@@ -83,18 +90,16 @@ _NOT_NOVA = "not a Nova command (TUNE ON|OFF, TRACK ON|OFF, SAT=n, ANTAZ=deg, AN
 ])
 def test_bad_pokes_are_refused_with_a_reason(text: str, reason: str) -> None:
     # The reason is what the console, the event log and a TCP client see: it names what was wrong.
-    with pytest.raises(CommandError) as info:
-        parse_poke(text)
-    assert str(info.value) == reason
+    request = parse_request(text, Face.DDE)
+    assert not request.commands
+    assert str(request.error) == reason
 
 
 @given(st.text(max_size=300))
-def test_any_text_either_parses_or_raises_poke_error(text: str) -> None:
-    try:
-        pokes = parse_poke(text)
-    except CommandError:
-        return
-    assert pokes and all(isinstance(p, Poke) for p in pokes)
+def test_any_text_either_parses_or_is_refused_with_a_reason(text: str) -> None:
+    request = parse_request(text, Face.DDE)
+    assert bool(request.commands) != (request.error is not None)
+    assert all(p.command.faces & Face.DDE for p in request.commands)
 
 
 def test_log_escaping_keeps_one_line() -> None:

@@ -75,9 +75,9 @@ def test_a_poke_on_a_dialect_link_is_reported_too(capsys) -> None:
 
 @pytest.mark.parametrize(("poke", "line"), [
     ("60:STATUS", "t+60 s  poke 'STATUS': refused: not a Nova command (TUNE ON|OFF, TRACK ON|OFF, SAT=n, "
-                  "ANTAZ=deg, ANTEL=deg); nothing changed"),
+                  "ANTAZ=deg, ANTEL=deg, DOPPLER ON|OFF, AUTO ON|OFF); nothing changed"),
     ("60:BOGUS COMMAND", "t+60 s  poke 'BOGUS COMMAND': refused: not a Nova command (TUNE ON|OFF, TRACK ON|OFF, "
-                         "SAT=n, ANTAZ=deg, ANTEL=deg); nothing changed"),
+                         "SAT=n, ANTAZ=deg, ANTEL=deg, DOPPLER ON|OFF, AUTO ON|OFF); nothing changed"),
     ("60:SAT=ISS", "t+60 s  poke 'SAT=ISS': refused: SAT needs a catalog number, got 'ISS'; nothing changed"),
     ("60:ANTEL=200", "t+60 s  poke 'ANTEL=200': refused: ANTEL 200.0 is outside -90..180 degrees; nothing changed"),
     ("60:TUNE", "t+60 s  poke 'TUNE': refused: TUNE needs ON or OFF; nothing changed"),
@@ -88,7 +88,7 @@ def test_a_poke_on_a_dialect_link_is_reported_too(capsys) -> None:
     ("60:SAT=694\nTUNE OFF", "t+60 s  poke 'SAT=694\\nTUNE OFF': accepted; feed off; satellite 25544 ISS -> "
                               "694 ATLAS-CENT-2"),
     ("60:SAT=7530\nBOGUS", "t+60 s  poke 'SAT=7530\\nBOGUS': refused: not a Nova command (TUNE ON|OFF, "
-                           "TRACK ON|OFF, SAT=n, ANTAZ=deg, ANTEL=deg); nothing changed"),
+                           "TRACK ON|OFF, SAT=n, ANTAZ=deg, ANTEL=deg, DOPPLER ON|OFF, AUTO ON|OFF); nothing changed"),
 ])
 def test_any_poke_goes_to_the_server_and_stderr_says_what_it_did(capsys, poke, line) -> None:
     """issue 34 item 6: simulate sends what a client sends, a command the server refuses too."""

@@ -10,6 +10,8 @@ from __future__ import annotations
 import re
 from datetime import datetime, timezone
 
+import pytest
+
 from nfwserver.cli import main
 from tests.conftest import DATA
 from tests.dde.conftest import ISS_PASS, OBSERVER
@@ -91,7 +93,7 @@ def test_link_watches_the_other_names_and_the_dialects(capsys) -> None:
     lines = capsys.readouterr().out.splitlines()
     assert lines and all(re.match(r"^\S+Z\tSNISS\S* AZ\d+\.\d EL\d+\.\d DN\d+ UP\d+", line) for line in lines)
     rows = _run(capsys, "--client", "delphi", "--link", "Orbitron|Tracking!TrackingDataEx", "--duration", "1")
-    assert rows[0] == (0.0, "poke", "TUNE ON (to the server)")  # the dialects take no pokes
+    assert rows[0] == (0.0, "poke", "TUNE ON (on NFW32|NFW_DATA!NFW_SERVER)")  # the dialects take no pokes
     assert any(kind == "reply" and text.startswith('SN"ISS') for _, kind, text in rows)
     rows = _run(capsys, "--client", "ndde", "--link", "WXtrack|Tracking!Tracking", "--duration", "1")
     assert any(kind == "reply" and text.startswith("SNISS") for _, kind, text in rows)
@@ -100,3 +102,21 @@ def test_link_watches_the_other_names_and_the_dialects(capsys) -> None:
     replies = [text for _, kind, text in rows if kind == "reply"]
     assert replies and all(re.match(r"^SNISS AZ\d+\.\d EL\d+\.\d UP\d+ UM\S* DN\d+ DM\S* MA\d+\.\d\\r\\n$", text)
                            for text in replies)
+
+
+@pytest.mark.parametrize("link", ["NFW32|NFW_DATA!NFW_SERVER", "Orbitron|Tracking!TrackingDataEx"])
+def test_every_poke_takes_the_path_of_a_dde_clients_poke(capsys, monkeypatch, link) -> None:
+    """The automatic TUNE ON and each --poke reach the station through Nova's DDE service, as a client's poke does,
+    on a dialect link too (before, there they went to the core's command method, behind the DDE service)."""
+    from nfwserver.dde.nova_service import NovaDdeService
+
+    poked: list[str] = []
+    on_poke = NovaDdeService.on_poke
+
+    def counting(self, conv, topic, item, fmt, data):
+        poked.append(data.rstrip(b"\x00").decode("ascii"))
+        return on_poke(self, conv, topic, item, fmt, data)
+
+    monkeypatch.setattr(NovaDdeService, "on_poke", counting)
+    _run(capsys, "--client", "delphi", "--link", link, "--duration", "2", "--poke", "1:SAT=694")
+    assert poked == ["TUNE ON", "SAT=694"]

@@ -115,8 +115,8 @@ def test_control_requests_are_checked_whole_before_the_core_sees_them() -> None:
         assert (status, body["message"]) == (409, "no rotor is configured")
         help_ = web.get("/api/help")
         assert [c["usage"] for c in help_["commands"]] == ["TUNE ON|OFF", "TRACK ON|OFF", "SAT=<catalog number>",
-                                                           "ANTAZ=<degrees>", "ANTEL=<degrees>",
-                                                           "FLIP AUTO|ON|OFF", "PARK"]
+                                                           "ANTAZ=<degrees>", "ANTEL=<degrees>", "DOPPLER ON|OFF",
+                                                           "AUTO ON|OFF", "FLIP AUTO|ON|OFF", "PARK"]
     finally:
         web.station.stop()
 
