@@ -49,6 +49,7 @@ class Connection:
         self.closing = False  # QUIT: close once the output is sent
         self.eof = False  # the client shut its side: answer what it sent, then close (unless watching)
         self.closed = False
+        self.announced = False  #: its connect is on record (log and event stream): from its first line on
 
 
 def peer_label(address: tuple[Any, ...]) -> str:

@@ -263,8 +263,6 @@ class NovaTcpServer(ServiceThread):
             self._clients.add(client)
             self._selector.register(sock, client.mask, client)
             self.stats.accepted += 1
-            log.info("TCP client %s connected", peer)
-            self.core.events.add(self.core.clock.now(), Direction.IN, "connect", "TCP", client=peer, accepted=True)
             self._queue(client, GREETING.encode("ascii") + CRLF)
             self._pump(client)
 
@@ -295,6 +293,11 @@ class NovaTcpServer(ServiceThread):
         while client.inbox and len(client.out) < COMMAND_HIGH_WATER and not client.closing:
             item = client.inbox.popleft()
             client.last_line = self.core.clock.monotonic()
+            if not client.announced:  # on record from its first line: an HTTP flood leaves no connect events
+                client.announced = True
+                log.info("TCP client %s connected", client.peer)
+                self.core.events.add(self.core.clock.now(), Direction.IN, "connect", "TCP", client=client.peer,
+                                     accepted=True)
             reply: Reply | None
             if client.watching:  # any line ends WATCH, and is not executed
                 client.watching = False
@@ -396,6 +399,9 @@ class NovaTcpServer(ServiceThread):
         client.sock.close()
         client.out.clear()
         client.inbox.clear()
+        if not client.announced:  # it never sent a line: only the counters (and refusals) keep it
+            log.debug("TCP client %s closed before its first line: %s", client.peer, reason)
+            return
         log.info("TCP client %s disconnected: %s", client.peer, reason)
         self.core.events.add(self.core.clock.now(), Direction.IN, "disconnect", reason, client=client.peer,
                              accepted=accepted)
