@@ -254,9 +254,9 @@ class NovaTcpServer(ServiceThread):
                 self._close(decision.victim, f"the quietest, closed to make room for {peer} under the connection "
                                              "caps")
             if decision.refusal is not None:
-                turn_away(sock, decision.line)
-                self.stats.refused += 1
+                self.stats.refused += 1  # counted and on record before the peer can see the close
                 self._peers.record(key, peer, f"refused: {decision.refusal}")
+                turn_away(sock, decision.line)
                 continue
             prepare_socket(sock, self.send_buffer_bytes)
             client = Connection(sock, peer, key, self.core.clock.monotonic(), self.stats.accepted)

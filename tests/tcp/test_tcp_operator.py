@@ -169,3 +169,41 @@ def test_the_operators_watch_survives_other_addresses_filling_the_cap() -> None:
         for c in crowd:
             c.close()
         server.stop()
+
+
+def test_the_operators_watch_holds_a_watch_and_outlasts_a_watch_crowd_from_its_own_address(served) -> None:
+    """``nfwserver watch`` holds a real WATCH between its questions (so no idle timeout closes it), and when a
+    crowd of idle WATCH subscribers from 127.0.0.1 fills the cap, ``status`` closes one of the crowd, not it."""
+    station, server, clients = served
+    assert server.address is not None
+    updates: list[WatchUpdate] = []
+    stop = threading.Event()
+    watcher = StationWatcher("127.0.0.1", server.address[1], updates.append, clock=station.clock,
+                             interval_s=1.0, stop=stop)
+    thread = threading.Thread(target=watcher.run, name="test-watch", daemon=True)
+    try:
+        thread.start()
+        assert wait_for(lambda: watcher.answers >= 1 and server.watcher_count() == 1)  # between two questions
+        crowd = [LineClient(server.address) for _ in range(LOOPBACK_ONLY.max_per_address - 1)]
+        clients += crowd
+        for c in crowd:
+            assert c.read_line() == GREETING and c.ask("WATCH") == "OK"
+        answers = watcher.answers
+
+        def polled_again() -> bool:  # the station's clock moves on until the watch has asked twice more
+            station.run(0.25)
+            return watcher.answers >= answers + 2
+
+        assert wait_for(polled_again)
+        for k in range(3):
+            assert _status(server).startswith("satellite="), k
+            assert _closed(crowd[k])
+            crowd.append(LineClient(server.address))  # the crowd fills the room again
+            clients.append(crowd[-1])
+            assert crowd[-1].read_line() == GREETING and crowd[-1].ask("WATCH") == "OK"
+        assert wait_for(polled_again)
+        assert [u for u in updates if not u.connected] == [] and server.stats.evicted == 3
+    finally:
+        stop.set()
+        station.clock.advance(10.0)
+        thread.join(5.0)
