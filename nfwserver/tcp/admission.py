@@ -9,15 +9,17 @@ address or by a crowd from the operator's own:
   reserve`` connections, a newcomer from another address displaces one of theirs (or is refused).  A
   connection from an own address is never closed to make room for another address, so the operator's
   ``nfwserver watch`` survives any crowd of other addresses.
-- **Over a cap, the quietest connection goes**: the one whose last command (or connect) is oldest
-  (:attr:`~nfwserver.tcp.connection.Connection.last_active`), among the newcomer's own connections when the
-  per-address cap is reached, else among other addresses' connections (an own-address newcomer at the global
-  cap takes another address's connection first, then its own quietest).  A blank line, a partial line, an
-  over-long line or the line that ends a ``WATCH`` is not a command; a ``WATCH`` counts when it is sent, not
-  while it streams.  So neither a crowd sending a blank line every half second nor a crowd of idle ``WATCH``
-  subscribers locks out ``nfwserver status``; and ``nfwserver watch``, which asks ``STATUS`` every
-  ``--interval`` (1 s), is the last of its address to be chosen.  A crowd that keeps sending real commands
-  still loses its quietest member to each newcomer: a newcomer is always served.
+- **Over a cap, the quietest connection goes**: one that never sent a command, else the one whose last
+  command is oldest (:attr:`~nfwserver.tcp.connection.Connection.last_active`); among the newcomer's own
+  connections when the per-address cap is reached, else among other addresses' connections (an own-address
+  newcomer at the global cap takes another address's connection first, then its own quietest).  A blank line,
+  a partial line, an over-long line or the line that ends a ``WATCH`` is not a command; a ``WATCH`` counts when
+  it is sent, not while it streams.  So neither a crowd sending a blank line every half second nor a crowd of
+  idle ``WATCH`` subscribers locks out ``nfwserver status``; and ``nfwserver watch``, which asks ``STATUS``
+  every ``--interval`` (1 s) and holds a ``WATCH`` between, is the last of its address to be chosen: a burst
+  of new connections that have sent nothing goes first, then the ``WATCH`` subscribers quiet for longest.  A
+  crowd that keeps sending real commands still loses its quietest member to each newcomer: a newcomer is
+  always served.
 - A newcomer is refused (one ``ERROR`` line, see :func:`admit`) only when there is nobody it may displace:
   another address when own addresses hold every slot.  A peer outside ``[tcp] allow`` is closed without a word.
 """
@@ -61,8 +63,11 @@ def reserve_for(max_clients: int) -> int:
 
 
 def _quietest(clients: Iterable[Connection]) -> Connection | None:
-    """The open connection whose last command (or connect) is oldest; None when there is none."""
-    return min((c for c in clients if not c.closed), key=lambda c: (c.last_active, c.order), default=None)
+    """The open connection that has done least for longest; None when there is none: one that never sent a
+    command before any that did, then the one whose last command (or connect) is oldest, then the one that came
+    later (of two equally quiet, the established one stays)."""
+    return min((c for c in clients if not c.closed), key=lambda c: (c.commands > 0, c.last_active, -c.order),
+               default=None)
 
 
 def admit(config: TcpConfig, clients: Collection[Connection], max_clients: int, own: frozenset[str],

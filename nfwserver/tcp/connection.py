@@ -3,17 +3,22 @@
 from __future__ import annotations
 
 import errno
+import logging
 import os
 import selectors
 import socket
 from collections import deque
 from dataclasses import dataclass
+from datetime import datetime
 from typing import Any
 
+from nfwserver.core.events import Direction, EventLog
 from nfwserver.health.link_health import LinkHealth
 from nfwserver.tcp.line_splitter import MAX_LINE_BYTES, LineSplitter
 
 __all__ = ["Connection", "ListenerRest", "TcpStats", "peer_label", "prepare_socket"]
+
+log = logging.getLogger("nfwserver.tcp.server")  #: the server's log: one name for everything the TCP face writes
 
 
 @dataclass
@@ -28,6 +33,10 @@ class TcpStats:
     delivered: int = 0  #: published strings handed to the watchers
     max_buffered: int = 0  #: the most bytes ever waiting for one client
 
+    def status_fields(self) -> dict[str, object]:
+        """The counts STATUS shows: peers refused, closed for speaking HTTP, closed to make room."""
+        return {"tcp_refused": self.refused, "tcp_http_closed": self.http_closed, "tcp_evicted": self.evicted}
+
 
 class Connection:
     """One connection; owned by the ``nfw-tcp`` thread."""
@@ -40,6 +49,7 @@ class Connection:
         #: clock monotonic seconds of the last command it sent (or of the connect): a blank line, a partial or
         #: over-long line, or a line ending a WATCH is not one; a WATCH is one when it is sent, not while it lasts
         self.last_active = now
+        self.commands = 0  #: commands it has sent (lines answered; blank, over-long and WATCH-ending ones are not)
         self.order = order  #: the server's count of accepted connections when this one came (breaks ties)
         self.splitter = LineSplitter(MAX_LINE_BYTES)
         self.inbox: deque[bytes | None] = deque()  # received lines not handled yet (one read's worth)
@@ -50,6 +60,13 @@ class Connection:
         self.eof = False  # the client shut its side: answer what it sent, then close (unless watching)
         self.closed = False
         self.announced = False  #: its connect is on record (log and event stream): from its first line on
+
+
+    def announce(self, events: EventLog, now: datetime) -> None:
+        """Put its connect on record (log and event stream): done at its first line."""
+        self.announced = True
+        log.info("TCP client %s connected", self.peer)
+        events.add(now, Direction.IN, "connect", "TCP", client=self.peer, accepted=True)
 
 
 def peer_label(address: tuple[Any, ...]) -> str:

@@ -15,8 +15,9 @@ send, or ``Sec-*``), at any point of a connection: no Nova command has either fo
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
 
-__all__ = ["http_line"]
+__all__ = ["http_in", "http_line"]
 
 #: ``METHOD request-target HTTP/x.y`` (RFC 9112 section 3): a token, one target, the version.
 _REQUEST_LINE = re.compile(rb"[!#$%&'*+.^_`|~0-9A-Za-z-]+[ \t]+\S+[ \t]+HTTP/\d(\.\d)?[ \t]*", re.IGNORECASE)
@@ -44,3 +45,9 @@ def http_line(line: bytes) -> str | None:
         if name in _REQUEST_HEADERS or name.startswith(b"sec-"):
             return "an HTTP header line"
     return None
+
+
+def http_in(lines: Iterable[bytes | None]) -> str | None:
+    """What the first HTTP line among ``lines`` is (see :func:`http_line`; None stands for an over-long line,
+    which is not looked at); None when there is none."""
+    return next((kind for line in lines if line is not None and (kind := http_line(line)) is not None), None)

@@ -51,7 +51,7 @@ from nfwserver.listen_socket import stream_listener
 from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.tcp.admission import admit, own_addresses, turn_away
 from nfwserver.tcp.connection import Connection, ListenerRest, TcpStats, peer_label, prepare_socket
-from nfwserver.tcp.http_guard import http_line
+from nfwserver.tcp.http_guard import http_in
 from nfwserver.tcp.line_splitter import MAX_LINE_BYTES
 from nfwserver.tcp.protocol import GREETING, Action, NovaTcpProtocol, Reply, StatusFields
 from nfwserver.tcp.refusals import PeerRefusals
@@ -112,10 +112,7 @@ class NovaTcpServer(ServiceThread):
 
     def _status_fields(self) -> dict[str, object]:
         """STATUS's fields beyond the core's: ``extra``'s, then this server's refusal counts."""
-        fields = dict(self.extra()) if self.extra is not None else {}
-        fields.update(tcp_refused=self.stats.refused, tcp_http_closed=self.stats.http_closed,
-                      tcp_evicted=self.stats.evicted)
-        return fields
+        return {**(self.extra() if self.extra is not None else {}), **self.stats.status_fields()}
 
     def wake(self) -> None:
         """Let the loop look at the clock now (idle connections, the accept back-off): for a clock that
@@ -279,8 +276,8 @@ class NovaTcpServer(ServiceThread):
                 client.eof = True
             elif data:
                 lines = client.splitter.feed(data)
-                kind = next((k for line in lines if line is not None and (k := http_line(line)) is not None), None)
-                if kind is not None:  # a web page's request: nothing of it runs, not even the lines before
+                if (kind := http_in(lines)) is not None:  # a web page's request: nothing of it runs, not even the
+                    # lines before it in this read
                     self.stats.http_closed += 1
                     self._peers.record(client.address, client.peer, f"closed: it sent {kind} (a web page's "
                                        "request?); Nova's TCP port does not speak HTTP")
@@ -294,10 +291,7 @@ class NovaTcpServer(ServiceThread):
             item = client.inbox.popleft()
             client.last_line = self.core.clock.monotonic()
             if not client.announced:  # on record from its first line: an HTTP flood leaves no connect events
-                client.announced = True
-                log.info("TCP client %s connected", client.peer)
-                self.core.events.add(self.core.clock.now(), Direction.IN, "connect", "TCP", client=client.peer,
-                                     accepted=True)
+                client.announce(self.core.events, self.core.clock.now())
             reply: Reply | None
             if client.watching:  # any line ends WATCH, and is not executed
                 client.watching = False
@@ -311,6 +305,7 @@ class NovaTcpServer(ServiceThread):
                                                  rate_key=f"tcp {client.address}")
                     if reply is not None:  # a command (a blank line gets no reply): the client is doing something
                         client.last_active = client.last_line
+                        client.commands += 1
                 except Exception:
                     self._refusals.log(logging.ERROR, f"failed:{client.address}", "TCP command from %s failed",
                                        client.peer, exc_info=True)

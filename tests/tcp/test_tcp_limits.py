@@ -63,10 +63,11 @@ def test_one_address_cannot_lock_the_others_out(limited) -> None:
     assert mine[0].read_line() == b""  # the quietest of 127.0.0.1's made room
     others = [connect("127.0.0.2"), connect("127.0.0.3")]
     assert all(c.read_line() == GREETING for c in others)
+    assert others[0].ask("STATUS").startswith("satellite=")
     late = connect("127.0.0.4")
     assert late.read_line() == GREETING
-    assert others[0].read_line() == b""  # another address's quietest, not one of 127.0.0.1's
-    for c in (mine[1], mine[2], fourth, others[1], late):
+    assert others[1].read_line() == b""  # another address's quietest (no command yet), not one of 127.0.0.1's
+    for c in (mine[1], mine[2], fourth, others[0], late):
         assert c.ask("STATUS").startswith("satellite=")
     assert server.stats.evicted == 2 and server.stats.refused == 0
 
