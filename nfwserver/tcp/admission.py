@@ -9,15 +9,17 @@ address or by a crowd from the operator's own:
   reserve`` connections, a newcomer from another address displaces one of theirs (or is refused).  A
   connection from an own address is never closed to make room for another address, so the operator's
   ``nfwserver watch`` survives any crowd of other addresses.
-- **Over a cap, the quietest connection goes**: one that never sent a command, else the one whose last
-  command is oldest (:attr:`~nfwserver.tcp.connection.Connection.last_active`); among the newcomer's own
+- **Over a cap, the quietest connection goes**: the one that has done least lately -- its commands, each
+  weighing half as much every minute (:meth:`~nfwserver.tcp.connection.Connection.activity`; none for one that
+  never sent a command) -- and of equals the one quiet longest; among the newcomer's own
   connections when the per-address cap is reached, else among other addresses' connections (an own-address
   newcomer at the global cap takes another address's connection first, then its own quietest).  A blank line,
   a partial line, an over-long line or the line that ends a ``WATCH`` is not a command; a ``WATCH`` counts when
   it is sent, not while it streams.  So neither a crowd sending a blank line every half second nor a crowd of
   idle ``WATCH`` subscribers locks out ``nfwserver status``; and ``nfwserver watch``, which asks ``STATUS``
   every ``--interval`` (1 s) and holds a ``WATCH`` between, is the last of its address to be chosen: a burst
-  of new connections that have sent nothing goes first, then the ``WATCH`` subscribers quiet for longest.  A
+  of new connections that have sent nothing goes first, then ``WATCH`` subscribers that sent one command,
+  the oldest first, while the watch's three commands a cycle keep its weight far above theirs.  A
   crowd that keeps sending real commands still loses its quietest member to each newcomer: a newcomer is
   always served.
 - A newcomer is refused (one ``ERROR`` line, see :func:`admit`) only when there is nobody it may displace:
@@ -62,24 +64,25 @@ def reserve_for(max_clients: int) -> int:
     return min(OWN_RESERVE, max_clients // 2)
 
 
-def _quietest(clients: Iterable[Connection]) -> Connection | None:
-    """The open connection that has done least for longest; None when there is none: one that never sent a
-    command before any that did, then the one whose last command (or connect) is oldest, then the one that came
-    later (of two equally quiet, the established one stays)."""
-    return min((c for c in clients if not c.closed), key=lambda c: (c.commands > 0, c.last_active, -c.order),
+def _quietest(clients: Iterable[Connection], now: float) -> Connection | None:
+    """The open connection that has done least for longest; None when there is none: the least
+    :meth:`~nfwserver.tcp.connection.Connection.activity` (0 for one that never sent a command), then the oldest
+    last command (or connect), then the one that came later (of two equally quiet, the established one stays)."""
+    return min((c for c in clients if not c.closed), key=lambda c: (c.activity(now), c.last_active, -c.order),
                default=None)
 
 
 def admit(config: TcpConfig, clients: Collection[Connection], max_clients: int, own: frozenset[str],
-          address: str) -> Admission:
+          address: str, now: float) -> Admission:
     """Serve or refuse a new connection from ``address`` (an IP address string) while ``clients`` are
-    connected, under ``[tcp] allow``/``max_per_address`` and ``max_clients`` (see the module docstring)."""
+    connected, at ``now`` (clock monotonic seconds), under ``[tcp] allow``/``max_per_address`` and
+    ``max_clients`` (see the module docstring)."""
     key = TcpConfig.peer_key(address)
     if not config.allows(address):
         return Admission(refusal="not in [tcp] allow")
     same = [c for c in clients if c.address == key]
     if len(same) >= config.max_per_address:
-        victim = _quietest(same)
+        victim = _quietest(same, now)
         if victim is not None:
             return Admission(victim)
         return Admission(refusal=f"already {len(same)} connections from {key}",
@@ -87,10 +90,10 @@ def admit(config: TcpConfig, clients: Collection[Connection], max_clients: int, 
     others = [c for c in clients if c.address not in own]
     if key in own:
         full = len(clients) >= max_clients
-        victim = (_quietest(others) or _quietest(clients)) if full else None
+        victim = (_quietest(others, now) or _quietest(clients, now)) if full else None
     else:
         full = len(clients) >= max_clients or len(others) >= max_clients - reserve_for(max_clients)
-        victim = _quietest(others) if full else None
+        victim = _quietest(others, now) if full else None
     if full and victim is None:
         return Admission(refusal=f"already {len(clients)} clients",
                          line=f"ERROR the station serves {max_clients} connections at most; try again later")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import errno
 import logging
+import math
 import os
 import selectors
 import socket
@@ -18,6 +19,7 @@ from nfwserver.tcp.line_splitter import MAX_LINE_BYTES, LineSplitter
 
 __all__ = ["Connection", "ListenerRest", "TcpStats", "peer_label", "prepare_socket"]
 
+ACTIVITY_HALF_LIFE_S = 60.0  #: clock seconds in which a command's weight in Connection.activity halves
 log = logging.getLogger("nfwserver.tcp.server")  #: the server's log: one name for everything the TCP face writes
 
 
@@ -49,7 +51,7 @@ class Connection:
         #: clock monotonic seconds of the last command it sent (or of the connect): a blank line, a partial or
         #: over-long line, or a line ending a WATCH is not one; a WATCH is one when it is sent, not while it lasts
         self.last_active = now
-        self.commands = 0  #: commands it has sent (lines answered; blank, over-long and WATCH-ending ones are not)
+        self._activity = 0.0  #: commands sent, each weighing less as it ages (half-life ACTIVITY_HALF_LIFE_S)
         self.order = order  #: the server's count of accepted connections when this one came (breaks ties)
         self.splitter = LineSplitter(MAX_LINE_BYTES)
         self.inbox: deque[bytes | None] = deque()  # received lines not handled yet (one read's worth)
@@ -61,6 +63,16 @@ class Connection:
         self.closed = False
         self.announced = False  #: its connect is on record (log and event stream): from its first line on
 
+
+    def commanded(self, now: float) -> None:
+        """It sent a command (a line answered; blank, over-long and WATCH-ending lines are not) at ``now``."""
+        self._activity = self.activity(now) + 1.0
+        self.last_active = now
+
+    def activity(self, now: float) -> float:
+        """How much it has done lately: its commands, each counting 1 when sent and half as much every
+        :data:`ACTIVITY_HALF_LIFE_S` clock seconds after; 0 for one that never sent a command."""
+        return self._activity * math.pow(0.5, max(0.0, now - self.last_active) / ACTIVITY_HALF_LIFE_S)
 
     def announce(self, events: EventLog, now: datetime) -> None:
         """Put its connect on record (log and event stream): done at its first line."""

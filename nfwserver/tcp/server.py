@@ -245,7 +245,8 @@ class NovaTcpServer(ServiceThread):
             self._rest.health.succeeded()
             peer = peer_label(address)
             key = TcpConfig.peer_key(address[0])
-            decision = admit(self.config, self._clients, self.max_clients, self._own, address[0])
+            decision = admit(self.config, self._clients, self.max_clients, self._own, address[0],
+                             self.core.clock.monotonic())
             if decision.victim is not None:  # over a cap: the quietest connection makes room (tcp.admission)
                 self.stats.evicted += 1
                 self._close(decision.victim, f"the quietest, closed to make room for {peer} under the connection "
@@ -304,8 +305,7 @@ class NovaTcpServer(ServiceThread):
                     reply = self.protocol.handle(item.decode("ascii", errors="replace"), client.peer,
                                                  rate_key=f"tcp {client.address}")
                     if reply is not None:  # a command (a blank line gets no reply): the client is doing something
-                        client.last_active = client.last_line
-                        client.commands += 1
+                        client.commanded(client.last_line)
                 except Exception:
                     self._refusals.log(logging.ERROR, f"failed:{client.address}", "TCP command from %s failed",
                                        client.peer, exc_info=True)

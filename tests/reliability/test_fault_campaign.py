@@ -59,7 +59,7 @@ def test_slow_loris_evicts_idle_connections_and_serves_local_tools(monkeypatch) 
     assert counts.local_served >= 8 and counts.evicted == 9, counts  # 10 s, a check a second
     # The check can fail: with no connection ever chosen to make room, 127.0.0.1 is locked out, and those
     # ticks are counted as not working while STATUS names no fault.
-    monkeypatch.setattr("nfwserver.tcp.admission._quietest", lambda clients: None)
+    monkeypatch.setattr("nfwserver.tcp.admission._quietest", lambda clients, now: None)
     with FaultRig() as rig:
         locked = run_fault(rig, loris)
     assert not locked.passed and locked.unexplained > 0, locked

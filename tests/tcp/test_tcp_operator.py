@@ -187,11 +187,14 @@ def test_the_operators_watch_holds_a_watch_and_outlasts_a_watch_crowd_from_its_o
     try:
         thread.start()
         assert wait_for(lambda: watcher.answers >= 1 and server.watcher_count() == 1)  # between two questions
-        crowd = [LineClient(server.address) for _ in range(LOOPBACK_ONLY.max_per_address - 1)]
-        clients += crowd
-        for c in crowd:
-            assert c.read_line() == GREETING and c.ask("WATCH") == "OK"
+        crowd: list[LineClient] = []
+        for _ in range(LOOPBACK_ONLY.max_per_address):  # one too many: with the watch, over the cap
+            crowd.append(LineClient(server.address))
+            clients.append(crowd[-1])
+            assert crowd[-1].read_line() == GREETING and crowd[-1].ask("WATCH") == "OK"
             station.run(0.2)  # each subscribed a little later than the one before
+        assert _closed(crowd[0]) and server.stats.evicted == 1  # the last one took the first one's place
+        crowd.pop(0)
         answers = watcher.answers
 
         def polled_again() -> bool:  # the station's clock moves on until the watch has asked twice more
@@ -206,7 +209,7 @@ def test_the_operators_watch_holds_a_watch_and_outlasts_a_watch_crowd_from_its_o
             clients.append(crowd[-1])
             assert crowd[-1].read_line() == GREETING and crowd[-1].ask("WATCH") == "OK"
         assert wait_for(polled_again)
-        assert [u for u in updates if not u.connected] == [] and server.stats.evicted == 3
+        assert [u for u in updates if not u.connected] == [] and server.stats.evicted == 4
     finally:
         stop.set()
         station.clock.advance(10.0)
