@@ -200,6 +200,11 @@ def run_lockout(tally: Tally, rounds: int, workdir: Path) -> None:
         watcher = StationWatcher("127.0.0.1", port, updates.append, clock=SystemClock(), interval_s=1.0, stop=stop)
         thread = threading.Thread(target=watcher.run, name="campaign-operator-watch", daemon=True)
         thread.start()
+        for _ in range(100):  # the operator's watch is running before the crowds come (at most 10 s)
+            if watcher.answers:
+                break
+            time.sleep(0.1)
+        watched = [e.client for e in station.core.events.recent() if e.kind == "connect"]
         scenarios = {"32 from 127.0.0.1, a blank line every 0.5 s": [("127.0.0.1", False)],
                      "32 WATCH from 127.0.0.1": [("127.0.0.1", True)],
                      "32 from each of 127.0.0.2-9 (the global cap), blank lines": [(a, False) for a in ADDRESSES]}
@@ -231,5 +236,8 @@ def run_lockout(tally: Tally, rounds: int, workdir: Path) -> None:
             thread.join(5.0)
         lost = [u for u in updates if not u.connected]
         if lost:
-            tally.loss(f"`nfwserver watch` lost its connection {len(lost)} times: {lost[0].problem}", len(lost))
+            why = [e.text for e in station.core.events.recent() if e.kind == "disconnect"
+                   and e.time <= lost[0].time and e.client == watched[0]][-1:] if watched else []
+            tally.loss(f"`nfwserver watch` lost its connection {len(lost)} times: {lost[0].problem} {why}",
+                       len(lost))
         tally.extra["`nfwserver watch` updates, disconnected"] = f"{watcher.answers}, {len(lost)}"
