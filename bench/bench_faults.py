@@ -55,8 +55,8 @@ def main(argv: list[str]) -> int:
           f"virtual time; {time.monotonic() - started:.0f} s of real time.\n")
     print(table(results))
     if loris is not None:
-        print(f"\nSlow-loris, from 127.0.0.1: {loris.refused} connections refused with an ERROR line at the burst "
-              f"(none idle 1 s yet), {loris.evicted} idle one(s) closed to make room, {loris.local_served} checks "
+        print(f"\nSlow-loris, from 127.0.0.1: {loris.refused} connections refused with an ERROR line, "
+              f"{loris.evicted} quietest one(s) closed to make room, {loris.local_served} checks "
               "from 127.0.0.1 (as `nfwserver status` connects) answered.")
     return 0 if all(r.passed for r in results) else 1
 

@@ -20,7 +20,7 @@ from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
-from bench.campaign import fault_families, input_families, realtime, write_kills
+from bench.campaign import fault_families, input_families, realtime, tcp_attacks, write_kills
 from bench.campaign.station_rig import StationRig, hamlib_available
 from bench.campaign.tally import Budget, Tally, run_family
 
@@ -56,6 +56,10 @@ def run_campaign(budget: Budget, workdir: Path, progress: Callable[[str], None] 
                lambda t: input_families.run_predict_datagrams(t, rig, budget.datagrams, seed))
         family("rotctld/rigctld killed and restarted",
                lambda t: fault_families.run_daemon_kills(t, rig, budget.daemon_kills))
+    family("TCP: web pages' requests (cross-protocol), 8 addresses",
+           lambda t: tcp_attacks.run_cross_protocol(t, budget.http_requests, seed, workdir))
+    family("TCP: the operator's status and watch under crowds",
+           lambda t: tcp_attacks.run_lockout(t, budget.lockout_rounds, workdir))
     files = Tally("station files after the run (store, state)", tried=2)
     rig.files_whole(files)
     tallies.append(files)
@@ -99,7 +103,8 @@ def main(argv: list[str] | None = None) -> int:
     budget = Budget(seed=args.seed)
     if args.quick:
         budget = replace(budget, elements=500, updates=30, configs=500, pokes=500, datagrams=500,
-                         hamlib_replies=120, daemon_kills=2, write_kills=2, realtime_s=30.0)
+                         hamlib_replies=120, daemon_kills=2, write_kills=2, realtime_s=30.0, http_requests=300,
+                         lockout_rounds=6)
     if args.minutes is not None:
         budget = replace(budget, realtime_s=args.minutes * 60.0)
     started = time.monotonic()

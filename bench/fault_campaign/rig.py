@@ -94,8 +94,8 @@ class LorisCounts:
     since: float | None  #: clock monotonic seconds the connections were opened; None once they are closed
     evicted_before: int
     refused_before: int
-    evicted: int = 0  #: idle connections the server closed to make room
-    refused: int = 0  #: connections refused with an ERROR line (over the cap, none idle long enough)
+    evicted: int = 0  #: connections the server closed to make room (the quietest)
+    refused: int = 0  #: connections refused with an ERROR line (over a cap, nobody to displace)
     local_served: int = 0  #: STATUS answered to a new client from 127.0.0.1
 
 

@@ -19,7 +19,6 @@ from dataclasses import dataclass
 
 from bench.fault_campaign.rig import ELEMENTS, ISS, ROOT, FaultRig, LorisCounts, TickRecord
 from nfwserver.config.loader import parse_config
-from nfwserver.tcp.connection import EVICT_AFTER_S
 from nfwserver.tracking.elements import load_element_file, load_elements
 from nfwserver.tracking.tle import tle_checksum
 
@@ -197,9 +196,9 @@ def _nothing(rig: FaultRig) -> None:
 
 def _slow_loris(rig: FaultRig) -> None:
     """Forty connections from 127.0.0.1, the address every local tool shares on the loopback default, opened
-    at one instant, a byte each and never a line: over the per-address cap (32), and none of the first 32 has
-    been idle :data:`~nfwserver.tcp.connection.EVICT_AFTER_S` yet, so the last 8 get one ``ERROR`` line each.
-    From then on a new connection from 127.0.0.1 closes the one idle longest (:func:`tcp_served` makes one)."""
+    at one instant, a byte each and never a line: over the per-address cap (32), so each of the last 8 closes
+    the quietest before it (:mod:`nfwserver.tcp.admission`).  From then on a new connection from 127.0.0.1
+    closes the quietest one again (:func:`tcp_served` makes one)."""
     tcp = rig.station.tcp
     assert tcp is not None
     rig.loris = LorisCounts(since=rig.clock.monotonic(), evicted_before=tcp.stats.evicted,
@@ -239,15 +238,15 @@ def _served_status(rig: FaultRig, source: str) -> bool:
 
 def tcp_served(rig: FaultRig, record: TickRecord) -> bool:
     """The feed publishes; every fifth tick a client from another address (127.0.0.2) is greeted and answered,
-    and, while the slow-loris connections hold 127.0.0.1's cap and have been idle ``EVICT_AFTER_S`` (clock
-    seconds), so is one from 127.0.0.1, as ``nfwserver status`` and ``poke`` connect: it needs an idle
-    connection closed to make room, and ``rig.loris`` counts it."""
+    and, while the slow-loris connections hold 127.0.0.1's cap, so is one from 127.0.0.1, as ``nfwserver
+    status`` and ``poke`` connect: it needs the quietest connection closed to make room, and ``rig.loris``
+    counts it."""
     if not record.published or rig.station.tcp is None or rig.index % 5:
         return record.published
     if not _served_status(rig, "127.0.0.2"):
         return False
     loris = rig.loris
-    if loris is None or loris.since is None or rig.clock.monotonic() - loris.since < EVICT_AFTER_S:
+    if loris is None or loris.since is None:
         return True
     if not _served_status(rig, "127.0.0.1"):
         return False

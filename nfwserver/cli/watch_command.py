@@ -1,10 +1,15 @@
 """``nfwserver watch``: a live view of a running (headless) station in a terminal, over its TCP port.
 
 Host and port as for ``nfwserver status`` (the configuration's ``[tcp]``, ``--host``/``--port`` override).
-Decision: ``STATUS`` and ``SUMMARY`` are polled on one connection every ``--interval`` seconds (default 1)
-rather than holding a ``WATCH`` stream beside a second, polling connection: one connection has one failure
-to handle, the STATUS line already carries the published values (``az``/``el``/``rr``/``ah``), SUMMARY gives
-the exact Nova string, and a poll cannot fall behind (a WATCH stream at 20 Hz would have to be drained).
+Decision: one connection, which asks ``STATUS`` and ``SUMMARY`` every ``--interval`` seconds (default 1)
+and holds a ``WATCH`` subscription between two questions (the stream is read and dropped; a blank line ends
+it before the next question): one connection has one failure to handle, the STATUS line already carries the
+published values (``az``/``el``/``rr``/``ah``) and SUMMARY gives the exact Nova string.  The subscription
+keeps the connection a watcher, never closed by the station's idle timeout whatever the interval, and the
+questions are commands, so the connection is never the quietest of its address: when a crowd from the same
+address fills the per-address cap, the station closes one of the crowd for ``nfwserver status``, not the
+view; and a connection from the station's own address is never closed for another address
+(:mod:`nfwserver.tcp.admission`).
 
 On a terminal the status block is redrawn in place (``rich.live``); otherwise one plain line per update;
 ``--json`` prints one JSON object per update (:meth:`WatchUpdate.to_json`).  When the station does not answer
@@ -30,6 +35,7 @@ from nfwserver.tcp.client import StationLink, StationUnreachable
 
 #: Seconds between attempts while the station does not answer: 1, 2, 4, then 8.
 RETRY_S = (1.0, 2.0, 4.0, 8.0)
+DRAIN_S = 0.25  #: seconds between two reads of the WATCH stream while waiting (a few published strings)
 
 
 def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -75,7 +81,7 @@ class StationWatcher:
                         self.show(WatchUpdate(self.clock.now(), self.where, True, parse_status(status), nova))
                         if count is not None and self.answers >= count:
                             return
-                        self.clock.wait(self.stop, self.interval_s)
+                        self._watch_for(link, self.interval_s)
                 finally:
                     link.close()
             except StationUnreachable as exc:
@@ -84,6 +90,20 @@ class StationWatcher:
                 self.show(WatchUpdate(self.clock.now(), self.where, False, problem=str(exc), retry_s=retry,
                                       ever_connected=self.answers > 0))
                 self.clock.wait(self.stop, retry)
+
+
+    def _watch_for(self, link: StationLink, seconds: float) -> None:
+        """Hold a ``WATCH`` for ``seconds`` of the clock (or until ``stop``), reading the stream as it comes so
+        that the station never finds it stalled, then end it (a blank line; the station answers ``OK``)."""
+        if link.ask("WATCH") != "OK":
+            raise StationUnreachable(f"the station at {self.where} refused WATCH")
+        deadline = self.clock.monotonic() + seconds
+        while not self.stop.is_set() and (left := deadline - self.clock.monotonic()) > 0:
+            link.drain()
+            self.clock.wait(self.stop, min(DRAIN_S, left))
+        link.send("")
+        while link.reply() != "OK":  # strings published before the blank line arrived
+            pass
 
 
 def _json_printer(out: TextIO) -> Callable[[WatchUpdate], None]:

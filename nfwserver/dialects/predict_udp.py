@@ -20,6 +20,7 @@ from typing import Any
 from nfwserver.core.service_thread import ServiceThread
 from nfwserver.dialects.predict_protocol import END_OF_LISTING, PredictContext, PredictProtocol
 from nfwserver.listen_errors import bind_failure
+from nfwserver.listen_socket import datagram_socket
 
 __all__ = ["DEFAULT_PORT", "PredictContext", "PredictUdpServer"]
 
@@ -70,11 +71,9 @@ class PredictUdpServer(ServiceThread):
     def start(self) -> None:
         if self.running:
             return
-        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         try:
-            sock.bind((self.host, self.port))
+            sock = datagram_socket(self.host, self.port)
         except OSError as exc:
-            sock.close()
             raise bind_failure(exc, "dialects", self.host, self.port, host_key="predict_host",
                                port_key="predict_port", what="PREDICT UDP") from None
         sock.settimeout(0.2)

@@ -3,45 +3,56 @@
 from __future__ import annotations
 
 import errno
+import logging
+import math
 import os
 import selectors
 import socket
 from collections import deque
-from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
+from datetime import datetime
 from typing import Any
 
-from nfwserver.config.schema import TcpConfig
+from nfwserver.core.events import Direction, EventLog
 from nfwserver.health.link_health import LinkHealth
 from nfwserver.tcp.line_splitter import MAX_LINE_BYTES, LineSplitter
 
-__all__ = ["Connection", "ListenerRest", "TcpStats", "admission", "admission_refusal", "bind_listener",
-           "idle_victim", "peer_label"]
+__all__ = ["Connection", "ListenerRest", "TcpStats", "peer_label", "prepare_socket"]
 
-#: A connection idle (no complete line) for at least this long (clock seconds) may be closed to make room.
-EVICT_AFTER_S = 1.0
+ACTIVITY_HALF_LIFE_S = 60.0  #: clock seconds in which a command's weight in Connection.activity halves
+log = logging.getLogger("nfwserver.tcp.server")  #: the server's log: one name for everything the TCP face writes
 
 
 @dataclass
 class TcpStats:
     accepted: int = 0
-    refused: int = 0  #: peers not allowed, or over a connection cap
+    refused: int = 0  #: peers not allowed, or over a connection cap with no connection to close for them
+    http_closed: int = 0  #: connections closed for speaking HTTP (a web page's request: cross-protocol)
     idle_closed: int = 0  #: connections closed for completing no line within the idle timeout
-    evicted: int = 0  #: idle connections closed to make room for a new one under a cap
+    evicted: int = 0  #: connections closed to make room for a new one under a cap (the quietest)
     dropped: int = 0  #: watching clients dropped for not reading
     lost: int = 0  #: published strings lost because the loop fell PUBLISHED_BACKLOG behind
     delivered: int = 0  #: published strings handed to the watchers
     max_buffered: int = 0  #: the most bytes ever waiting for one client
 
+    def status_fields(self) -> dict[str, object]:
+        """The counts STATUS shows: peers refused, closed for speaking HTTP, closed to make room."""
+        return {"tcp_refused": self.refused, "tcp_http_closed": self.http_closed, "tcp_evicted": self.evicted}
+
 
 class Connection:
     """One connection; owned by the ``nfw-tcp`` thread."""
 
-    def __init__(self, sock: socket.socket, peer: str, address: str, now: float) -> None:
+    def __init__(self, sock: socket.socket, peer: str, address: str, now: float, order: int = 0) -> None:
         self.sock = sock
         self.peer = peer
         self.address = address  #: the peer's address, one key per host (TcpConfig.peer_key)
-        self.last_line = now  #: clock monotonic seconds of the last complete line (or of the connect)
+        self.last_line = now  #: clock monotonic seconds of the last complete line (or of the connect): idle timeout
+        #: clock monotonic seconds of the last command it sent (or of the connect): a blank line, a partial or
+        #: over-long line, or a line ending a WATCH is not one; a WATCH is one when it is sent, not while it lasts
+        self.last_active = now
+        self._activity = 0.0  #: commands sent, each weighing less as it ages (half-life ACTIVITY_HALF_LIFE_S)
+        self.order = order  #: the server's count of accepted connections when this one came (breaks ties)
         self.splitter = LineSplitter(MAX_LINE_BYTES)
         self.inbox: deque[bytes | None] = deque()  # received lines not handled yet (one read's worth)
         self.out = bytearray()
@@ -50,30 +61,24 @@ class Connection:
         self.closing = False  # QUIT: close once the output is sent
         self.eof = False  # the client shut its side: answer what it sent, then close (unless watching)
         self.closed = False
+        self.announced = False  #: its connect is on record (log and event stream): from its first line on
 
 
-def admission(config: TcpConfig, per_address: Mapping[str, int], clients: Iterable[Connection], max_clients: int,
-              address: str, now: float) -> tuple[tuple[str, str | None] | None, Connection | None]:
-    """(why a new connection from ``address`` is refused, or None; a connection to close first so it fits, or
-    None): over a cap, :func:`idle_victim` makes room when it finds one (see :func:`admission_refusal`)."""
-    key = TcpConfig.peer_key(address)
-    clients = list(clients)
-    refusal = admission_refusal(config, per_address.get(key, 0), len(clients), max_clients, address)
-    if refusal is None or refusal[1] is None:  # served, or not allowed at all
-        return refusal, None
-    victim = idle_victim(clients, key, per_address.get(key, 0) >= config.max_per_address, now)
-    return (refusal, None) if victim is None else (None, victim)
+    def commanded(self, now: float) -> None:
+        """It sent a command (a line answered; blank, over-long and WATCH-ending lines are not) at ``now``."""
+        self._activity = self.activity(now) + 1.0
+        self.last_active = now
 
+    def activity(self, now: float) -> float:
+        """How much it has done lately: its commands, each counting 1 when sent and half as much every
+        :data:`ACTIVITY_HALF_LIFE_S` clock seconds after; 0 for one that never sent a command."""
+        return self._activity * math.pow(0.5, max(0.0, now - self.last_active) / ACTIVITY_HALF_LIFE_S)
 
-def idle_victim(clients: Iterable[Connection], key: str, same_address: bool, now: float) -> Connection | None:
-    """The connection to close so that a new one from ``key`` fits under a cap, or None: the one idle longest,
-    for at least :data:`EVICT_AFTER_S`, never a ``WATCH`` subscriber; among ``key``'s own connections when the
-    cap reached is the per-address one (``same_address``).  So idle connections never lock out a client that
-    talks -- on the loopback default every local tool shares one address, the operator's ``status`` and
-    ``poke`` included -- while a client that keeps talking keeps its connection."""
-    idle = [c for c in clients if not c.watching and not c.closed and now - c.last_line >= EVICT_AFTER_S
-            and (not same_address or c.address == key)]
-    return min(idle, key=lambda c: c.last_line, default=None)
+    def announce(self, events: EventLog, now: datetime) -> None:
+        """Put its connect on record (log and event stream): done at its first line."""
+        self.announced = True
+        log.info("TCP client %s connected", self.peer)
+        events.add(now, Direction.IN, "connect", "TCP", client=self.peer, accepted=True)
 
 
 def peer_label(address: tuple[Any, ...]) -> str:
@@ -81,36 +86,13 @@ def peer_label(address: tuple[Any, ...]) -> str:
     return f"tcp [{host}]:{port}" if ":" in host else f"tcp {host}:{port}"
 
 
-
-def admission_refusal(config: TcpConfig, from_address: int, connected: int, max_clients: int,
-                      address: str) -> tuple[str, str | None] | None:
-    """Why a new connection from ``address`` (already holding ``from_address`` of the ``connected``
-    ones) is refused, as (log reason, line sent to the peer or None to close without a word); None to serve it."""
-    key = TcpConfig.peer_key(address)
-    if not config.allows(address):
-        return "not in [tcp] allow", None
-    if from_address >= config.max_per_address:
-        return (f"already {from_address} connections from {key}",
-                f"ERROR too many connections from {key} (at most {config.max_per_address})")
-    if connected >= max_clients:
-        return (f"already {max_clients} clients",
-                f"ERROR the station serves {max_clients} connections at most; try again later")
-    return None
-
-
-def bind_listener(host: str, port: int) -> socket.socket:
-    """A non-blocking listening socket on ``host``:``port`` (0: any free port); OSError when it cannot bind."""
-    family, _, _, _, sockaddr = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)[0]
-    listener = socket.socket(family, socket.SOCK_STREAM)
-    try:
-        listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        listener.bind(sockaddr)
-        listener.listen(64)
-        listener.setblocking(False)
-    except OSError:
-        listener.close()
-        raise
-    return listener
+def prepare_socket(sock: socket.socket, send_buffer_bytes: int | None) -> None:
+    """An accepted socket made ready: non-blocking, no Nagle delay (one short line per reply), ``SO_SNDBUF``
+    set when ``send_buffer_bytes`` is given."""
+    sock.setblocking(False)
+    sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+    if send_buffer_bytes:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, send_buffer_bytes)
 
 
 class ListenerRest:

@@ -4,23 +4,25 @@ One thread, ``nfw-tcp``, owns the listening socket and every connection: a :mod:
 so many clients cost no thread each.  The loop waits in ``select`` until the next idle deadline;
 :meth:`NovaTcpServer.stop` and new published strings wake it through a socket pair.
 
-- Construction is pure; :meth:`NovaTcpServer.start` binds (raising :class:`OSError` when it cannot)
-  and :meth:`NovaTcpServer.stop` closes everything.  Port 0 binds any free port (see ``address``).
-- A peer whose address is not in ``[tcp] allow`` is closed at once, before the greeting, and
-  logged (once a minute per address at most) and recorded in the event stream.  IPv4-mapped IPv6
+- Construction is pure; :meth:`NovaTcpServer.start` binds (raising :class:`OSError` when it cannot), ``stop``
+  closes everything.  Port 0 binds any free port (see ``address``).
+- A peer whose address is not in ``[tcp] allow`` is closed at once, before the greeting.  IPv4-mapped IPv6
   peers count as their IPv4 address everywhere (allow list, caps, rate limits).
-- Caps: ``[tcp] max_per_address`` per address, ``max_clients`` in all; a new connection over one closes the
-  one idle longest (1 s or more, never a ``WATCH``), else gets one ``ERROR`` line and is closed.  A connection
-  that completes no line for ``idle_timeout_s`` is closed (a ``WATCH`` subscriber never is).
+- HTTP (a web page's request: a request line or a header line, :mod:`nfwserver.tcp.http_guard`) closes the
+  connection at once: no line of that read, nor anything after it, is run (``tcp_http_closed`` in STATUS).
+- Caps: ``[tcp] max_per_address`` per address, ``max_clients`` in all, with a reserve for the station's own
+  addresses; a new connection over one closes the quietest connection it may displace, else gets one
+  ``ERROR`` line and is closed (:mod:`nfwserver.tcp.admission`).  A connection that completes no line for
+  ``idle_timeout_s`` is closed (a ``WATCH`` subscriber never is).
+- Refused and HTTP-speaking peers are counted always, and logged and put in the event stream once a minute
+  per peer address (:mod:`nfwserver.tcp.refusals`); refused commands are logged once a minute per address too.
 - Out of file descriptors (EMFILE and kin), the listener rests for a back-off (0.1 s doubling to 5 s)
   instead of spinning: the ``tcp-accept`` link shows it in STATUS until a spare descriptor is found.
-- Refused commands are logged once a minute per peer *address* (reconnecting does not reset it).
 - Lines: :mod:`nfwserver.tcp.protocol`, split by :mod:`nfwserver.tcp.line_splitter` (CR, LF, CR LF
   or NUL; at most 1 KiB kept; longer lines refused).  The line ending a ``WATCH`` gets ``OK`` and is
   not executed (a client stopping the stream with ``QUIT`` meant "stop").
-- The publisher thread only runs :meth:`NovaTcpServer.on_tick`: it appends the published string to
-  a bounded queue and wakes the loop, at a cost that does not depend on the number of clients.
-  The loop then copies the string to each ``WATCH`` client's output buffer.
+- The publisher thread only runs :meth:`NovaTcpServer.on_tick` (append to a bounded queue, wake the loop:
+  a cost independent of the clients); the loop copies the string to each ``WATCH`` client's buffer.
 - Output is bounded per client (``output_limit`` bytes, 64 KiB by default): a watching client whose
   buffer would grow past it has stopped reading and is dropped with one log line; it never delays
   the publisher or any other client.  A client that sends commands without reading the replies is
@@ -34,7 +36,7 @@ import errno
 import logging
 import selectors
 import socket
-from collections import Counter, deque
+from collections import deque
 from collections.abc import Callable
 
 from nfwserver.config.schema import TcpConfig
@@ -44,17 +46,14 @@ from nfwserver.core.service_thread import ServiceThread
 from nfwserver.core.station_core import StationCore
 from nfwserver.health.link_health import Backoff
 from nfwserver.listen_errors import bind_failure
+from nfwserver.listen_socket import stream_listener
 from nfwserver.ratelimited_log import RateLimitedLog
-from nfwserver.tcp.connection import (
-    Connection,
-    ListenerRest,
-    TcpStats,
-    admission,
-    bind_listener,
-    peer_label,
-)
+from nfwserver.tcp.admission import admit, own_addresses, turn_away
+from nfwserver.tcp.connection import Connection, ListenerRest, TcpStats, peer_label, prepare_socket
+from nfwserver.tcp.http_guard import http_in
 from nfwserver.tcp.line_splitter import MAX_LINE_BYTES
 from nfwserver.tcp.protocol import GREETING, Action, NovaTcpProtocol, Reply, StatusFields
+from nfwserver.tcp.refusals import PeerRefusals
 
 log = logging.getLogger(__name__)
 
@@ -81,11 +80,11 @@ class NovaTcpServer(ServiceThread):
         super().__init__()
         self.core = core
         self.config = config
-        self.protocol = NovaTcpProtocol(core, extra)
+        self.extra = extra
+        self.protocol = NovaTcpProtocol(core, self._status_fields)
         self.output_limit = output_limit
         self.send_buffer_bytes = send_buffer_bytes
         self.max_clients = max_clients if max_clients is not None else config.max_clients
-        self._per_address: Counter[str] = Counter()
         self._rest = ListenerRest(core.health.link("tcp-accept", ACCEPT_BACKOFF))
         self.stats = TcpStats()
         self.address: tuple[str, int] | None = None
@@ -98,7 +97,9 @@ class NovaTcpServer(ServiceThread):
         self._wake_r: socket.socket | None = None
         self._wake_w: socket.socket | None = None
         self._unsubscribe: Callable[[], None] | None = None
-        self._refusals = RateLimitedLog(log, core.clock, 60.0)
+        self._refusals = RateLimitedLog(log, core.clock, 60.0)  #: the server's own troubles
+        self._peers = PeerRefusals(core, log)  #: refused and HTTP-speaking peers, once a minute per address
+        self._own = own_addresses(config.host)
 
     # -- what others read ------------------------------------------------------------------------
     def client_count(self) -> int:
@@ -107,6 +108,10 @@ class NovaTcpServer(ServiceThread):
 
     def watcher_count(self) -> int:
         return len(self._watching)
+
+    def _status_fields(self) -> dict[str, object]:
+        """STATUS's fields beyond the core's: ``extra``'s, then this server's refusal counts."""
+        return {**(self.extra() if self.extra is not None else {}), **self.stats.status_fields()}
 
     def wake(self) -> None:
         """Let the loop look at the clock now (idle connections, the accept back-off): for a clock that
@@ -119,7 +124,7 @@ class NovaTcpServer(ServiceThread):
         if self.running:
             return
         try:
-            listener = bind_listener(self.config.host, self.config.port)
+            listener = stream_listener(self.config.host, self.config.port)
         except OSError as exc:
             raise bind_failure(exc, "tcp", self.config.host, self.config.port) from None
         self._listener = listener
@@ -239,36 +244,22 @@ class NovaTcpServer(ServiceThread):
             self._rest.health.succeeded()
             peer = peer_label(address)
             key = TcpConfig.peer_key(address[0])
-            refusal, victim = admission(self.config, self._per_address, self._clients, self.max_clients, address[0],
-                                        self.core.clock.monotonic())
-            if victim is not None:  # over a cap: the connection idle longest makes room (connection.admission)
+            decision = admit(self.config, self._clients, self.max_clients, self._own, address[0],
+                             self.core.clock.monotonic())
+            if decision.victim is not None:  # over a cap: the quietest connection makes room (tcp.admission)
                 self.stats.evicted += 1
-                self._close(victim, "idle, closed to make room for a new connection under the connection caps")
-            if refusal is not None:
-                reason, line = refusal
-                if line is not None:
-                    try:
-                        sock.setblocking(False)
-                        sock.send(line.encode("ascii") + CRLF)
-                    except OSError:
-                        pass
-                sock.close()
-                self._refusals.warning(key, "TCP connection from %s refused: %s", peer, reason)
-                self.core.events.add(self.core.clock.now(), Direction.INFO, "note", f"connection refused: {reason}",
-                                     client=peer, accepted=False)
-                self.stats.refused += 1  # counted once it is on record (log and event stream)
+                self._close(decision.victim, f"the quietest, closed to make room for {peer} under the connection "
+                                             "caps")
+            if decision.refusal is not None:
+                self.stats.refused += 1  # counted and on record before the peer can see the close
+                self._peers.record(key, peer, f"refused: {decision.refusal}")
+                turn_away(sock, decision.line)
                 continue
-            sock.setblocking(False)
-            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            if self.send_buffer_bytes:
-                sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, self.send_buffer_bytes)
-            client = Connection(sock, peer, key, self.core.clock.monotonic())
+            prepare_socket(sock, self.send_buffer_bytes)
+            client = Connection(sock, peer, key, self.core.clock.monotonic(), self.stats.accepted)
             self._clients.add(client)
-            self._per_address[key] += 1
             self._selector.register(sock, client.mask, client)
             self.stats.accepted += 1
-            log.info("TCP client %s connected", peer)
-            self.core.events.add(self.core.clock.now(), Direction.IN, "connect", "TCP", client=peer, accepted=True)
             self._queue(client, GREETING.encode("ascii") + CRLF)
             self._pump(client)
 
@@ -284,13 +275,23 @@ class NovaTcpServer(ServiceThread):
             if data == b"":
                 client.eof = True
             elif data:
-                client.inbox.extend(client.splitter.feed(data))
+                lines = client.splitter.feed(data)
+                if (kind := http_in(lines)) is not None:  # a web page's request: nothing of it runs, not even the
+                    # lines before it in this read
+                    self.stats.http_closed += 1
+                    self._peers.record(client.address, client.peer, f"closed: it sent {kind} (a web page's "
+                                       "request?); Nova's TCP port does not speak HTTP")
+                    self._close(client, f"sent {kind}", accepted=False)
+                    return
+                client.inbox.extend(lines)
         self._pump(client)
 
     def _handle_lines(self, client: Connection) -> None:
         while client.inbox and len(client.out) < COMMAND_HIGH_WATER and not client.closing:
             item = client.inbox.popleft()
             client.last_line = self.core.clock.monotonic()
+            if not client.announced:  # on record from its first line: an HTTP flood leaves no connect events
+                client.announce(self.core.events, self.core.clock.now())
             reply: Reply | None
             if client.watching:  # any line ends WATCH, and is not executed
                 client.watching = False
@@ -302,6 +303,8 @@ class NovaTcpServer(ServiceThread):
                 try:
                     reply = self.protocol.handle(item.decode("ascii", errors="replace"), client.peer,
                                                  rate_key=f"tcp {client.address}")
+                    if reply is not None:  # a command (a blank line gets no reply): the client is doing something
+                        client.commanded(client.last_line)
                 except Exception:
                     self._refusals.log(logging.ERROR, f"failed:{client.address}", "TCP command from %s failed",
                                        client.peer, exc_info=True)
@@ -380,11 +383,7 @@ class NovaTcpServer(ServiceThread):
         if client.closed:
             return
         client.closed = True
-        if client in self._clients:
-            self._clients.discard(client)
-            self._per_address[client.address] -= 1
-            if self._per_address[client.address] <= 0:
-                del self._per_address[client.address]
+        self._clients.discard(client)
         self._watching.discard(client)
         if self._selector is not None:
             try:
@@ -394,6 +393,9 @@ class NovaTcpServer(ServiceThread):
         client.sock.close()
         client.out.clear()
         client.inbox.clear()
+        if not client.announced:  # it never sent a line: only the counters (and refusals) keep it
+            log.debug("TCP client %s closed before its first line: %s", client.peer, reason)
+            return
         log.info("TCP client %s disconnected: %s", client.peer, reason)
         self.core.events.add(self.core.clock.now(), Direction.IN, "disconnect", reason, client=client.peer,
                              accepted=accepted)

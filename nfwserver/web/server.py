@@ -48,6 +48,7 @@ from nfwserver.core.events import Direction
 from nfwserver.core.sample import TickSample
 from nfwserver.core.station_core import StationCore
 from nfwserver.listen_errors import bind_failure
+from nfwserver.listen_socket import claim_port
 from nfwserver.ratelimited_log import RateLimitedLog
 from nfwserver.web.admission import OWN_RESERVE, Admission
 from nfwserver.web.control import Control
@@ -88,13 +89,17 @@ class WebStats:
 
 class _HttpServer(ThreadingHTTPServer):
     daemon_threads = True
-    allow_reuse_address = True
+    allow_reuse_address = False  #: the port's options are nfwserver.listen_socket's (server_bind)
     request_queue_size = 64
 
     def __init__(self, address: tuple[Any, ...], web: WebServer, family: int) -> None:
         self.address_family = family
         self.web = web
         super().__init__(address, WebHandler)
+
+    def server_bind(self) -> None:
+        claim_port(self.socket)  # SO_EXCLUSIVEADDRUSE on Windows, SO_REUSEADDR on POSIX (nfwserver.listen_socket)
+        super().server_bind()
 
     def verify_request(self, request: Any, client_address: Any) -> bool:
         return self.web._admit(request, client_address)

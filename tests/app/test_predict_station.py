@@ -78,8 +78,8 @@ def test_run_says_one_sentence_when_the_predict_port_is_taken(tmp_path, capsys) 
     err = capsys.readouterr().err
     lines = [line for line in err.splitlines() if line.strip() and not line.startswith("nfwserver: logging to ")]
     assert len(lines) == 1 and "Traceback" not in err, err
-    assert lines[0] == (f"nfwserver: cannot start the station: PREDICT UDP [dialects] predict_port {port} is in use "
-                        "(another nfwserver? set [dialects] predict_port)")
+    assert lines[0] == (f"nfwserver: cannot start the station: PREDICT UDP port {port} is already in use (by another "
+                        "program or another station); set [dialects] predict_port to another port")
 
 
 def test_a_non_loopback_predict_host_is_warned_about_at_start(caplog) -> None:

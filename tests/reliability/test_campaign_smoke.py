@@ -17,7 +17,7 @@ def test_a_tiny_campaign_runs_every_family_and_finds_nothing(tmp_path) -> None:
     budget = Budget.smoke()
     tallies = run_campaign(budget, tmp_path)
     by_name = {t.family: t for t in tallies}
-    assert len(tallies) == 12
+    assert len(tallies) == 14
     for tally in tallies:
         assert tally.clean, (tally.family, tally.crashes, tally.tracebacks, tally.lost, tally.notes)
         if tally.family != "rotctld/rigctld killed and restarted" or hamlib_available():
@@ -25,6 +25,8 @@ def test_a_tiny_campaign_runs_every_family_and_finds_nothing(tmp_path) -> None:
     assert by_name["element files: load_elements"].tried == budget.elements
     assert by_name["Nova lines over TCP"].extra["replies owed / received"].split(" / ")[0] == \
         by_name["Nova lines over TCP"].extra["replies owed / received"].split(" / ")[1]
+    assert by_name["TCP: web pages' requests (cross-protocol), 8 addresses"].extra[
+        "closed as HTTP (tcp_http_closed)"] == budget.http_requests
     realtime = tallies[-1]
     assert realtime.extra["ticks"] >= 50 * budget.realtime_s * 0.8  # 50 Hz for the whole run
     assert realtime.extra["tick failures"] == 0 and len(realtime.extra["rss samples"]) >= 2
@@ -57,3 +59,12 @@ def test_the_independent_tcp_splitter_counts_owed_replies() -> None:
     assert expected_replies(b"TUNE ON\rTRACK ON\nSAT=1\x00\r\n") == 3
     assert expected_replies(b" " * 2000 + b"\r\n") == 1
     assert expected_replies(b"A" * 1024 + b"\r\n") == 1
+
+
+def test_the_cross_protocol_family_sees_commands_run_from_a_request(tmp_path, monkeypatch) -> None:
+    """Without the TCP face's HTTP check the family must count the damage (replies, a changed satellite)."""
+    from bench.campaign import tcp_attacks
+
+    monkeypatch.setattr("nfwserver.tcp.server.http_in", lambda lines: None)
+    tally = run_family(Tally("cross"), lambda t: tcp_attacks.run_cross_protocol(t, 4, 2026, tmp_path))
+    assert tally.lost > 0 and not tally.clean, tally

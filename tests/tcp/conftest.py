@@ -2,17 +2,23 @@
 
 from __future__ import annotations
 
+import dataclasses
 import socket
 import time
 from collections.abc import Iterator
+from datetime import timedelta
 
 import pytest
 
 from nfwserver.config.schema import TcpConfig
 from nfwserver.tcp.server import NovaTcpServer
-from tests.dde.conftest import Station, make_station
+from nfwserver.tracking.catalog import Catalog
+from nfwserver.tracking.elements import load_element_file, load_elements
+from tests.conftest import DATA
+from tests.dde.conftest import ISS_PASS, Station, make_station
 
 LOOPBACK_ONLY = TcpConfig(enabled=True, host="127.0.0.1", port=0, allow=("127.0.0.1/32",))
+SO_50 = 27607  #: in :func:`with_so_50`'s catalog, so that SAT=27607 takes effect if it runs
 
 
 class LineClient:
@@ -72,3 +78,23 @@ def client(tcp_station) -> Iterator[LineClient]:
     assert c.read_line() == b"Hello, this is Nova for Windows.\r\n"
     yield c
     c.close()
+
+
+def with_so_50() -> Catalog:
+    """The tests' catalog and SO-50 (27607), from the bundled test data."""
+    lines = (DATA / "active.txt").read_text().splitlines()
+    at = next(k for k, line in enumerate(lines) if line.startswith(f"1 {SO_50}U"))
+    extra = load_elements("\n".join(lines[at - 1:at + 2]) + "\n", "so-50").sets
+    return Catalog([*load_element_file(DATA / "visual.txt").sets, *extra])
+
+
+@pytest.fixture
+def http_station() -> Iterator[tuple[Station, NovaTcpServer]]:
+    """A station tracking the ISS whose catalog holds SO-50 too; TCP open to 127.0.0.0/8."""
+    station = make_station(ISS_PASS.aos - timedelta(seconds=60), catalog=with_so_50())
+    server = NovaTcpServer(station.core, dataclasses.replace(LOOPBACK_ONLY, allow=("127.0.0.0/8",)))
+    server.start()
+    try:
+        yield station, server
+    finally:
+        server.stop()
