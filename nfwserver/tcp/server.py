@@ -14,8 +14,7 @@ so many clients cost no thread each.  The loop waits in ``select`` until the nex
   addresses; a new connection over one closes the quietest connection it may displace, else gets one
   ``ERROR`` line and is closed (:mod:`nfwserver.tcp.admission`).  A connection that completes no line for
   ``idle_timeout_s`` is closed (a ``WATCH`` subscriber never is).
-- Refused and HTTP-speaking peers are counted always, and logged and put in the event stream once a minute
-  per peer address (:mod:`nfwserver.tcp.refusals`); refused commands are logged once a minute per address too.
+- Refusals (HTTP, allow list, commands) are counted always, logged once a minute per peer address (refusals.py).
 - Out of file descriptors (EMFILE and kin), the listener rests for a back-off (0.1 s doubling to 5 s)
   instead of spinning: the ``tcp-accept`` link shows it in STATUS until a spare descriptor is found.
 - Lines: :mod:`nfwserver.tcp.protocol`, split by :mod:`nfwserver.tcp.line_splitter` (CR, LF, CR LF
