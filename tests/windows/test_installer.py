@@ -208,6 +208,18 @@ def test_the_installed_configuration_serves_the_dashboard_on_loopback(installed:
     assert re.search(r"^enabled = true\b", web, re.M) and re.search(r'^host = "127\.0\.0\.1"', web, re.M)
 
 
+def test_an_environment_fact_is_shown_under_v_only(installed: Installed) -> None:
+    """Under Wine sgp4's compiled TLE reader is wrong and the program works around it: a fact the operator cannot
+    act on, so a command says it only with -v (it began every command's output as a warning)."""
+    quiet = installed.nfwserver("passes", "--hours", "1")
+    assert quiet.returncode == 0, quiet.stderr
+    assert "sgp4" not in quiet.stderr
+    verbose = installed.nfwserver("-v", "passes", "--hours", "1")
+    assert verbose.returncode == 0, verbose.stderr
+    notes = [line for line in verbose.stderr.splitlines() if "sgp4" in line]
+    assert len(notes) == 1 and notes[0].startswith("nfwserver: info: "), notes
+
+
 def test_the_installed_program_serves_ddeml_clients_and_stops_on_request(installed: Installed) -> None:
     station = installed.prefix.start([installed.exe, "run", "--headless"])
     try:
@@ -229,6 +241,7 @@ def test_the_installed_program_serves_ddeml_clients_and_stops_on_request(install
         assert station.wait(60) == 0  # a clean stop, not a kill
         log = (installed.user_files / "Logs" / "nfwserver.log").read_text(encoding="utf-8", errors="replace")
         assert "control file" in log and log.rstrip().endswith("stopped")
+        assert log.count("compiled TLE reader is wrong here") == 1  # the first run's log says it, once
         again = installed.nfwserver("stop")
         assert again.returncode == 1 and again.stdout == ""
         assert again.stderr.strip().endswith("no station is running for this user: nothing to stop")
