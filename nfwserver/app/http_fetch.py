@@ -107,7 +107,10 @@ def _connect_within(deadline: Deadline, address: tuple[str, int], timeout: objec
     host, port = address
     per_operation = float(timeout) if isinstance(timeout, (int, float)) else None
     failure: OSError | None = None
-    for family, kind, proto, _, where in socket.getaddrinfo(host, port, 0, socket.SOCK_STREAM):
+    addresses = socket.getaddrinfo(host, port, 0, socket.SOCK_STREAM)
+    if not addresses:
+        raise OSError(f"{host} has no address")
+    for family, kind, proto, _, where in addresses:
         left = deadline.remaining()
         if left <= 0:
             break
