@@ -32,12 +32,16 @@ static int fail(const wchar_t *what, const wchar_t *detail)
     return 3;
 }
 
+/* FOLDERID_LocalAppData, {F1B32785-6FBA-4FCF-9D55-7B8E7F157091} (KnownFolders.h), written here: mingw-w64's
+ * libuuid would link 40 KB of every other GUID into each launcher. */
+static const GUID local_app_data = {0xF1B32785, 0x6FBA, 0x4FCF, {0x9D, 0x55, 0x7B, 0x8E, 0x7F, 0x15, 0x70, 0x91}};
+
 /* "pycache_prefix=<LocalAppData>\nfwserver\Cache\pycache" in `out`, or L"" when the folder is unknown. */
 static void pycache_option(wchar_t *out, size_t size)
 {
     PWSTR local = NULL;
     out[0] = 0;
-    if (SUCCEEDED(SHGetKnownFolderPath(&FOLDERID_LocalAppData, 0, NULL, &local)) && local != NULL)
+    if (SUCCEEDED(SHGetKnownFolderPath(&local_app_data, 0, NULL, &local)) && local != NULL)
         _snwprintf(out, size - 1, L"pycache_prefix=%ls\\nfwserver\\Cache\\pycache", local);
     out[size - 1] = 0;
     CoTaskMemFree(local);
