@@ -9,6 +9,14 @@ Sub-packages:
 - :mod:`nfwserver.radio` -- Doppler tuning and radio backends.
 - :mod:`nfwserver.console` -- the diagnostic console.
 - :mod:`nfwserver.cli` -- the ``nfwserver`` command.
+
+``nfwserver.__version__`` is derived from the repository when first asked for (:mod:`nfwserver.release`).
 """
 
-__version__ = "0.1.0"
+
+def __getattr__(name: str) -> str:
+    if name == "__version__":
+        from nfwserver.release import package_version
+
+        return package_version()
+    raise AttributeError(f"module 'nfwserver' has no attribute {name!r}")

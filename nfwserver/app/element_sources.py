@@ -18,9 +18,13 @@ import threading
 from collections.abc import Callable, Mapping
 from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from nfwserver.config.files import FileRefused, FileTooLarge, read_regular_bytes
 from nfwserver.tracking.elements import ElementSet, LoadResult, Rejection, load_elements
+
+if TYPE_CHECKING:
+    from nfwserver.clock import Clock
 
 BUNDLED = "amateur.txt"
 BUNDLED_SOURCE = f"bundled {BUNDLED}"
@@ -103,10 +107,11 @@ def _network_reason(exc: BaseException, timeout_s: float) -> str:
 
 
 def fetch_url(url: str, timeout_s: float = 20.0, progress: ProgressCallback | None = None,
-              limits: SourceLimits = SourceLimits(), cancel: threading.Event | None = None) -> bytes:
-    """GET ``url`` (http/https only, redirects too), at most ``limits.max_bytes``, the whole transfer within
-    ``timeout_s`` seconds (each read too); ``cancel`` set aborts it at once.  Raises :class:`SourceError`
-    (one sentence)."""
+              limits: SourceLimits = SourceLimits(), cancel: threading.Event | None = None,
+              clock: Clock | None = None) -> bytes:
+    """GET ``url`` (http/https only, redirects too), at most ``limits.max_bytes``, the whole transfer (connect
+    included) within ``timeout_s`` seconds of ``clock`` (the system's unless given); ``cancel`` set aborts it
+    at once.  Raises :class:`SourceError` (one sentence)."""
     scheme = url.partition("://")[0].lower()
     if scheme not in ("http", "https"):
         raise SourceError(f"{url}: unsupported scheme {scheme}:// (element sources are files or http(s) URLs)")
@@ -117,7 +122,7 @@ def fetch_url(url: str, timeout_s: float = 20.0, progress: ProgressCallback | No
 
     chunks: list[bytes] = []
     size = 0
-    deadline = Deadline(timeout_s, cancel).start()
+    deadline = Deadline(timeout_s, cancel, clock).start()
     try:
         with open_url(url, timeout_s, deadline) as response:
             length = response.headers.get("Content-Length")

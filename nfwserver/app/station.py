@@ -50,6 +50,7 @@ from nfwserver.health import Backoff
 from nfwserver.radio.coupling import RadioCoupling
 from nfwserver.rotor.coupling import RotorCoupling
 from nfwserver.tcp.server import NovaTcpServer
+from nfwserver.tracking import SGP4_CHOICE
 from nfwserver.tracking.catalog import Catalog, UpdateSummary
 from nfwserver.web import StationParts, WebServer
 
@@ -295,6 +296,8 @@ class Station:
         self._stopping.clear()
         for warning in self.config.warnings:
             log.warning("%s", warning)
+        if SGP4_CHOICE.mode != "compiled":  # the machine's sgp4, in the log once per start (sgp4_selfcheck)
+            log.info("%s", SGP4_CHOICE.detail)
         self._load_catalog()
         self._restore_session()
         if self.predict is not None:

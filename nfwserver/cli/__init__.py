@@ -18,7 +18,6 @@ import logging
 import sys
 from collections.abc import Sequence
 
-from nfwserver import __version__
 from nfwserver.blas_threads import single_threaded_blas
 from nfwserver.cli.arguments import COMMANDS, command_word, join_negative_values
 from nfwserver.cli.errors import CliError, say
@@ -45,6 +44,22 @@ class TerminalFormatter(logging.Formatter):
         return f"nfwserver: {record.levelname.lower()}{where}: {text}"
 
 
+class VersionAction(argparse.Action):
+    """``--version``: prints ``nfwserver <version>`` and exits; the version is derived only then (in a checkout
+    it asks git: :mod:`nfwserver.release`), not for every command."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str = argparse.SUPPRESS) -> None:
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS,
+                         help="show the program's version and exit")
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace, values: object,
+                 option_string: str | None = None) -> None:
+        from nfwserver.release import package_version
+
+        print(f"nfwserver {package_version()}")
+        parser.exit()
+
+
 def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
     """The argument parser; with ``argv``, only the module of the command named in it is imported
     (the other commands get help-only stand-ins), without it every command module is."""
@@ -52,7 +67,7 @@ def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
         prog="nfwserver",
         description="Satellite-tracking server speaking Nova for Windows' DDE interface.",
     )
-    parser.add_argument("--version", action="version", version=f"nfwserver {__version__}")
+    parser.add_argument("--version", action=VersionAction)
     parser.add_argument("-v", "--verbose", action="count", default=0, help="more diagnostics on stderr")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     wanted = command_word(argv) if argv is not None else None

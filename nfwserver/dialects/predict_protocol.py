@@ -38,11 +38,11 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from datetime import datetime, timedelta, timezone
 
-from nfwserver import __version__
 from nfwserver.clock import Clock
 from nfwserver.core.state import StationState
 from nfwserver.dialects.predict_listing import Listing, atol
 from nfwserver.ratelimited_log import RateLimitedLog
+from nfwserver.release import package_version
 from nfwserver.tracking.bodies import BodyView, moon_view, sun_view
 from nfwserver.tracking.catalog import Catalog, Satellite
 from nfwserver.tracking.constants import SPEED_OF_LIGHT_KM_S
@@ -222,7 +222,7 @@ class PredictProtocol:
         if text.startswith("GET_MODE"):
             return self._mode()
         if text.startswith("GET_VERSION"):
-            return f"{__version__}\n"
+            return f"{package_version()}\n"
         if text.startswith("GET_QTH"):
             o = self.ctx.observer
             west = -o.longitude_deg % 360.0

@@ -18,6 +18,10 @@ then keeps the first of these that agrees (within 1 m):
     (about a hundred times slower).  Modules must import those names after the switch, which
     is why :mod:`nfwserver.tracking` runs the check when the package is first imported.
 
+The choice is a fact about the machine that its operator can do nothing about, so it is logged at INFO:
+shown by a command under ``-v``, and written once into the station's log at each start
+(:meth:`nfwserver.app.station.Station.start`), never as a warning before every command's output.
+
 Reference: satellite 00005 from Vallado, Crawford, Hujsak and Kelso, "Revisiting Spacetrack
 Report #3" (AIAA 2006-6753), its verification output ``tcppver.out``: TEME position in km at
 0 and 360 minutes after epoch.
@@ -71,10 +75,10 @@ def reference_error_km(twoline2rv: Callable[[str, str], sgp4.api.Satrec]) -> flo
         return math.inf
 
 
-def _warn(message: str) -> None:
+def _note(message: str) -> None:
     import logging
 
-    logging.getLogger(__name__).warning("%s", message)
+    logging.getLogger(__name__).info("%s", message)
 
 
 def python_parsed_twoline2rv(cls: type, line1: str, line2: str, whichconst: int = sgp4.api.WGS72) -> Any:
@@ -107,7 +111,7 @@ def ensure_working_sgp4() -> Sgp4Choice:
         choice = Sgp4Choice("compiled-python-parser",
                             f"sgp4's compiled TLE reader is wrong here (error {error:.3g} km): TLEs are read "
                             "by sgp4's pure-Python reader, the compiled propagator is kept")
-        _warn(choice.detail)
+        _note(choice.detail)
         return choice
     from sgp4 import model as python_model
 
@@ -115,5 +119,5 @@ def ensure_working_sgp4() -> Sgp4Choice:
     sgp4.api.accelerated = False
     choice = Sgp4Choice("python", f"sgp4's compiled extension is wrong here (error {error:.3g} km, "
                         f"with the Python reader {mixed:.3g} km): using its pure-Python model (slower)")
-    _warn(choice.detail)
+    _note(choice.detail)
     return choice

@@ -31,6 +31,7 @@ from http.server import BaseHTTPRequestHandler
 from importlib import resources
 from typing import Any
 
+from nfwserver.release import package_version
 from nfwserver.web.admission import Phase
 from nfwserver.web.control import help_entries
 from nfwserver.web.guard import cross_site_reason, host_refusal
@@ -152,7 +153,7 @@ class WebHandler(BaseHTTPRequestHandler):
         if path in ("/", "/index.html"):
             body = static_file("index.html")
             assert body is not None
-            self._send(200, body, _TYPES[".html"])
+            self._send(200, body.replace(b"@NFW_VERSION@", package_version().encode()), _TYPES[".html"])
         elif path.startswith("/static/") or path == "/favicon.ico":
             name = "icon.svg" if path == "/favicon.ico" else path[len("/static/"):]
             body = static_file(name)

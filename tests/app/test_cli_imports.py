@@ -36,7 +36,8 @@ def _closed_port() -> int:
 def test_version_loads_nothing_but_the_parser() -> None:
     loaded = {m for m in _modules_after("--version") if m.startswith(("nfwserver", "numpy", "sgp4"))}
     assert loaded == {"nfwserver", "nfwserver.blas_threads", "nfwserver.cli", "nfwserver.cli.arguments",
-                      "nfwserver.cli.errors"}  # CliError and say: the standard library only
+                      "nfwserver.cli.errors",  # CliError and say: the standard library only
+                      "nfwserver.release"}  # the version, derived when asked (standard library only)
 
 
 def test_status_loads_neither_numpy_nor_the_server() -> None:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import os
 import re
+import struct
 import subprocess
 import time
 import urllib.request
@@ -22,6 +23,7 @@ from pathlib import Path, PureWindowsPath
 import pytest
 
 from nfwserver import __version__
+from nfwserver.release import windows_version
 from tests.conftest import ROOT
 from tests.waiting import wait_for
 from tests.windows.conftest import NOVA
@@ -38,6 +40,49 @@ RUN_KEY = r"HKCU\Software\Microsoft\Windows\CurrentVersion\Run"
 MENU = {"nfwserver station.lnk": ("nfwserver.exe", "run"), "nfwserver dashboard.lnk": ("nfwserverw.exe", "dashboard"),
         "nfwserver configuration.lnk": ("nfwserverw.exe", "config edit"),
         "Stop the station.lnk": ("nfwserverw.exe", "stop")}
+
+
+#: Where an upgrade moves what it finds at the program folder's top and does not know (docs/WINDOWS.md).
+KEPT = "Left in the program folder"
+
+
+def manifest() -> dict[str, int]:
+    """The build's list of what the installer puts in the program's folder: relative path -> size in bytes."""
+    assert SETUP is not None
+    lines = Path(SETUP).with_name(f"nfwserver-{__version__}-files.txt").read_text(encoding="utf-8").splitlines()
+    files = {}
+    for line in lines[1:]:
+        size, name = line.split("\t", 1)
+        files[name] = int(size)
+    assert lines[0].startswith(f"# {len(files)} files, {sum(files.values())} bytes")
+    return files
+
+
+def program_files(folder: Path) -> dict[str, int]:
+    """What is in the installed program's folder: relative path -> size in bytes."""
+    return {p.relative_to(folder).as_posix(): p.stat().st_size for p in folder.rglob("*") if p.is_file()}
+
+
+def version_resource(exe: Path) -> tuple[str, str, str]:
+    """(FILEVERSION as four numbers, the FileVersion string, the ProductVersion string) of a PE file's version
+    resource, read as Microsoft's VS_FIXEDFILEINFO and StringFileInfo layouts define them."""
+    data = exe.read_bytes()
+    fixed_at = data.find(struct.pack("<I", 0xFEEF04BD))  # VS_FIXEDFILEINFO.dwSignature
+    assert fixed_at > 0, f"{exe.name} has no version resource"
+    ms, ls = struct.unpack_from("<II", data, fixed_at + 8)  # dwFileVersionMS, dwFileVersionLS
+
+    def string(key: str) -> str:
+        name = (key + "\0").encode("utf-16-le")
+        at = data.find(name)
+        assert at > 0, key
+        at += len(name)
+        at += (-at) % 4  # the value starts on a 32-bit boundary
+        end = at
+        while data[end:end + 2] != b"\0\0":
+            end += 2
+        return data[at:end].decode("utf-16-le")
+
+    return f"{ms >> 16}.{ms & 0xFFFF}.{ls >> 16}.{ls & 0xFFFF}", string("FileVersion"), string("ProductVersion")
 
 
 def winpath(path: Path) -> str:
@@ -94,11 +139,28 @@ def installed(tmp_path_factory) -> Iterator[Installed]:
 
 
 def test_two_builds_of_one_commit_are_the_same_bytes_and_the_setup_is_small() -> None:
+    """The second build is of a clone of the commit in a folder named with spaces and non-ASCII letters
+    (tools/windows/test): a build works from any path, and its bytes do not depend on it."""
     assert SETUP is not None and REBUILT is not None
     first, second = Path(SETUP), Path(REBUILT)
+    assert "+" not in __version__  # derived from git, not the fallback of a checkout whose history is unknown
     assert first.name == second.name == f"nfwserver-{__version__}-setup.exe"
     assert first.read_bytes() == second.read_bytes()
     assert first.stat().st_size <= 40 * 1024 * 1024
+
+
+def test_no_test_code_ships_and_the_documented_size_is_the_builds() -> None:
+    files = manifest()
+    assert not [name for name in files if name.rsplit("/", 1)[-1] == "conftest.py" or "/tests/" in f"/{name}"
+                or name.startswith("Lib/site-packages/numpy/testing/")]
+    assert "Lib/site-packages/nfwserver/_version.py" in files
+    text = " ".join((ROOT / "docs" / "WINDOWS.md").read_text(encoding="utf-8").split())
+    found = re.search(r"installed, the program takes about ([\d.]+) MB \(([\d,]+) files\)", text)
+    assert found, "docs/WINDOWS.md gives no installed size and file count"
+    documented_mb, documented_files = float(found.group(1)), int(found.group(2).replace(",", ""))
+    built_mb = sum(files.values()) / 1e6
+    assert abs(documented_files - len(files)) <= 0.02 * len(files), (len(files), "files; correct docs/WINDOWS.md")
+    assert abs(documented_mb - built_mb) <= 0.02 * built_mb, (f"{built_mb:.1f} MB; correct docs/WINDOWS.md")
 
 
 def test_a_silent_install_registers_for_apps_and_features(installed: Installed) -> None:
@@ -118,6 +180,8 @@ def test_a_silent_install_registers_for_apps_and_features(installed: Installed) 
     assert version.returncode == 0 and version.stdout.strip() == f"nfwserver {__version__}"
     program = installed.prefix.unix(installed.folder)
     assert (program / "nfwserver.exe").is_file() and not (program / "python.exe").exists()
+    for exe in ("nfwserver.exe", "nfwserverw.exe"):
+        assert version_resource(program / exe) == (windows_version(__version__), __version__, __version__), exe
     assert installed.prefix.reg_values(RUN_KEY) is None or "nfwserver" not in installed.prefix.reg_values(RUN_KEY)
 
 
@@ -144,6 +208,18 @@ def test_the_installed_configuration_serves_the_dashboard_on_loopback(installed:
     assert re.search(r"^enabled = true\b", web, re.M) and re.search(r'^host = "127\.0\.0\.1"', web, re.M)
 
 
+def test_an_environment_fact_is_shown_under_v_only(installed: Installed) -> None:
+    """Under Wine sgp4's compiled TLE reader is wrong and the program works around it: a fact the operator cannot
+    act on, so a command says it only with -v (it began every command's output as a warning)."""
+    quiet = installed.nfwserver("passes", "--hours", "1")
+    assert quiet.returncode == 0, quiet.stderr
+    assert "sgp4" not in quiet.stderr
+    verbose = installed.nfwserver("-v", "passes", "--hours", "1")
+    assert verbose.returncode == 0, verbose.stderr
+    notes = [line for line in verbose.stderr.splitlines() if "sgp4" in line]
+    assert len(notes) == 1 and notes[0].startswith("nfwserver: info: "), notes
+
+
 def test_the_installed_program_serves_ddeml_clients_and_stops_on_request(installed: Installed) -> None:
     station = installed.prefix.start([installed.exe, "run", "--headless"])
     try:
@@ -165,6 +241,7 @@ def test_the_installed_program_serves_ddeml_clients_and_stops_on_request(install
         assert station.wait(60) == 0  # a clean stop, not a kill
         log = (installed.user_files / "Logs" / "nfwserver.log").read_text(encoding="utf-8", errors="replace")
         assert "control file" in log and log.rstrip().endswith("stopped")
+        assert log.count("compiled TLE reader is wrong here") == 1  # the first run's log says it, once
         again = installed.nfwserver("stop")
         assert again.returncode == 1 and again.stdout == ""
         assert again.stderr.strip().endswith("no station is running for this user: nothing to stop")
@@ -172,6 +249,16 @@ def test_the_installed_program_serves_ddeml_clients_and_stops_on_request(install
         if station.poll() is None:
             station.kill()
             station.wait(30)
+
+
+def test_the_program_folder_holds_exactly_what_the_installer_put_there(installed: Installed) -> None:
+    """After the install's own `config init`, a station's run, `dashboard` and `stop`: nothing was written into
+    the program's folder (Python's byte-code cache is in the user's folder instead)."""
+    program = installed.prefix.unix(installed.folder)
+    expected = manifest()
+    expected["uninstall.exe"] = program_files(program).get("uninstall.exe", -1)
+    assert program_files(program) == expected
+    assert list((installed.user_files / "Cache" / "pycache").rglob("*.pyc"))
 
 
 def test_an_upgrade_keeps_the_users_files_and_restarts_a_station_started_at_logon(installed: Installed) -> None:
@@ -189,6 +276,11 @@ def test_an_upgrade_keeps_the_users_files_and_restarts_a_station_started_at_logo
         for path in planted:  # what an older version had and this one has not
             path.parent.mkdir(parents=True, exist_ok=True)
             path.write_text("# old\n")
+        program = installed.prefix.unix(installed.folder)
+        foreign = {"notes.txt": program / "notes.txt", "My rotor/setup.ini": program / "My rotor" / "setup.ini"}
+        for path in foreign.values():  # a user's files at the program folder's top
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text("mine\n")
         upgrade_started_ns = time.time_ns()
         assert installed.setup("/LOGON") == 0
         assert logon.wait(60) == 0  # the old station was stopped cleanly by the upgrade
@@ -203,6 +295,11 @@ def test_an_upgrade_keeps_the_users_files_and_restarts_a_station_started_at_logo
              120, "the upgraded station started again", interval_s=0.2, tolerate=(OSError,))
     assert config.read_text() == before
     assert not any(path.exists() for path in planted)  # nothing of the older program stays importable
+    expected = manifest()
+    expected["uninstall.exe"] = program_files(program).get("uninstall.exe", -1)
+    assert program_files(program) == expected  # exactly the new program
+    for name in foreign:  # the user's files, kept where docs/WINDOWS.md says
+        assert (installed.user_files / KEPT / name).read_text() == "mine\n", name
     assert json.loads(state.read_text())["satellite"] == 25544
     assert (installed.user_files / "Logs" / "nfwserver.log").is_file()
     stop = installed.nfwserver("stop")

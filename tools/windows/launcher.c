@@ -3,12 +3,15 @@
  * Each loads the embeddable CPython that sits beside it (python312.dll, its ._pth file naming the
  * standard library zip and Lib\site-packages) and runs `python -I -m nfwserver ARGS...` inside this
  * process, so the station shows as nfwserver.exe in the Task Manager and a console's Ctrl+C reaches
- * Python directly.  nfwserver.exe is a console program (the station's console, every command);
+ * Python directly.  Python's byte-code cache goes to the user's %LOCALAPPDATA%\nfwserver\Cache\pycache
+ * (-X pycache_prefix), never into the program's folder, which holds exactly what the installer put there
+ * (without a known LocalAppData folder, -B: no cache at all).  nfwserver.exe is a console program (the station's console, every command);
  * nfwserverw.exe is built with NFW_WINDOWLESS as a GUI-subsystem program with no console window (start at
  * logon, the Start-menu entries that need no terminal).  Built by tools/windows/build with mingw-w64.
  */
 #include <windows.h>
 #include <shellapi.h>
+#include <shlobj.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <wchar.h>
@@ -29,9 +32,30 @@ static int fail(const wchar_t *what, const wchar_t *detail)
     return 3;
 }
 
+/* FOLDERID_LocalAppData, {F1B32785-6FBA-4FCF-9D55-7B8E7F157091} (KnownFolders.h), written here: mingw-w64's
+ * libuuid would link 40 KB of every other GUID into each launcher. */
+static const GUID local_app_data = {0xF1B32785, 0x6FBA, 0x4FCF, {0x9D, 0x55, 0x7B, 0x8E, 0x7F, 0x15, 0x70, 0x91}};
+
+/* "pycache_prefix=<LocalAppData>\nfwserver\Cache\pycache" in `out`, or L"" when the folder is unknown. */
+static void pycache_option(wchar_t *out, size_t size)
+{
+    PWSTR local = NULL;
+    out[0] = 0;
+    if (SUCCEEDED(SHGetKnownFolderPath(&local_app_data, 0, NULL, &local)) && local != NULL)
+        _snwprintf(out, size - 1, L"pycache_prefix=%ls\\nfwserver\\Cache\\pycache", local);
+    out[size - 1] = 0;
+    CoTaskMemFree(local);
+}
+
 static int launch(void)
 {
-    static const wchar_t *const fixed[] = {L"-I", L"-m", L"nfwserver"};
+    static wchar_t pycache[32768 + 64];
+    pycache_option(pycache, sizeof pycache / sizeof pycache[0]);
+    const wchar_t *fixed[] = {L"-I", L"-X", pycache, L"-m", L"nfwserver"};
+    if (pycache[0] == 0) {
+        fixed[1] = L"-I";
+        fixed[2] = L"-B";
+    }
     const int nfixed = (int)(sizeof fixed / sizeof fixed[0]);
     wchar_t dll[32768];
     DWORD n = GetModuleFileNameW(NULL, dll, (DWORD)(sizeof dll / sizeof dll[0]));

@@ -7,11 +7,14 @@
 ; for a silent install.  An install over an earlier one stops its running station cleanly
 ; (`nfwserver stop`), replaces the program, keeps the user's configuration, state, logs and element store
 ; (they live in %LOCALAPPDATA%\nfwserver, never in the program's folder); one installed in another folder
-; is removed first.  With start at logon the station is started at the end, as the next logon would.  Exit
-; status: 0 done, 2 a folder holding someone else's files was refused, 3 a running station did not stop.
+; is removed first.  An upgrade leaves exactly the new program in its folder: the older program is removed by
+; its own uninstaller (which knows its files), and anything else at the folder's top (a user's file) is moved
+; to %LOCALAPPDATA%\nfwserver\Left in the program folder.  With start at logon the station is started at the
+; end, as the next logon would.  Exit status: 0 done, 2 a folder holding someone else's files was refused, 3 a
+; running station did not stop.
 ;
-; Defined by the build: VERSION, STAGE (the staged program folder), OUTFILE; included: size.nsh,
-; files.nsh, uninstall.nsh (tools/windows/stage.py).
+; Defined by the build: VERSION, VERSION_QUAD, STAGE (the staged program folder), OUTFILE; included: size.nsh,
+; files.nsh, uninstall.nsh, known.nsh (tools/windows/stage.py).
 
 Target amd64-unicode  ; the program is win_amd64, and a 64-bit setup also runs on a 64-bit-only Wine
 ManifestDPIAware true
@@ -31,6 +34,7 @@ CRCCheck on
 !define UNINST_KEY "Software\Microsoft\Windows\CurrentVersion\Uninstall\${PRODUCT}"
 !define RUN_KEY "Software\Microsoft\Windows\CurrentVersion\Run"
 !define MENU "$SMPROGRAMS\${PRODUCT}"
+!define KEPT "$LOCALAPPDATA\${PRODUCT}\Left in the program folder"
 
 Name "${PRODUCT} ${VERSION}"
 OutFile "${OUTFILE}"
@@ -103,6 +107,31 @@ VIAddVersionKey "LegalCopyright" "MIT licence"
   ${EndIf}
 !macroend
 
+; KeepForeignFiles: every top-level entry of $INSTDIR that is not the program's (known.nsh) is moved to ${KEPT}
+; (copied, then removed once the copy succeeded): after an upgrade the folder holds the new program only, and
+; nothing of the user's is lost.
+!macro KeepForeignFiles
+  FindFirst $R7 $R9 "$INSTDIR\*"
+  ${DoWhile} $R9 != ""
+    ${If} $R9 != "."
+    ${AndIf} $R9 != ".."
+      !include "known.nsh"
+      ${If} $R8 == "0"
+        DetailPrint "Moving $R9, which is not nfwserver's, to ${KEPT}"
+        CreateDirectory "${KEPT}"
+        ClearErrors
+        CopyFiles /SILENT "$INSTDIR\$R9" "${KEPT}"
+        ${IfNot} ${Errors}
+          RMDir /r "$INSTDIR\$R9"
+          Delete "$INSTDIR\$R9"
+        ${EndIf}
+      ${EndIf}
+    ${EndIf}
+    FindNext $R7 $R9
+  ${Loop}
+  FindClose $R7
+!macroend
+
 Function .onVerifyInstDir
   !insertmacro NotOurFolder
   ${If} $R1 == "1"
@@ -137,7 +166,18 @@ Section "nfwserver (required)" SecProgram
   ${EndIf}
   !insertmacro StopStation
   ; An upgrade replaces the whole program: what an older version had and this one does not must not stay
-  ; importable.  Only the program's own folders and files are removed (uninstall.nsh lists them).
+  ; importable.  The older version's uninstaller removes its files (its start-at-logon and Apps & features
+  ; entries are written again below); what is left and is not this program's is the user's (KeepForeignFiles).
+  ${If} ${FileExists} "$INSTDIR\uninstall.exe"
+    DetailPrint "Removing the installed version before installing ${VERSION}"
+    ExecWait '"$INSTDIR\uninstall.exe" /S _?=$INSTDIR' $0
+    ${If} $0 != 0
+      MessageBox MB_OK|MB_ICONSTOP "The installed version could not be removed (its station did not stop).$\r$\nStop it, then run this again." /SD IDOK
+      SetErrorLevel 3
+      Quit
+    ${EndIf}
+  ${EndIf}
+  !insertmacro KeepForeignFiles
   !include "uninstall.nsh"
   !include "files.nsh"
   SetOutPath "$INSTDIR"
