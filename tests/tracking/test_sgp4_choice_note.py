@@ -13,7 +13,7 @@ import sgp4.api
 from nfwserver.app import station as station_module
 from nfwserver.app.station import Station
 from nfwserver.clock import VirtualClock
-from nfwserver.config import parse_config
+from nfwserver.config.loader import parse_config
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.tracking.sgp4_selfcheck import Sgp4Choice, ensure_working_sgp4
 
