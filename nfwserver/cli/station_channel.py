@@ -185,6 +185,13 @@ class StationChannel:
         except (OSError, ValueError, KeyError, TypeError, AttributeError):
             return None
 
+    def serving(self) -> StationInfo | None:
+        """The running station's verified description once it is up (its addresses known), else None."""
+        if not self.running():
+            return None
+        info = self.info()
+        return info if info is not None and info.started and self.verified(info) else None
+
     def verified(self, info: StationInfo | None) -> bool:
         """Whether ``info`` describes the process holding this channel's lock: its start time is the one
         recorded and, where the system tells (Linux), it is the lock's holder."""

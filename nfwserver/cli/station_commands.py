@@ -32,7 +32,7 @@ import sys
 import time
 
 from nfwserver.cli.arguments import number_in
-from nfwserver.cli.errors import CliError, say
+from nfwserver.cli.errors import CliError, config_refused, say, say_last_good
 from nfwserver.cli.station_channel import StationChannel, StationInfo
 from nfwserver.cli.station_process import process_ended, process_start
 from nfwserver.storage import atomic_write_text
@@ -155,6 +155,9 @@ def run_dashboard(args: argparse.Namespace) -> int:
         raise CliError(f"the station has not finished starting after {args.wait:g} s; try again in a moment")
     if info is not None and not channel.verified(info):
         raise _not_the_station(channel, info)
+    problem = config_refused(None)
+    if problem is not None:
+        say_last_good(problem)
     if info is None or not info.web_url:
         raise CliError("the running station serves no web dashboard: `nfwserver config set web.enabled true` "
                        "turns it on (the station applies it at its next start)")
