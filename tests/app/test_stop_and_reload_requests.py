@@ -145,3 +145,38 @@ def test_a_reload_asked_for_while_the_station_starts_is_carried_out_once_it_is_u
         assert len([r for r in caplog.records if "reloading the configuration" in r.getMessage()]) == 2
     finally:
         station.stop()
+
+
+def test_a_request_withdrawn_before_the_station_removed_it_is_not_acted_on(tmp_path: Path, caplog) -> None:
+    """#42 item 12 (Windows' `stop`): a writer that gives up removes its request again; the station acts only on
+    a request it removed itself, so "withdrawn" is exactly true.  The interleaving is made real with a FIFO: the
+    station's read ends only when the writer closes it, and the writer removes the name first."""
+    path = tmp_path / "control"
+    got: list[str] = []
+    control = ControlFile(path, SystemClock(), lambda word, origin: got.append(word))
+    os.mkfifo(path)
+
+    def write_then_withdraw() -> None:
+        with open(path, "w") as fifo:
+            fifo.write("stop\n")
+            fifo.flush()
+            path.unlink()  # withdrawn after the station has it to read, before it could remove it
+
+    writer = threading.Thread(target=write_then_withdraw)
+    writer.start()
+    caplog.set_level(logging.INFO, logger="nfwserver")
+    assert control.check() is None  # one look: read "stop", found it gone
+    writer.join()
+    assert got == [] and "the request was withdrawn before it was read" in caplog.text
+
+
+def test_the_state_folders_control_file_is_watched_beside_the_environments(tmp_path: Path) -> None:
+    """The station always watches its state folder's `control` (where `stop` writes on Windows), also when
+    NFW_CONTROL_FILE names another file (the Wine launcher's)."""
+    named, own = tmp_path / "named", tmp_path / "control"
+    got: list[tuple[str, str]] = []
+    control = ControlFile(named, SystemClock(), lambda word, origin: got.append((word, origin)), also=own)
+    own.write_text("stop\n")
+    assert control.check() == "stop" and got == [("stop", f"control file {own}")] and not own.exists()
+    named.write_text("reload\n")
+    assert control.check() == "reload" and got[-1] == ("reload", f"control file {named}")
