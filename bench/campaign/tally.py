@@ -30,6 +30,7 @@ class Budget:
     hamlib_replies: int = 2400
     daemon_kills: int = 20  #: kills of both daemons together
     write_kills: int = 20  #: SIGKILLs of each writer (element store, state file)
+    stop_attacks: int = 10  #: rounds of each attack on `nfwserver stop` (start-up, forged description, suspended)
     realtime_s: float = 600.0
     seed: int = 2026
 
@@ -37,7 +38,7 @@ class Budget:
     def smoke(cls) -> Budget:
         """A few seconds of everything: for the test that keeps the campaign code working."""
         return cls(elements=40, updates=4, configs=60, pokes=60, datagrams=60, hamlib_replies=24,
-                   daemon_kills=1, write_kills=1, realtime_s=3.0)
+                   daemon_kills=1, write_kills=1, stop_attacks=1, realtime_s=3.0)
 
 
 @dataclass
