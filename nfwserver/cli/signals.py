@@ -16,7 +16,9 @@ number to a pipe: it takes no lock, so a signal arriving while the main thread h
 deadlock.  On POSIX the interpreter's own C-level handler writes it (``signal.set_wakeup_fd``), in whichever
 thread the system delivers the signal to: a Python handler runs only in the main thread, which may be waiting
 for minutes (a signal that arrives while the process is suspended by ``SIGSTOP`` goes to whichever thread runs
-first when it is continued).  The thread ``nfw-signals`` reads the pipe and calls the action;
+first when it is continued).  The interpreter writes there every signal that has a Python handler, also those of
+others (the console's ``SIGTSTP`` and ``SIGCONT``): only this table's are acted on.  The thread
+``nfw-signals`` reads the pipe and calls the action;
 :meth:`StationSignals.request` does the same for requests that arrive otherwise (the control file,
 :mod:`nfwserver.cli.control_file`).
 """
@@ -114,7 +116,9 @@ class StationSignals(ServiceThread):
                     sig = signal.Signals(signum)
                 except ValueError:
                     continue
-                self.request(self.actions.get(sig, STOP), sig.name)
+                action = self.actions.get(sig)  # None: another handler's signal (the console's SIGTSTP, SIGCONT)
+                if action is not None:
+                    self.request(action, sig.name)
 
     def request(self, action: str, origin: str) -> None:
         """Carry out ``action`` (:data:`STOP` or :data:`RELOAD`) asked for by ``origin`` (any thread)."""

@@ -54,6 +54,36 @@ def test_real_signals_become_one_stop_and_reloads_and_later_ones_are_only_noted(
             signal.signal(sig, handler)
 
 
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_signals_handled_by_others_are_not_requests_and_any_thread_may_take_ours() -> None:
+    """The wakeup descriptor carries every signal with a Python handler: the console's own (Textual handles
+    SIGTSTP and SIGCONT: Ctrl+Z, fg) must not stop the station.  A SIGTERM the system hands to another thread
+    than the main one is acted on while the main thread waits (as the station's does, for minutes); before, it
+    waited for the main thread's next bytecode (a station suspended and continued kept running)."""
+    saved = {sig: signal.getsignal(sig) for sig in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP, signal.SIGCONT)}
+    calls: list[str] = []
+    stopped = threading.Event()
+    signals = StationSignals(signal_actions(headless=True), lambda: (calls.append("stop"), stopped.set()),
+                             lambda: calls.append("reload"))
+    try:
+        assert signals.install()
+        signal.signal(signal.SIGCONT, lambda *_: None)  # as the console's driver does
+        os.kill(os.getpid(), signal.SIGCONT)
+        os.kill(os.getpid(), signal.SIGHUP)
+        assert wait_for(lambda: calls == ["reload"])  # the SIGCONT before it asked for nothing
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})  # so another thread (nfw-signals) takes it
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+            assert stopped.wait(5.0)  # the main thread blocked in a wait, as the station's
+        finally:
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
+        assert calls == ["reload", "stop"]
+    finally:
+        signals.close()
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)
+
+
 def test_off_the_main_thread_nothing_is_installed() -> None:
     result: list[bool] = []
     signals = StationSignals(signal_actions(headless=True), lambda: None, lambda: None)
