@@ -184,6 +184,9 @@ def test_status_and_poke_reach_the_station_while_its_configuration_file_is_broke
     poke = _cli(tmp_path, "poke", "TRACK OFF")
     assert poke.returncode == 0 and poke.stdout == "OK\n" and poke.stderr.splitlines() == lines
     assert st.status()["track"] == "off"
+    dashboard = _cli(tmp_path, "dashboard", "--print")  # this station serves no web page: it says so, and the same line
+    assert dashboard.returncode == 1 and "serves no web dashboard" in dashboard.stderr
+    assert dashboard.stderr.splitlines()[0] == lines[0]
 
 
 def test_a_second_run_is_refused_before_it_reads_its_configuration(station, tmp_path) -> None:
