@@ -47,7 +47,7 @@ def run_campaign(budget: Budget, workdir: Path, progress: Callable[[str], None] 
            lambda t: write_kills.run_store_kills(t, budget.write_kills, seed, workdir))
     family("SIGKILL during state-file writes",
            lambda t: write_kills.run_state_kills(t, budget.write_kills, seed, workdir))
-    family("nfwserver stop: during start-up, forged description, suspended station",
+    family("nfwserver stop: during start-up, forged description, suspended station, full disk",
            lambda t: stop_attacks.run_stop_attacks(t, budget.stop_attacks, seed, workdir))
     station_dir = workdir / "station"
     station_dir.mkdir(exist_ok=True)

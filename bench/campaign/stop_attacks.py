@@ -6,15 +6,17 @@
 - **forged description**: ``station.json`` rewritten to name a live ``sleep`` (its true start time) and a file as
   the control file; ``stop`` must signal no one and write nothing, and the station must run on;
 - **suspended**: the station stopped with ``SIGSTOP``; ``stop --timeout 0.5`` must exit 3, and the station, once
-  continued, must stop cleanly as the sentence says.
+  continued, must stop cleanly as the sentence says;
+- **full disk**: the state folder on a 1 MiB tmpfs written full while the station runs; ``stop`` must stop it
+  (exit 0, the station's exit 0).  Needs the right to mount (root); otherwise noted and not counted.
 
 Data lost counts every broken promise: a file written, a process signalled, a station left running after a
-``stop`` that said it was stopped, or not stopped after a sentence that said it would be.  The full-disk case
-needs a mount (tests/app/test_stop_hostile.py has it).
+``stop`` that said it was stopped, or not stopped after a sentence that said it would be.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import random
@@ -144,7 +146,34 @@ def _suspended(tally: Tally, home: _Home, rng: random.Random) -> None:
             proc.wait(10)
 
 
-ATTACKS = (_during_start, _forged, _suspended)
+def _full_disk(tally: Tally, home: _Home, rng: random.Random) -> bool:
+    """The full-disk round; False when no tmpfs could be mounted (the round is then not counted)."""
+    state = home.where / "state"
+    state.mkdir(parents=True, exist_ok=True)
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=1m", "tmpfs", str(state)], capture_output=True,
+                      check=False).returncode != 0:
+        tally.note("full disk: no tmpfs could be mounted here; not run")
+        return False
+    try:
+        proc = home.run()
+        if not home.started(proc):
+            tally.loss("the station did not start")
+        else:
+            with contextlib.suppress(OSError), open(state / "filler", "wb", buffering=0) as filler:
+                while True:
+                    filler.write(b"\0" * rng.choice((4096, 65536)))
+            result = home.stop()
+            if result.returncode != 0 or _ended(proc, 10.0) != 0:
+                tally.loss(f"full disk: stop exit {result.returncode}: {result.stderr.strip()}")
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(10)
+    finally:
+        subprocess.run(["umount", "-l", str(state)], check=False)
+    return True
+
+
+ATTACKS = (_during_start, _forged, _suspended, _full_disk)
 
 
 def run_stop_attacks(tally: Tally, rounds: int, seed: int, workdir: Path) -> None:
@@ -156,5 +185,5 @@ def run_stop_attacks(tally: Tally, rounds: int, seed: int, workdir: Path) -> Non
     for k in range(rounds * len(ATTACKS)):
         attack = ATTACKS[k % len(ATTACKS)]
         home = _Home(workdir / f"stop-{k}")
-        attack(tally, home, rng)
-        tally.tried += 1
+        if attack(tally, home, rng) is not False:
+            tally.tried += 1
