@@ -34,6 +34,12 @@ def _channel(home: Path) -> StationChannel:
     return StationChannel(home / "state" / "nfwserver")
 
 
+def _described_up(st: test_run_signals.Station) -> None:
+    """Wait until the serving station has also described itself as up (just after its TCP port answers)."""
+    st.wait_serving()
+    wait_for(lambda: _channel(st.home).serving() is not None, 30.0, "the station's description")
+
+
 @contextlib.contextmanager
 def _opened(path: Path) -> Iterator[int]:
     """An inotify descriptor that becomes readable when ``path`` is next opened (Linux)."""
@@ -126,7 +132,7 @@ def test_a_forged_description_makes_stop_write_and_signal_nothing(station, tmp_p
     overwrite as the control file: ``stop`` signals no one and writes nothing, and says why in one sentence
     (before: that file was replaced with "stop")."""
     st = station()
-    st.wait_serving()
+    _described_up(st)  # else its own description, written once up, could replace the forged one
     victim = tmp_path / "precious.txt"
     victim.write_text("the operator's notes\n")
     sleeper = subprocess.Popen(["sleep", "60"])
@@ -172,7 +178,7 @@ def test_status_and_poke_reach_the_station_while_its_configuration_file_is_broke
     syntax error in the file; they say in one line what is wrong and that the station runs on its last good
     configuration (before: "configuration refused", exit 1)."""
     st = station()
-    st.wait_serving()
+    _described_up(st)
     st.config.write_text(st.config.read_text() + "[tcp\n")
     status = _cli(tmp_path, "status")
     assert status.returncode == 0, status.stderr
