@@ -48,6 +48,8 @@ def station_address(args: argparse.Namespace) -> tuple[str, int]:
     from nfwserver.cli.station_channel import StationChannel
     from nfwserver.tcp.client import connect_host
 
+    if args.host and args.port:  # both given: neither the file nor the channel is asked
+        return args.host, int(args.port)
     problem = config_refused(args.config)
     info = StationChannel().serving() if problem is not None or not args.config else None
     if info is not None and info.tcp is not None:
