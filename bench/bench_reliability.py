@@ -20,7 +20,7 @@ from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
-from bench.campaign import fault_families, input_families, realtime, tcp_attacks, write_kills
+from bench.campaign import fault_families, input_families, realtime, stop_attacks, tcp_attacks, write_kills
 from bench.campaign.station_rig import StationRig, hamlib_available
 from bench.campaign.tally import Budget, Tally, run_family
 
@@ -47,6 +47,8 @@ def run_campaign(budget: Budget, workdir: Path, progress: Callable[[str], None] 
            lambda t: write_kills.run_store_kills(t, budget.write_kills, seed, workdir))
     family("SIGKILL during state-file writes",
            lambda t: write_kills.run_state_kills(t, budget.write_kills, seed, workdir))
+    family("nfwserver stop: during start-up, forged description, suspended station, full disk",
+           lambda t: stop_attacks.run_stop_attacks(t, budget.stop_attacks, seed, workdir))
     station_dir = workdir / "station"
     station_dir.mkdir(exist_ok=True)
     with StationRig(station_dir) as rig:
@@ -103,8 +105,8 @@ def main(argv: list[str] | None = None) -> int:
     budget = Budget(seed=args.seed)
     if args.quick:
         budget = replace(budget, elements=500, updates=30, configs=500, pokes=500, datagrams=500,
-                         hamlib_replies=120, daemon_kills=2, write_kills=2, realtime_s=30.0, http_requests=300,
-                         lockout_rounds=6)
+                         hamlib_replies=120, daemon_kills=2, write_kills=2, stop_attacks=2, realtime_s=30.0,
+                         http_requests=300, lockout_rounds=6)
     if args.minutes is not None:
         budget = replace(budget, realtime_s=args.minutes * 60.0)
     started = time.monotonic()

@@ -30,6 +30,7 @@ class Budget:
     hamlib_replies: int = 2400
     daemon_kills: int = 20  #: kills of both daemons together
     write_kills: int = 20  #: SIGKILLs of each writer (element store, state file)
+    stop_attacks: int = 10  #: rounds of each attack on `nfwserver stop` (start-up, forged description, suspended)
     realtime_s: float = 600.0
     http_requests: int = 2000  #: web pages' requests to the TCP port (cross-protocol)
     lockout_rounds: int = 20  #: questions of the operator's status per crowd
@@ -39,7 +40,7 @@ class Budget:
     def smoke(cls) -> Budget:
         """A few seconds of everything: for the test that keeps the campaign code working."""
         return cls(elements=40, updates=4, configs=60, pokes=60, datagrams=60, hamlib_replies=24,
-                   daemon_kills=1, write_kills=1, realtime_s=3.0, http_requests=20, lockout_rounds=2)
+                   daemon_kills=1, write_kills=1, stop_attacks=1, realtime_s=3.0, http_requests=20, lockout_rounds=2)
 
 
 @dataclass

@@ -1,7 +1,10 @@
 """``nfwserver poke TEXT`` and ``nfwserver status``: control a running station over its TCP port.
 
-Host and port come from the configuration's ``[tcp]`` section (``--config`` honoured; ``--host`` and
-``--port`` override), so a second terminal or a cron job can switch a headless station:
+Host and port are where this user's running station says it listens (its channel,
+:mod:`nfwserver.cli.station_channel`), so these commands reach it whatever state the configuration file is in
+(a file it refuses is named in one warning line); with no station described, or with ``--config``, they come
+from the configuration's ``[tcp]`` section; ``--host`` and ``--port`` override.  So a second terminal or a cron
+job can switch a headless station:
 ``nfwserver poke "TRACK ON"`` (``nfwserver watch``, :mod:`nfwserver.cli.watch_command`, shows it live).
 The reply goes to stdout; ``ERROR ...`` replies and an unreachable station are one sentence on stderr with exit code 1.
 """
@@ -11,7 +14,7 @@ from __future__ import annotations
 import argparse
 
 from nfwserver.cli.arguments import number_in
-from nfwserver.cli.errors import CliError, load_config_or_fail, say
+from nfwserver.cli.errors import CliError, config_refused, load_config_or_fail, say, say_last_good
 
 
 def add_station_options(p: argparse.ArgumentParser) -> None:
@@ -40,11 +43,25 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
 
 
 def station_address(args: argparse.Namespace) -> tuple[str, int]:
-    """Host and port of the station: ``--host``/``--port``, else the configuration's ``[tcp]``."""
+    """Host and port of the station: ``--host``/``--port``, else the running station's own description
+    (unless ``--config`` names a file that loads), else the configuration's ``[tcp]``."""
+    from nfwserver.cli.station_channel import StationChannel
     from nfwserver.tcp.client import connect_host
 
-    config = load_config_or_fail(args.config)
-    return args.host or connect_host(config.tcp.host), int(args.port or config.tcp.port)
+    if args.host and args.port:  # both given: neither the file nor the channel is asked
+        return args.host, int(args.port)
+    problem = config_refused(args.config)
+    info = StationChannel().serving() if problem is not None or not args.config else None
+    if info is not None and info.tcp is not None:
+        if problem is not None:
+            say_last_good(problem)
+        host, port = info.tcp
+    elif problem is not None:
+        raise problem  # no station to fall back on: the file's problem is the answer
+    else:
+        config = load_config_or_fail(args.config)
+        host, port = connect_host(config.tcp.host), config.tcp.port
+    return args.host or host, int(args.port or port)
 
 
 def _ask(args: argparse.Namespace, line: str, until: str | None = None) -> str:

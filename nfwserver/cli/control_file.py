@@ -7,9 +7,9 @@ saved, DDE clients never told), and Windows has no ``SIGHUP``.  So when the envi
 ``stop`` stops the station as ``SIGTERM`` does, ``reload`` re-reads the configuration as ``SIGHUP`` does.
 Anything else gets one warning and is removed.  ``tools/wine/nfwserver`` sets the variable and writes
 ``stop`` when it receives ``SIGTERM``, ``SIGINT`` or ``SIGHUP`` (``reload`` on ``SIGUSR1``); on Windows
-a service wrapper can do the same.  Without the variable, ``run`` watches ``control`` in the user's state
-directory and says so in its description (:mod:`nfwserver.cli.station_channel`), which is how
-``nfwserver stop`` reaches it.  Writers should write another name and rename it into place, so that the
+a service wrapper can do the same.  Besides that file, ``run`` always watches ``control`` in the user's
+state directory (:mod:`nfwserver.cli.station_channel`), which is how ``nfwserver stop`` reaches it on
+Windows.  Writers should write another name and rename it into place, so that the
 station never reads half a word (an empty file is left alone until it has a word).
 
 Owned by its own thread, ``nfw-control``; it waits on the injected clock.
@@ -42,46 +42,58 @@ def control_path(environ: dict[str, str] | None = None) -> Path | None:
 
 
 class ControlFile(ServiceThread):
-    """Calls ``request(word, origin)`` for each word written to ``path`` (see the module docstring)."""
+    """Calls ``request(word, origin)`` for each word written to ``path`` or ``also`` (see the module docstring)."""
 
     thread_name = "nfw-control"
 
     def __init__(self, path: Path, clock: Clock, request: Callable[[str, str], None],
-                 interval_s: float = POLL_S, each_look: Callable[[], None] | None = None) -> None:
+                 interval_s: float = POLL_S, each_look: Callable[[], None] | None = None,
+                 also: Path | None = None) -> None:
         super().__init__()
         self.path = path
+        self.paths = (path,) if also is None or also == path else (path, also)  #: every file watched
         self.clock = clock
         self.request = request
         self.interval_s = interval_s
         self.each_look = each_look  #: also called at every look (the station's description, written again)
 
     def start(self) -> None:
-        """Remove a file left by an earlier run (it was meant for that run), then watch."""
-        try:
-            self.path.unlink()
-            log.info("removed %s, left by an earlier run", self.path)
-        except OSError:
-            pass
+        """Remove files left by an earlier run (they were meant for that run), then watch."""
+        for path in self.paths:
+            try:
+                path.unlink()
+                log.info("removed %s, left by an earlier run", path)
+            except OSError:
+                pass
         super().start()
 
     def check(self) -> str | None:
-        """One look: the word found (and acted on), or None."""
+        """One look at each file: the last word found (and acted on), or None."""
+        found = None
+        for path in self.paths:
+            found = self._check(path) or found
+        return found
+
+    def _check(self, path: Path) -> str | None:
         try:
-            text = self.path.read_text(encoding="ascii", errors="replace")
+            text = path.read_text(encoding="ascii", errors="replace")
         except OSError:
             return None  # absent (the usual case) or not readable yet
         words = text.split()
         if not words:
             return None  # being written: the next look reads it
         try:
-            self.path.unlink()
+            path.unlink()
+        except FileNotFoundError:  # its writer took it back (`nfwserver stop` giving up) before this look
+            log.info("control file %s: the request was withdrawn before it was read", path)
+            return None
         except OSError as exc:
-            log.warning("cannot remove the control file %s: %s", self.path, exc.strerror or exc)
+            log.warning("cannot remove the control file %s: %s", path, exc.strerror or exc)
         word = words[0].lower()
         if word not in WORDS:
-            log.warning("control file %s: %r is not a request (stop or reload); ignored", self.path, words[0][:40])
+            log.warning("control file %s: %r is not a request (stop or reload); ignored", path, words[0][:40])
             return None
-        self.request(word, f"control file {self.path}")
+        self.request(word, f"control file {path}")
         return word
 
     def _run(self) -> None:

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from nfwserver.config.schema import Config
 
-__all__ = ["CliError", "load_config_or_fail", "say"]
+__all__ = ["CliError", "config_refused", "load_config_or_fail", "say"]
 
 
 class CliError(Exception):
@@ -36,3 +36,18 @@ def load_config_or_fail(path: str | None) -> Config:
         return load_config(path)
     except ConfigError as exc:
         raise CliError(f"configuration refused: {exc}") from None
+
+
+def config_refused(path: str | None) -> CliError | None:
+    """Why the configuration at ``path`` (None: the default file) is refused, or None when it loads: for the
+    commands that reach a running station, which runs on its last good configuration whatever the file says."""
+    try:
+        load_config_or_fail(path)
+    except CliError as exc:
+        return exc
+    return None
+
+
+def say_last_good(problem: CliError) -> None:
+    """The one warning line of a command that reached the running station although its file is refused."""
+    say(f"warning: {problem}; the running station runs on its last good configuration")

@@ -89,18 +89,25 @@ class RunPlan:
 
 
 def run(args: argparse.Namespace) -> int:
-    from nfwserver.config.files import default_config_path
-
-    config = load_config_or_fail(args.config)
+    """The station's lock is the first thing taken (:func:`_open_channel`), before the configuration is read or
+    anything heavy is loaded: a second ``run`` is refused at once, and a ``stop`` finds a station that is still
+    starting."""
     if args.duration is not None and not args.duration > 0:
         raise CliError("--duration must be positive")
-    if getattr(args, "web", False) and not config.web.enabled:
-        config = with_web(config)
     plan = RunPlan(console=sys.stdout.isatty() and not args.headless,
                    log_file=Path(args.log_file) if args.log_file else default_log_file(), duration_s=args.duration)
-    # The station follows the file it loaded, with or without --config; with none yet, the file `config init`
-    # or `config set` would create, so a station started on built-in defaults takes it when it appears.
-    return serve(config, plan, watch=config.path or str(default_config_path()))
+    opened = _open_channel(plan, SystemClock())
+    try:
+        from nfwserver.config.files import default_config_path
+
+        config = load_config_or_fail(args.config)
+        if getattr(args, "web", False) and not config.web.enabled:
+            config = with_web(config)
+        # The station follows the file it loaded, with or without --config; with none yet, the file `config init`
+        # or `config set` would create, so a station started on built-in defaults takes it when it appears.
+        return serve(config, plan, watch=config.path or str(default_config_path()), opened=opened)
+    finally:
+        opened.close()
 
 
 def with_web(config: Config) -> Config:
@@ -195,9 +202,70 @@ def _claim_channel(plan: RunPlan) -> StationChannel | None:
         raise CliError(f"cannot use {channel.lock_path}: {exc.strerror or exc}") from None
     if not claimed:
         info = channel.info()
-        who = f" (process {info.pid})" if info is not None else ""
+        who = f" (process {info.pid})" if info is not None and channel.verified(info) else ""
         raise CliError(f"a station is already running for this user{who}: `nfwserver stop` stops it")
     return channel
+
+
+@dataclass
+class _OpenChannel:
+    """What a run takes before anything else and holds to its end: the user's station lock, the signal handlers
+    and the control file's watcher (none of them when the caller stops the run itself, ``plan.stop``)."""
+
+    requests: _Requests
+    channel: StationChannel | None
+    signals: StationSignals | None
+    control: ControlFile | None
+
+    def describe(self, station: Station | None = None) -> None:
+        """Say who runs (and, with ``station``, that it is up and where it listens) in the channel."""
+        from nfwserver.cli.station_process import process_start
+
+        if self.channel is None:
+            return
+        pid = os.getpid()
+        if station is None:
+            self.channel.describe(StationInfo(pid, process_start(pid)))
+        else:
+            self.channel.describe(StationInfo(pid, process_start(pid), _browser_url(station), started=True,
+                                              tcp=_tcp_address(station)))
+
+    def close(self) -> None:
+        """Stop watching, restore the signals, free the lock (once the station has stopped)."""
+        control, self.control = self.control, None
+        signals, self.signals = self.signals, None
+        channel, self.channel = self.channel, None
+        if control is not None:
+            control.stop()
+        if signals is not None:
+            signals.close()
+        if channel is not None:
+            channel.release()
+
+
+def _open_channel(plan: RunPlan, clock: Clock) -> _OpenChannel:
+    """Claim the channel, then listen for requests (:func:`_listen`) and describe the station as starting."""
+    requests = _Requests(plan.stop or threading.Event())
+    channel = _claim_channel(plan)
+    try:
+        signals, control = _listen(plan, requests, clock, channel)
+    except BaseException:
+        if channel is not None:
+            channel.release()
+        raise
+    opened = _OpenChannel(requests, channel, signals, control)
+    opened.describe()
+    return opened
+
+
+def _tcp_address(station: Station) -> tuple[str, int] | None:
+    """Where a client on this machine reaches the station's TCP port (a wildcard host is reached on loopback)."""
+    from nfwserver.tcp.client import connect_host
+
+    if station.tcp is None or station.tcp.address is None:
+        return None
+    host, port = station.tcp.address
+    return connect_host(str(host)), int(port)
 
 
 def _browser_url(station: Station) -> str | None:
@@ -213,37 +281,36 @@ def _browser_url(station: Station) -> str | None:
 def _listen(plan: RunPlan, requests: _Requests, clock: Clock,
             channel: StationChannel | None) -> tuple[StationSignals | None, ControlFile | None]:
     """Signal handlers and the control file's watcher, unless the caller stops the run itself (``plan.stop``).
-    The control file is NFW_CONTROL_FILE's or the channel's; the channel then says where it is."""
+    The control file is NFW_CONTROL_FILE's or the channel's; the channel's is watched in any case."""
     if plan.stop is not None:
         return None, None
     signals = StationSignals(signal_actions(headless=not plan.console), requests.on_stop, requests.on_reload)
     signals.install()
-    path = control_path() or (channel.default_control if channel is not None else None)
+    own = channel.default_control if channel is not None else None
+    path = control_path() or own
     again = channel.describe_again if channel is not None else None
-    control = ControlFile(path, clock, signals.request, each_look=again) if path is not None else None
+    control = ControlFile(path, clock, signals.request, each_look=again, also=own) if path is not None else None
     if control is not None:
         control.start()
-    if channel is not None and control is not None:
-        channel.describe(StationInfo(os.getpid(), control.path))
     return signals, control
 
 
-def serve(config: Config, plan: RunPlan, watch: str | None = None) -> int:
+def serve(config: Config, plan: RunPlan, watch: str | None = None, opened: _OpenChannel | None = None) -> int:
     """Start the station from ``config``, run it as ``plan`` says, stop it; the exit code.
 
     Without ``plan.stop``, signals and the control file stop it or reload its configuration
-    (:mod:`nfwserver.cli.signals`), from before the station starts until it has stopped."""
+    (:mod:`nfwserver.cli.signals`), from before the station starts until it has stopped; ``opened`` is the
+    channel ``run`` claimed before reading the configuration (claimed here without it).  A stop asked for while
+    the station starts is carried out once it has started."""
     from nfwserver.app.station import Station
     from nfwserver.cli.log_file import LOG_BACKOFF
 
     clock = plan.clock or SystemClock()
-    stop = plan.stop or threading.Event()
-    requests = _Requests(stop)
-    channel = _claim_channel(plan)
-    signals, control = None, None
+    own = opened is None
+    channel = opened if opened is not None else _open_channel(plan, clock)
+    requests = channel.requests
     file_handler = None
     try:
-        signals, control = _listen(plan, requests, clock, channel)
         if not plan.console:
             file_handler = _log_to_file(plan.log_file, clock)
             say(f"logging to {plan.log_file}")
@@ -256,25 +323,20 @@ def serve(config: Config, plan: RunPlan, watch: str | None = None) -> int:
             station.stop()
             raise CliError(f"cannot start the station: {exc.strerror or exc}") from None
         requests.station_started(station)
-        if channel is not None and control is not None:
-            channel.describe(StationInfo(os.getpid(), control.path, _browser_url(station), started=True))
+        channel.describe(station)
         try:
             file_handler = _serve_started(station, config, plan, watch, requests, file_handler)
         finally:
-            if signals is not None:
-                signals.stopping()  # no reload from here on; a further stop request is only noted
+            if channel.signals is not None:
+                channel.signals.stopping()  # no reload from here on; a further stop request is only noted
             station.stop()
             log.info("stopped")
     finally:
-        if control is not None:
-            control.stop()
-        if signals is not None:
-            signals.close()
         if file_handler is not None:
             logging.getLogger().removeHandler(file_handler)
             file_handler.close()
-        if channel is not None:
-            channel.release()
+        if own:
+            channel.close()
     return 0
 
 

@@ -13,8 +13,14 @@ What each signal does (README, "Running as a service"):
 The handlers are installed before the station starts, so a signal during start-up is a request like
 any other: the station finishes starting and then stops cleanly.  A handler only writes the signal's
 number to a pipe: it takes no lock, so a signal arriving while the main thread holds one cannot
-deadlock.  The thread ``nfw-signals`` reads the pipe and calls the action; :meth:`StationSignals.request`
-does the same for requests that arrive otherwise (the control file, :mod:`nfwserver.cli.control_file`).
+deadlock.  On POSIX the interpreter's own C-level handler writes it (``signal.set_wakeup_fd``), in whichever
+thread the system delivers the signal to: a Python handler runs only in the main thread, which may be waiting
+for minutes (a signal that arrives while the process is suspended by ``SIGSTOP`` goes to whichever thread runs
+first when it is continued).  The interpreter writes there every signal that has a Python handler, also those of
+others (the console's ``SIGTSTP`` and ``SIGCONT``): only this table's are acted on.  The thread
+``nfw-signals`` reads the pipe and calls the action;
+:meth:`StationSignals.request` does the same for requests that arrive otherwise (the control file,
+:mod:`nfwserver.cli.control_file`).
 """
 
 from __future__ import annotations
@@ -22,6 +28,7 @@ from __future__ import annotations
 import logging
 import os
 import signal
+import sys
 import threading
 from collections.abc import Callable
 from typing import Any
@@ -68,16 +75,27 @@ class StationSignals(ServiceThread):
         self._lock = threading.Lock()
         self._stopping = False
         self._read_fd, self._write_fd = os.pipe()
+        self._wakeup = False  #: the interpreter writes the signals to the pipe itself (POSIX)
         self.start()  # reads the pipe the handlers write to, from now on
 
     def install(self) -> bool:
         """Install the handlers; False (nothing installed) off the main thread, as when embedded."""
         if threading.current_thread() is not threading.main_thread():
             return False
+        handler: Callable[[int, Any], None] = self._handler
+        if sys.platform != "win32":  # Windows takes only a socket there (and runs its handlers in the main thread)
+            os.set_blocking(self._write_fd, False)
+            signal.set_wakeup_fd(self._write_fd, warn_on_full_buffer=False)
+            self._wakeup = True
+            handler = self._noted
         for sig in self.actions:
-            signal.signal(sig, self._handler)
+            signal.signal(sig, handler)
             self._installed.append(sig)
         return True
+
+    @staticmethod
+    def _noted(_signum: int, _frame: Any) -> None:
+        """The Python-level handler where the wakeup descriptor has already passed the signal on."""
 
     def _handler(self, signum: int, _frame: Any) -> None:
         try:
@@ -98,7 +116,9 @@ class StationSignals(ServiceThread):
                     sig = signal.Signals(signum)
                 except ValueError:
                     continue
-                self.request(self.actions.get(sig, STOP), sig.name)
+                action = self.actions.get(sig)  # None: another handler's signal (the console's SIGTSTP, SIGCONT)
+                if action is not None:
+                    self.request(action, sig.name)
 
     def request(self, action: str, origin: str) -> None:
         """Carry out ``action`` (:data:`STOP` or :data:`RELOAD`) asked for by ``origin`` (any thread)."""
@@ -130,6 +150,9 @@ class StationSignals(ServiceThread):
         for sig in self._installed:
             signal.signal(sig, signal.SIG_IGN)
         self._installed.clear()
+        if self._wakeup:
+            signal.set_wakeup_fd(-1)
+            self._wakeup = False
         os.close(self._write_fd)  # the thread reads the end of the pipe and returns
         self.stop()
         os.close(self._read_fd)

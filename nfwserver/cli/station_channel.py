@@ -1,16 +1,21 @@
 """The running station's local channel: one station per user, found and stopped by ``nfwserver stop``.
 
-A station started by ``nfwserver run`` holds an exclusive lock on ``station.lock`` in the user's state
-directory (``nfwserver config path`` names the configuration's; this is the state directory beside the
-saved state) for as long as it runs, and describes itself in ``station.json`` beside it: its process id,
-the control file it watches (:mod:`nfwserver.cli.control_file`; ``control`` in the same directory unless
-``NFW_CONTROL_FILE`` names another) and, once serving, its web dashboard's address.  The operating system
-releases the lock when the process ends, however it ends, so a station killed outright never leaves a
-"running" station behind: the lock, not the description, says whether one runs.
+A station started by ``nfwserver run`` takes an exclusive lock on ``station.lock`` in the user's state
+directory first of all (before it reads its configuration or loads anything heavy) and holds it for as long as
+it runs.  It describes itself in ``station.json`` beside it: its process id and start time
+(:mod:`nfwserver.cli.station_process`), and, once serving, where it listens (its TCP port, its web dashboard's
+address).  The operating system releases the lock when the process ends,
+however it ends, so a station killed outright never leaves a "running" station behind: the lock, not the
+description, says whether one runs, and a description is believed only about a process it can verify
+(:meth:`StationChannel.verified`).  The description never says where to write: the station's control file is
+always ``control`` in this same directory (:attr:`StationChannel.default_control`), whatever ``station.json``
+holds, so a forged description can make no command write elsewhere.
 
-``nfwserver stop`` writes ``stop`` to the control file and waits until the lock is free;
-``nfwserver dashboard`` opens the address.  A second ``nfwserver run`` of the same user while one runs is
-refused, naming the running one: two stations would offer the same DDE service names and ports.
+``nfwserver stop`` signals the verified process (Linux) or writes ``stop`` to the control file (Windows) and
+waits until the lock is free; ``nfwserver dashboard``, ``status``, ``poke`` and ``watch`` find the station's
+addresses here, whatever state the configuration file is in.  A second ``nfwserver run`` of the same user
+while one runs is refused at once, naming the running one: two stations would offer the same DDE service
+names and ports.
 
 The lock is :mod:`nfwserver.file_lock`'s (``fcntl.flock`` on Linux, ``msvcrt.locking`` of one byte on
 Windows), held here for the whole run; the system releases it at process exit.
@@ -33,7 +38,8 @@ log = logging.getLogger(__name__)
 LOCK_NAME = "station.lock"
 INFO_NAME = "station.json"
 CONTROL_NAME = "control"
-#: How long a station starting up retries the lock (a ``stop`` or ``status`` probing it holds it briefly).
+#: How long a station starting up retries the lock (a ``stop`` or ``status`` probing it holds it for an instant);
+#: not at all when the description names a verified running station.
 CLAIM_RETRY_S = 1.0
 
 
@@ -81,9 +87,10 @@ class StationInfo:
     """What a running station says of itself in ``station.json``."""
 
     pid: int
-    control: Path  #: the control file it watches
+    start: int | None = None  #: its process start time (:func:`~nfwserver.cli.station_process.process_start`)
     web_url: str | None = None  #: its dashboard's address, once it serves one
-    started: bool = False  #: the station is up (until then ``web_url`` is not known yet)
+    started: bool = False  #: the station is up (until then its addresses are not known yet)
+    tcp: tuple[str, int] | None = None  #: where a client on this machine reaches its TCP port, once it serves one
 
 
 class StationChannel:
@@ -103,11 +110,13 @@ class StationChannel:
 
     # -- the station's side ---------------------------------------------------------------------------
     def claim(self, retry_s: float = CLAIM_RETRY_S) -> bool:
-        """Take the lock for this process (retrying ``retry_s`` seconds, for a prober's brief hold), and remove
-        a description left by a station that was killed (a ``stop`` must never read that one's)."""
+        """Take the lock for this process, and remove a description left by a station that was killed (a
+        ``stop`` must never read that one's).  False at once when the lock is held by the station the
+        description names (verified); otherwise the lock is retried for ``retry_s`` seconds, for a prober's
+        brief hold or a station that has not described itself yet."""
         deadline = time.monotonic() + retry_s
         while not self._lock.try_acquire():
-            if time.monotonic() >= deadline:
+            if time.monotonic() >= deadline or self.verified(self.info()):
                 return False
             time.sleep(0.05)
         with contextlib.suppress(OSError):
@@ -118,7 +127,8 @@ class StationChannel:
         """Write ``station.json`` (atomically); only while this process holds the lock.  On Windows the
         replace fails while a reader has the old file open: it is tried again for up to a second."""
         self._description = info
-        record = {"pid": info.pid, "control": str(info.control), "web": info.web_url, "started": info.started}
+        record = {"pid": info.pid, "start": info.start, "web": info.web_url, "started": info.started,
+                  "tcp": list(info.tcp) if info.tcp is not None else None}
         problem: OSError | None = None
         for _ in range(20):
             try:
@@ -164,11 +174,30 @@ class StationChannel:
         return True
 
     def info(self) -> StationInfo | None:
-        """The running station's description, or None (none running, or not written yet)."""
+        """The running station's description as written, or None (none running, not written yet, or not one);
+        :meth:`verified` says whether it is the running station's."""
         try:
             record = json.loads(self.info_path.read_text(encoding="utf-8"))
-            web = record.get("web")
-            return StationInfo(int(record["pid"]), Path(str(record["control"])), str(web) if web else None,
-                               record.get("started") is True)
+            web, start, tcp = record.get("web"), record.get("start"), record.get("tcp")
+            address = (str(tcp[0]), int(tcp[1])) if isinstance(tcp, list) and len(tcp) == 2 else None
+            return StationInfo(int(record["pid"]), int(start) if start is not None else None,
+                               str(web) if web else None, record.get("started") is True, address)
         except (OSError, ValueError, KeyError, TypeError, AttributeError):
             return None
+
+    def serving(self) -> StationInfo | None:
+        """The running station's verified description once it is up (its addresses known), else None."""
+        if not self.running():
+            return None
+        info = self.info()
+        return info if info is not None and info.started and self.verified(info) else None
+
+    def verified(self, info: StationInfo | None) -> bool:
+        """Whether ``info`` describes the process holding this channel's lock: its start time is the one
+        recorded and, where the system tells (Linux), it is the lock's holder."""
+        from nfwserver.cli.station_process import lock_holders, process_start
+
+        if info is None or info.start is None or process_start(info.pid) != info.start:
+            return False
+        holders = lock_holders(self.lock_path)  # none listed: a file system whose locks the system does not show
+        return not holders or info.pid in holders

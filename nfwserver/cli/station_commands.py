@@ -1,13 +1,26 @@
 """``nfwserver stop`` and ``nfwserver dashboard``: the user's running station, reached through its local channel.
 
-``stop`` asks the station to stop cleanly (the request ``run`` takes from a signal: state saved, DDE
-conversations ended, listeners closed), through its control file, never by killing it, and waits until its
-process has ended (on Windows its program files are in use until then; an installer replacing them relies on
-it).  Exit status: 0 once stopped; 1 with one sentence when none is running (or it cannot be asked);
-:data:`STILL_RUNNING` (3) with one sentence when it has not stopped within ``--timeout``.  It works the same
-on Linux and Windows, for a station in a terminal, headless, or started at logon
-(:mod:`nfwserver.cli.station_channel`).  The waits are on the operating system (another process's lock and
-exit), in real time.
+``stop`` asks the station to stop cleanly (state saved, DDE conversations ended, listeners closed), never
+by killing it, and waits until its process has ended (on Windows its program files are in use until then; an
+installer replacing them relies on it).  A station that is still starting is found too: its lock is the first
+thing ``run`` takes, and ``stop`` waits (up to ``--timeout``) for it to describe itself.
+
+- Linux: ``SIGTERM`` (what systemd sends) to the process the description names, once that process is
+  verified to be the station (its start time and, from ``/proc/locks``, the lock it holds:
+  :meth:`~nfwserver.cli.station_channel.StationChannel.verified`).  Nothing is written, so a full disk does
+  not matter.  A signal cannot be taken back: when the station has not stopped within ``--timeout`` the
+  sentence says what will happen (a suspended station stops as soon as it is continued; a busy one when it
+  has finished what it is doing).
+- Windows: ``stop`` is written to the station's control file (``control`` in the state directory, never a
+  path the description names), and the process waited for is the described one only when verified by its
+  start time (``GetProcessTimes``); otherwise the lock alone.  When the station has not stopped within
+  ``--timeout``, the request is withdrawn (the file removed) unless the station has already taken it, and the
+  sentence says which.
+
+Exit status: 0 once stopped; 1 with one sentence when none is running (or it cannot be asked, or its
+description names a process that is not the station); :data:`STILL_RUNNING` (3) with one sentence when it has
+not stopped within ``--timeout``.  The waits are on the operating system (another process's lock and exit), in
+real time.
 
 ``dashboard`` opens the running station's web page in the default browser (``--print``: only print its
 address), waiting for a station that is still starting.
@@ -21,8 +34,9 @@ import sys
 import time
 
 from nfwserver.cli.arguments import number_in
-from nfwserver.cli.errors import CliError, say
+from nfwserver.cli.errors import CliError, config_refused, say, say_last_good
 from nfwserver.cli.station_channel import StationChannel, StationInfo
+from nfwserver.cli.station_process import process_ended, process_start
 from nfwserver.storage import atomic_write_text
 
 #: Default seconds ``stop`` waits for the station to be gone.
@@ -55,43 +69,57 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
 
 def _described(channel: StationChannel, timeout_s: float, started: bool = False) -> StationInfo | None:
     """The running station's description, waiting up to ``timeout_s`` for a station that is starting to
-    write it (first once it watches its control file, then, ``started``, once it is up); None if there is
-    none by then or no station runs any more."""
+    write it (first once it listens for requests, then, ``started``, once it is up) and for it to be
+    verified (:meth:`StationChannel.verified`: one left by a killed station is replaced at once); what was
+    found by then (verified or not: the caller checks), or None if nothing, or no station runs any more."""
     deadline = time.monotonic() + timeout_s
     while True:
         info = channel.info()
-        if info is not None and (info.started or not started):
+        if info is not None and (info.started or not started) and channel.verified(info):
             return info
         if not channel.running() or time.monotonic() >= deadline:
-            return info if info is not None and not started else None
+            return info if info is not None and (info.started or not started) else None
         time.sleep(POLL_S)
 
 
-def _process_ended(pid: int) -> bool:
-    """Whether process ``pid`` has ended (a zombie left for its parent to reap counts as ended)."""
-    if sys.platform == "win32":
-        import ctypes
+def _not_the_station(channel: StationChannel, info: StationInfo) -> CliError:
+    return CliError(f"the station's description {channel.info_path} names process {info.pid}, which is not the "
+                    f"process holding {channel.lock_path}: nothing was done; stop the station from its own console "
+                    "or with Ctrl+C")
 
-        synchronize, wait_timeout = 0x00100000, 0x102
-        kernel32 = ctypes.WinDLL("kernel32", use_last_error=True)
-        handle = kernel32.OpenProcess(synchronize, False, pid)
-        if not handle:
-            return True  # no such process (any more)
-        try:
-            return bool(kernel32.WaitForSingleObject(handle, 0) != wait_timeout)
-        finally:
-            kernel32.CloseHandle(handle)
+
+def _ask_to_stop(channel: StationChannel, info: StationInfo) -> None:
+    """Send the stop request to the verified station: a signal (POSIX), its own control file (Windows)."""
+    if sys.platform != "win32":
+        import signal
+
+        os.kill(info.pid, signal.SIGTERM)
+        return
     try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return True
-    except PermissionError:
-        return False
+        atomic_write_text(channel.default_control, "stop\n")
+    except OSError as exc:
+        raise CliError(f"cannot ask the station (process {info.pid}) to stop: {channel.default_control}: "
+                       f"{exc.strerror or exc}") from None
+
+
+def _gave_up(channel: StationChannel, info: StationInfo, timeout_s: float) -> str:
+    """What happens to the request of a ``stop`` that waited ``timeout_s`` in vain, in one sentence."""
+    from nfwserver.cli.station_process import suspended
+
+    head = f"the station (process {info.pid}) was asked to stop but is still running after {timeout_s:g} s"
+    if sys.platform != "win32":
+        if suspended(info.pid):
+            return (f"{head}: it is suspended (SIGSTOP or Ctrl+Z) and has the stop signal, so it will stop "
+                    f"cleanly as soon as it is continued (`kill -CONT {info.pid}`)")
+        return f"{head}: it has the stop signal and will stop once it finishes what it is doing (its log says what)"
     try:
-        with open(f"/proc/{pid}/stat", "rb") as stat:
-            return stat.read().rsplit(b")", 1)[1].split()[0] == b"Z"
-    except (OSError, IndexError):
-        return False
+        channel.default_control.unlink()
+    except FileNotFoundError:
+        return f"{head}: it has taken the request and is stopping (its log says what it is waiting for)"
+    except OSError as exc:
+        return (f"{head}; the request could not be withdrawn ({exc.strerror or exc}), so it will stop when it "
+                f"next looks at {channel.default_control}")
+    return f"{head}; the request is withdrawn: it will go on running (its log says what it is waiting for)"
 
 
 def run_stop(args: argparse.Namespace) -> int:
@@ -105,19 +133,18 @@ def run_stop(args: argparse.Namespace) -> int:
             return 0
         raise CliError(f"a station holds {channel.lock_path} but has not said how to reach it within "
                        f"{args.timeout:g} s; stop it from its own console or with Ctrl+C")
-    try:
-        atomic_write_text(info.control, "stop\n")
-    except OSError as exc:
-        raise CliError(f"cannot ask the station (process {info.pid}) to stop: {info.control}: "
-                       f"{exc.strerror or exc}") from None
+    verified = channel.verified(info)
+    if not verified and sys.platform != "win32":  # Windows writes only the station's own control file: no harm
+        raise _not_the_station(channel, info)
+    _ask_to_stop(channel, info)
     deadline = time.monotonic() + args.timeout
-    while channel.running() or not _process_ended(info.pid):
+    # the lock is freed just before the process ends: wait for its end too (the same start time: not a new one)
+    while channel.running() or (verified and process_start(info.pid) == info.start and not process_ended(info.pid)):
         if time.monotonic() >= deadline:
-            say(f"the station (process {info.pid}) was asked to stop but is still running after "
-                f"{args.timeout:g} s; its log says what it is waiting for")
+            say(_gave_up(channel, info, args.timeout))
             return STILL_RUNNING
         time.sleep(POLL_S)
-    print(f"stopped the station (process {info.pid})")
+    print(f"stopped the station (process {info.pid})" if verified else "stopped the station")
     return 0
 
 
@@ -129,6 +156,11 @@ def run_dashboard(args: argparse.Namespace) -> int:
     info = _described(channel, args.wait, started=True)
     if info is None and channel.running():
         raise CliError(f"the station has not finished starting after {args.wait:g} s; try again in a moment")
+    if info is not None and not channel.verified(info):
+        raise _not_the_station(channel, info)
+    problem = config_refused(None)
+    if problem is not None:
+        say_last_good(problem)
     if info is None or not info.web_url:
         raise CliError("the running station serves no web dashboard: `nfwserver config set web.enabled true` "
                        "turns it on (the station applies it at its next start)")

@@ -52,6 +52,36 @@ def test_real_signals_become_one_stop_and_reloads_and_later_ones_are_only_noted(
             signal.signal(sig, handler)
 
 
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_signals_handled_by_others_are_not_requests_and_any_thread_may_take_ours() -> None:
+    """The wakeup descriptor carries every signal with a Python handler: the console's own (Textual handles
+    SIGTSTP and SIGCONT: Ctrl+Z, fg) must not stop the station.  A SIGTERM the system hands to another thread
+    than the main one is acted on while the main thread waits (as the station's does, for minutes); before, it
+    waited for the main thread's next bytecode (a station suspended and continued kept running)."""
+    saved = {sig: signal.getsignal(sig) for sig in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP, signal.SIGCONT)}
+    calls: list[str] = []
+    stopped = threading.Event()
+    signals = StationSignals(signal_actions(headless=True), lambda: (calls.append("stop"), stopped.set()),
+                             lambda: calls.append("reload"))
+    try:
+        assert signals.install()
+        signal.signal(signal.SIGCONT, lambda *_: None)  # as the console's driver does
+        os.kill(os.getpid(), signal.SIGCONT)
+        os.kill(os.getpid(), signal.SIGHUP)
+        assert wait_for(lambda: calls == ["reload"])  # the SIGCONT before it asked for nothing
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})  # so another thread (nfw-signals) takes it
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+            assert stopped.wait(5.0)  # the main thread blocked in a wait, as the station's
+        finally:
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
+        assert calls == ["reload", "stop"]
+    finally:
+        signals.close()
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)
+
+
 def test_off_the_main_thread_nothing_is_installed() -> None:
     result: list[bool] = []
     signals = StationSignals(signal_actions(headless=True), lambda: None, lambda: None)
@@ -142,3 +172,38 @@ def test_a_reload_asked_for_while_the_station_starts_is_carried_out_once_it_is_u
         assert len([r for r in caplog.records if "reloading the configuration" in r.getMessage()]) == 2
     finally:
         station.stop()
+
+
+def test_a_request_withdrawn_before_the_station_removed_it_is_not_acted_on(tmp_path: Path, caplog) -> None:
+    """#42 item 12 (Windows' `stop`): a writer that gives up removes its request again; the station acts only on
+    a request it removed itself, so "withdrawn" is exactly true.  The interleaving is made real with a FIFO: the
+    station's read ends only when the writer closes it, and the writer removes the name first."""
+    path = tmp_path / "control"
+    got: list[str] = []
+    control = ControlFile(path, SystemClock(), lambda word, origin: got.append(word))
+    os.mkfifo(path)
+
+    def write_then_withdraw() -> None:
+        with open(path, "w") as fifo:
+            fifo.write("stop\n")
+            fifo.flush()
+            path.unlink()  # withdrawn after the station has it to read, before it could remove it
+
+    writer = threading.Thread(target=write_then_withdraw)
+    writer.start()
+    caplog.set_level(logging.INFO, logger="nfwserver")
+    assert control.check() is None  # one look: read "stop", found it gone
+    writer.join()
+    assert got == [] and "the request was withdrawn before it was read" in caplog.text
+
+
+def test_the_state_folders_control_file_is_watched_beside_the_environments(tmp_path: Path) -> None:
+    """The station always watches its state folder's `control` (where `stop` writes on Windows), also when
+    NFW_CONTROL_FILE names another file (the Wine launcher's)."""
+    named, own = tmp_path / "named", tmp_path / "control"
+    got: list[tuple[str, str]] = []
+    control = ControlFile(named, SystemClock(), lambda word, origin: got.append((word, origin)), also=own)
+    own.write_text("stop\n")
+    assert control.check() == "stop" and got == [("stop", f"control file {own}")] and not own.exists()
+    named.write_text("reload\n")
+    assert control.check() == "reload" and got[-1] == ("reload", f"control file {named}")

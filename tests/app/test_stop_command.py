@@ -44,7 +44,8 @@ def test_stop_asks_the_station_through_its_channel_and_returns_once_it_has_stopp
     assert result.stdout == f"stopped the station (process {st.proc.pid})\n" and result.stderr == ""
     assert st.proc.wait(10) == 0  # a clean exit, not a kill
     log = st.log.read_text()
-    assert f"control file {tmp_path / 'state' / 'nfwserver' / 'control'}: stopping" in log
+    assert "SIGTERM: stopping" in log  # the verified station was signalled: nothing written (#42 item 10)
+    assert not (tmp_path / "state" / "nfwserver" / "control").exists()
     assert log.rstrip().endswith("stopped")
     assert json.loads(st.state.read_text())["satellite"] == 694
     channel = StationChannel(tmp_path / "state" / "nfwserver")
@@ -169,18 +170,21 @@ def test_a_windowless_run_that_fails_unexpectedly_reports_the_failure(monkeypatc
     assert "RuntimeError: something nobody expected" in sys.stderr.getvalue()
 
 
-#: A process that holds the user's station channel as a station does, but never reads its control file (a
-#: station stuck while stopping); it says "started" only when its stdin gets a line, and exits at EOF.
+#: A process that holds the user's station channel as a station does, but never stops (it ignores SIGTERM and
+#: never reads its control file: a station stuck while stopping); it says "started" only when its stdin gets a
+#: line, and exits at EOF.
 STUCK = """
-import os, sys
+import os, signal, sys
+signal.signal(signal.SIGTERM, lambda *_: None)
 from pathlib import Path
 from nfwserver.cli.station_channel import StationChannel, StationInfo
 channel = StationChannel(Path(sys.argv[1]))
 assert channel.claim()
-channel.describe(StationInfo(os.getpid(), channel.default_control))
+from nfwserver.cli.station_process import process_start
+channel.describe(StationInfo(os.getpid(), process_start(os.getpid())))
 print("claimed", flush=True)
 sys.stdin.readline()
-channel.describe(StationInfo(os.getpid(), channel.default_control, "http://127.0.0.1:8091/", started=True))
+channel.describe(StationInfo(os.getpid(), process_start(os.getpid()), "http://127.0.0.1:8091/", started=True))
 print("started", flush=True)
 sys.stdin.readline()
 """
@@ -200,8 +204,8 @@ def test_a_station_that_does_not_stop_in_time_gets_its_own_exit_status(tmp_path)
         result = _cli(tmp_path, "stop", "--timeout", "0.5")
         assert result.returncode == 3 and result.stdout == ""
         assert result.stderr == (f"nfwserver: the station (process {stuck.pid}) was asked to stop but is still "
-                                 "running after 0.5 s; its log says what it is waiting for\n")
-        assert (tmp_path / "state" / "nfwserver" / "control").read_text() == "stop\n"  # it was asked
+                                 "running after 0.5 s: it has the stop signal and will stop once it finishes what "
+                                 "it is doing (its log says what)\n")
     finally:
         stuck.kill()
         stuck.wait(10)
@@ -238,7 +242,7 @@ def test_a_description_that_cannot_be_written_is_said_once_and_again_when_it_can
         channel.info_path.mkdir()  # a directory where the file should be: every replace fails
         caplog.set_level(logging.INFO, logger="nfwserver.cli.station_channel")
         for _ in range(3):
-            channel.describe(StationInfo(os.getpid(), tmp_path / "control"))
+            channel.describe(StationInfo(os.getpid()))
         warnings = [r for r in caplog.records if r.levelno == logging.WARNING]
         assert len(warnings) == 1 and "cannot write the station's description" in warnings[0].getMessage()
         channel.info_path.rmdir()

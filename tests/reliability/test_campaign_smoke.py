@@ -17,7 +17,7 @@ def test_a_tiny_campaign_runs_every_family_and_finds_nothing(tmp_path) -> None:
     budget = Budget.smoke()
     tallies = run_campaign(budget, tmp_path)
     by_name = {t.family: t for t in tallies}
-    assert len(tallies) == 14
+    assert len(tallies) == 15
     for tally in tallies:
         assert tally.clean, (tally.family, tally.crashes, tally.tracebacks, tally.lost, tally.notes)
         if tally.family != "rotctld/rigctld killed and restarted" or hamlib_available():
