@@ -98,7 +98,7 @@ def test_the_journey_is_on_the_first_screen_after_the_two_newcomer_commands() ->
     assert [c.split()[:3] for c in _journey()] == [
         ["pip", "install", "."], ["nfwserver", "config", "init"], ["nfwserver", "elements", "update"],
         ["nfwserver", "passes"], ["nfwserver", "config", "set"], ["nfwserver", "run"], ["nfwserver", "watch"],
-        ["nfwserver", "schedule", "--sat"]]
+        ["nfwserver", "config", "set"], ["nfwserver", "schedule"], ["nfwserver", "poke", '"AUTO']]
 
 
 def test_the_journey_runs_as_written(provider, tmp_path, capsys) -> None:  # noqa: F811 - the imported fixture
@@ -135,8 +135,12 @@ def test_the_journey_runs_as_written(provider, tmp_path, capsys) -> None:  # noq
             if argv[:3] == ["config", "set", "tcp.enabled"]:
                 assert main(["config", "set", "tcp.port", str(free_port())]) == 0  # 8090 may be taken here
             if argv[0] == "schedule":
-                header = out.splitlines()[0].split()
-                assert header[0] == "sat" and header[-2:] == ["scheduled", "reason"] and len(out.splitlines()) > 3, out
+                header, *rows = out.splitlines()
+                assert header.split()[0] == "sat" and header.split()[-2:] == ["scheduled", "reason"], out
+                assert len(rows) > 3 and {row.split()[1] for row in rows} == {"ISS", "AO-7"}, out
+            if argv[0] == "poke":  # the running station works the list by itself from now on
+                assert out.strip() == "OK", out
+                wait_for(lambda: _planned(capsys), 20.0, "the station to plan the list (it reads the file within 3 s)")
             if argv[0] == "watch":
                 lines = out.splitlines()
                 assert len(lines) == 2 and all("tune=" in line and "status=0x" in line for line in lines), out
@@ -145,6 +149,15 @@ def test_the_journey_runs_as_written(provider, tmp_path, capsys) -> None:  # noq
             station.send_signal(signal.SIGTERM)
             assert station.wait(15) == 0
     assert station is not None
+
+
+def _planned(capsys: pytest.CaptureFixture[str]) -> bool:
+    """Autotrack is on, its list has no problem and it names the next pass it will work (STATUS)."""
+    capsys.readouterr()
+    assert main(["status"]) == 0
+    fields = f" {capsys.readouterr().out.strip()} "
+    assert " auto=on " in fields, fields
+    return "auto_problems" not in fields and " auto_next=none " not in fields and " auto_next=" in fields
 
 
 def _start_station(argv: list[str]) -> subprocess.Popen[bytes]:
