@@ -33,6 +33,10 @@ log = logging.getLogger(__name__)
 
 #: Longest wait for the state file's lock (real seconds); a longer hold is a failed save, tried again.
 LOCK_WAIT_S = 2.0
+#: Bytes of the largest state file read (a saved state is about 200); a larger one is not the station's.
+MAX_STATE_BYTES = 16 * 1024
+#: Characters of the longest reason autotrack may be off for that is read back.
+MAX_REASON_CHARS = 300
 
 
 @dataclass(frozen=True)
@@ -65,7 +69,11 @@ class StateFile:
 
     def load(self) -> SessionState:
         try:
-            doc = json.loads(self.path.read_text(encoding="utf-8"))
+            with self.path.open("rb") as file:
+                data = file.read(MAX_STATE_BYTES + 1)
+            if len(data) > MAX_STATE_BYTES:
+                raise ValueError(f"larger than {MAX_STATE_BYTES} bytes")
+            doc = json.loads(data.decode("utf-8"))
             numbers = [doc.get("satellite"), doc.get("configured")]
             for number in numbers:
                 if number is not None and (isinstance(number, bool) or not isinstance(number, int)):
@@ -73,8 +81,15 @@ class StateFile:
             auto = [doc.get("autotrack"), doc.get("autotrack_off"), doc.get("autotrack_enabled")]
             if not all(v is None or isinstance(v, t) for v, t in zip(auto, (bool, str, bool), strict=True)):
                 raise ValueError("autotrack is not on/off with a reason")
+            reason = auto[1]
+            if isinstance(reason, str) and (len(reason) > MAX_REASON_CHARS or not reason.isprintable()):
+                raise ValueError(f"the reason autotrack is off is not one line of at most {MAX_REASON_CHARS} "
+                                 "printable characters")
             state = SessionState(*numbers, *auto)
         except FileNotFoundError:
+            state = SessionState()
+        except RecursionError:  # "[[[[..." deeper than the interpreter's stack
+            log.warning("ignoring the saved session state in %s: nested too deeply", self.path)
             state = SessionState()
         except (OSError, ValueError, AttributeError) as exc:
             log.warning("ignoring the saved session state in %s: %s", self.path, exc)

@@ -1,0 +1,42 @@
+"""A forged or garbled session state file (the autotrack mode kept across restarts) never stops the station:
+each gives one warning naming the file and is read as "no saved state"; a reason that would carry line breaks
+or a page of text into the log, STATUS and the page is refused at the door."""
+
+from __future__ import annotations
+
+import json
+import logging
+
+import pytest
+
+from nfwserver.app.session_state import MAX_STATE_BYTES, SessionState, StateFile
+
+FORGED = {
+    "nested arrays deeper than the interpreter's stack": "[" * 100_000,
+    "nested objects deeper than the interpreter's stack": '{"a":' * 100_000,
+    "a reason with a line break": json.dumps({"autotrack": False, "autotrack_off": "x\r\nOK satellite=evil"}),
+    "a reason with an escape sequence": json.dumps({"autotrack": False, "autotrack_off": "\x1b[2Jgone"}),
+    "a reason of a megabyte": json.dumps({"autotrack": False, "autotrack_off": "x" * 1_000_000}),
+    "a list": "[1, 2]",
+    "a file larger than any state": json.dumps({"satellite": 25544, "pad": " " * MAX_STATE_BYTES}),
+}
+
+
+@pytest.mark.parametrize("text", FORGED.values(), ids=list(FORGED))
+def test_a_forged_state_file_is_one_warning_and_no_saved_state(tmp_path, caplog, text: str) -> None:
+    path = tmp_path / "state.json"
+    path.write_text(text, encoding="utf-8")
+    with caplog.at_level(logging.WARNING):
+        state = StateFile(path).load()
+    assert state == SessionState()
+    warnings = [r for r in caplog.records if r.levelno >= logging.WARNING]
+    assert len(warnings) == 1 and str(path) in warnings[0].getMessage()
+    assert len(warnings[0].getMessage()) < 400
+
+
+
+def test_a_sane_file_loads_whole(tmp_path) -> None:
+    path = tmp_path / "state.json"
+    path.write_text(json.dumps({"satellite": 25544, "configured": None, "autotrack": False,
+                                "autotrack_off": "AUTO OFF from tcp 127.0.0.1:5000", "autotrack_enabled": True}))
+    assert StateFile(path).load() == SessionState(25544, None, False, "AUTO OFF from tcp 127.0.0.1:5000", True)
