@@ -14,7 +14,9 @@ stream (``STREAM``).  Three caps, and what happens at each:
 - **in all** (``max_clients``): a new connection takes the place of the oldest connection still sending
   its request, of another address first; one from the station's own address may also take the place of
   another address's event stream.  The station's own event streams and connections being answered are
-  never taken, and another address never takes the station's own connections.
+  never taken, and another address never takes the station's own connections;
+- **event streams** (the server's ``max_streams``): a stream for the station's own address ends another
+  address's oldest stream (:meth:`Admission.make_room_for_stream`); others are refused.
 
 "The oldest still sending its request" is the connection that has done least for longest: a slowloris that
 trickles a byte every few seconds, a half request, or a browser's spare connection that sent nothing.  A
@@ -139,6 +141,18 @@ class Admission:
             if victim is not None:
                 return victim
         return None
+
+    def make_room_for_stream(self, sock: socket.socket) -> Slot | None:
+        """The event streams' own cap is reached and ``sock`` asks for one: when it comes from the station's own
+        address, end another address's oldest event stream for it and return that slot; else None."""
+        with self._lock:
+            slot = self._slots.get(id(sock))
+            if slot is None or slot.sock is not sock or not slot.own:
+                return None
+            victim = _oldest(s for s in self._slots.values() if not s.own and s.phase is Phase.STREAM)
+            if victim is not None:
+                self._take(victim)
+            return victim
 
     def _take(self, victim: Slot) -> None:
         """Free ``victim``'s slot and end its connection (its own thread then finds it closed)."""

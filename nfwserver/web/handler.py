@@ -221,7 +221,7 @@ class WebHandler(BaseHTTPRequestHandler):
 
     def _stream(self) -> None:
         web = self.web
-        refusal = web.stream_opened(self.peer)
+        refusal = web.stream_opened(self.peer, self.connection)
         if refusal is not None:
             self._json(503, {"ok": False, "error": refusal})
             return

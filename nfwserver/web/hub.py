@@ -21,6 +21,7 @@ class FrameHub:
         self._seq = 0
         self._frame: bytes | None = None
         self._closed = False
+        self._wakes = 0  #: :meth:`wake` calls so far
 
     @property
     def seq(self) -> int:
@@ -40,12 +41,20 @@ class FrameHub:
 
     def wait_newer(self, seen: int, timeout_s: float | None = None) -> tuple[int, bytes | None]:
         """The newest frame once its number is above ``seen``; (seen, None) when closed or after
-        ``timeout_s`` real seconds (None: no limit)."""
+        ``timeout_s`` real seconds (None: no limit), or at a :meth:`wake`."""
         with self._cond:
-            self._cond.wait_for(lambda: self._closed or self._seq > seen, timeout_s)
+            wakes = self._wakes
+            self._cond.wait_for(lambda: self._closed or self._seq > seen or self._wakes != wakes, timeout_s)
             if self._closed or self._seq <= seen:
                 return seen, None
             return self._seq, self._frame
+
+    def wake(self) -> None:
+        """Make every waiting connection return now, as after its keep-alive timeout (one whose connection was
+        ended for another then finds it closed at its next write and counts itself out)."""
+        with self._cond:
+            self._wakes += 1
+            self._cond.notify_all()
 
     def close(self) -> None:
         """Wake every waiting connection for good (server stopping)."""

@@ -88,3 +88,26 @@ def test_other_addresses_cannot_take_the_reserve_of_the_station_own_address() ->
         _answered_at_once(web)  # the reserve
         for sock in held:
             sock.close()
+
+
+def test_other_addresses_event_streams_do_not_take_the_operator_page() -> None:
+    """Event streams have their own cap (``max_streams``): a crowd that holds all of them made the operator's
+    page answer 503 to its own event stream.  Now the station's own address takes the place of another
+    address's oldest stream."""
+    with running_web(max_streams=4) as (_core, web):
+        crowd = [connect(web, "127.0.0.2") for _ in range(4)]
+        for sock in crowd:
+            sock.sendall(b"GET /api/stream HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n")
+        wait_for(lambda: web.stats.streams == 4, what="the crowd's four streams")
+        mine = connect(web, "127.0.0.1")
+        mine.sendall(b"GET /api/stream HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n")
+        mine.settimeout(5.0)
+        assert mine.recv(64).startswith(b"HTTP/1.0 200"), "the operator's event stream was refused"
+        assert read_all(crowd[0]).startswith(b"HTTP/1.0 200")  # the oldest of the crowd's streams was ended
+        wait_for(lambda: web.stats.streams == 4, what="the evicted stream counted out")
+        assert all(_still_open(sock) for sock in crowd[1:])
+        third = connect(web, "127.0.0.3")  # another address still meets the cap
+        third.sendall(b"GET /api/stream HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n")
+        assert status(read_all(third)) == 503
+        for sock in (*crowd, mine, third):
+            sock.close()
