@@ -29,13 +29,14 @@ its slot is free before the new one is counted in.
 
 from __future__ import annotations
 
-import ipaddress
 import socket
 import threading
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass
 from enum import Enum
+
+from nfwserver.config.schema import plain_address
 
 __all__ = ["OWN_RESERVE", "Admission", "Phase", "Slot", "Verdict"]
 
@@ -67,17 +68,6 @@ class Verdict:
     slot: Slot | None
     reason: str | None = None
     evicted: Slot | None = None
-
-
-def plain_address(host: str) -> str:
-    """``host`` without an IPv6 zone, and an IPv4-mapped IPv6 address as IPv4."""
-    try:
-        ip = ipaddress.ip_address(host.split("%", 1)[0])
-    except ValueError:
-        return host
-    if isinstance(ip, ipaddress.IPv6Address) and ip.ipv4_mapped is not None:
-        return str(ip.ipv4_mapped)
-    return str(ip)
 
 
 def is_own(host: str, local: str) -> bool:
