@@ -17,6 +17,7 @@ from collections.abc import Callable
 from datetime import datetime
 
 from nfwserver.autotrack import AutotrackRuntime, AutotrackSettings, StationPlanner
+from nfwserver.autotrack.planner import list_warning
 from nfwserver.autotrack.runtime import NOT_SWITCHED_ON
 from nfwserver.autotrack.worker import AutotrackWorker
 from nfwserver.clock import Clock
@@ -38,7 +39,8 @@ class StationAutotrack:
         self._settings = AutotrackSettings.of(config())
         self._sky = core.state.sky_generation
         planner = StationPlanner(lambda: core.state.catalog, self._sky_now, lambda: self._settings)
-        self.runtime = AutotrackRuntime(planner, core.select_scheduled)
+        self.runtime = AutotrackRuntime(planner, core.select_scheduled, list_warning=lambda: list_warning(
+            AutotrackSettings.of(config()).satellites, core.state.catalog))
         core.autotrack = self.runtime
         self.worker = AutotrackWorker(self.runtime, clock)
         self._unsubscribe: list[Callable[[], None]] = []

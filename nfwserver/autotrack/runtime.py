@@ -64,8 +64,10 @@ class AutotrackRuntime:
     """See the module docstring.  Thread-safe: ticks on one thread, switching and status from others."""
 
     def __init__(self, planner: PlanProvider, select: Select, on: bool = False,
-                 off_reason: str = NOT_SWITCHED_ON) -> None:
+                 off_reason: str = NOT_SWITCHED_ON, list_warning: Callable[[], str | None] = lambda: None) -> None:
         self._planner, self._select = planner, select
+        #: what ``AUTO ON`` says about the list of satellites (nothing to work, names left out), or None
+        self.list_warning = list_warning
         self._lock = threading.Lock()
         self._on = on
         self._off_reason = off_reason
