@@ -23,6 +23,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from nfwserver.config.files import read_regular_bytes
 from nfwserver.core.sample import TickSample
 from nfwserver.core.tick_worker import TickWorker
 from nfwserver.file_lock import locked
@@ -69,11 +70,7 @@ class StateFile:
 
     def load(self) -> SessionState:
         try:
-            with self.path.open("rb") as file:
-                data = file.read(MAX_STATE_BYTES + 1)
-            if len(data) > MAX_STATE_BYTES:
-                raise ValueError(f"larger than {MAX_STATE_BYTES} bytes")
-            doc = json.loads(data.decode("utf-8"))
+            doc = json.loads(read_regular_bytes(self.path, MAX_STATE_BYTES).decode("utf-8"))  # never a FIFO's wait
             numbers = [doc.get("satellite"), doc.get("configured")]
             for number in numbers:
                 if number is not None and (isinstance(number, bool) or not isinstance(number, int)):

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import json
 import logging
+import os
+import sys
 
 import pytest
 
@@ -40,3 +42,14 @@ def test_a_sane_file_loads_whole(tmp_path) -> None:
     path.write_text(json.dumps({"satellite": 25544, "configured": None, "autotrack": False,
                                 "autotrack_off": "AUTO OFF from tcp 127.0.0.1:5000", "autotrack_enabled": True}))
     assert StateFile(path).load() == SessionState(25544, None, False, "AUTO OFF from tcp 127.0.0.1:5000", True)
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="no FIFOs")
+def test_a_fifo_in_place_of_the_state_file_is_one_warning_not_a_hang(tmp_path, caplog) -> None:
+    """A plain open() of a FIFO waits for a writer for ever: the station would never start."""
+    path = tmp_path / "state.json"
+    os.mkfifo(path)
+    with caplog.at_level(logging.WARNING):
+        assert StateFile(path).load() == SessionState()
+    assert len([r for r in caplog.records if r.levelno >= logging.WARNING]) == 1
+
