@@ -29,6 +29,8 @@ from nfwserver.tracking.observer import Observer
 
 __all__ = ["StationAutotrack"]
 
+_KEPT = " (before the restart, kept in "  #: what a restart adds to the reason autotrack is off
+
 
 class StationAutotrack:
     """Autotrack on ``core``, with the ``[autotrack]`` settings of ``config()`` (the running configuration)."""
@@ -80,7 +82,8 @@ class StationAutotrack:
         sentence for the log."""
         enabled = self.config().autotrack.enabled
         if saved_on is not None and saved_enabled == enabled:
-            on, why = saved_on, f"{saved_off or NOT_SWITCHED_ON} (before the restart, kept in {where})"
+            said = (saved_off or NOT_SWITCHED_ON).split(_KEPT, 1)[0]  # said once, however many restarts since
+            on, why = saved_on, f"{said}{_KEPT}{where})"
             origin = f"as it was before the restart ({where})"
         else:
             on, why, origin = enabled, NOT_SWITCHED_ON, "from [autotrack] enabled"
