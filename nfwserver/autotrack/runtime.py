@@ -52,7 +52,6 @@ class AutotrackStatus:
     next_pass: PlannedPass | None  #: the scheduled pass in progress, else the next one; None: none planned
     fault: str | None  #: planning or selecting failing now (None when all is well)
     problems: tuple[str, ...]  #: listed satellites that the plan could not use, and why
-    planned_at: datetime | None  #: when the schedule shown was made (None: no plan yet)
 
     def next_pass_text(self) -> str:
         """``SO-50 04:09-04:23`` (UTC) of :attr:`next_pass`, or ``none``."""
@@ -127,7 +126,7 @@ class AutotrackRuntime:
             return AutotrackStatus(self._on, None if self._on else self._off_reason,
                                    schedule.current_or_next(now) if schedule is not None else None,
                                    self._plan_fault or self._select_fault,
-                                   schedule.problems if schedule is not None else (), self._planned_at)
+                                   schedule.problems if schedule is not None else ())
 
     # -- ticks (one thread) ----------------------------------------------------------------------------------
     def tick(self, now: datetime) -> int | None:
