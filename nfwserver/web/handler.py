@@ -33,7 +33,7 @@ from typing import Any
 
 from nfwserver.web.admission import Phase
 from nfwserver.web.control import help_entries
-from nfwserver.web.guard import cross_site_reason, host_refusal
+from nfwserver.web.guard import cross_site_reason, foreign_site_reason, host_refusal
 from nfwserver.web.request_head import SECURITY_HEADERS, HeadReader, error_response, linger_close, read_head
 
 log = logging.getLogger(__name__)
@@ -221,6 +221,11 @@ class WebHandler(BaseHTTPRequestHandler):
 
     def _stream(self) -> None:
         web = self.web
+        foreign = foreign_site_reason(self.headers)
+        if foreign is not None:
+            web.request_refused(self.client_address[0], 403, foreign)
+            self._json(403, {"ok": False, "error": foreign})
+            return
         refusal = web.stream_opened(self.peer, self.connection)
         if refusal is not None:
             self._json(503, {"ok": False, "error": refusal})

@@ -111,3 +111,25 @@ def test_other_addresses_event_streams_do_not_take_the_operator_page() -> None:
         assert status(read_all(third)) == 503
         for sock in (*crowd, mine, third):
             sock.close()
+
+
+def test_another_site_page_cannot_hold_the_operator_event_streams() -> None:
+    """A page of another site the operator visits may open the station's event stream (``fetch`` with
+    ``no-cors`` reads on for ever): its connections come from 127.0.0.1, the station's own address, whose
+    event streams are never taken, so a few such pages filled the 16 per address and locked the operator's
+    page out.  The browser says where the request comes from (``Sec-Fetch-Site``); another site's is refused
+    before it holds a stream."""
+    with running_web() as (_core, web):
+        for site in ("cross-site", "same-site"):
+            reply = exchange(web, b"GET /api/stream HTTP/1.1\r\nHost: 127.0.0.1\r\nSec-Fetch-Site: " +
+                             site.encode() + b"\r\nSec-Fetch-Mode: no-cors\r\n\r\n")
+            assert status(reply) == 403 and b"another site" in reply, reply[:300]
+        assert web.stats.streams == 0
+        own = connect(web)  # the station's own page (same-origin), and a tool that says nothing, still stream
+        own.sendall(b"GET /api/stream HTTP/1.1\r\nHost: 127.0.0.1\r\nSec-Fetch-Site: same-origin\r\n\r\n")
+        tool = connect(web)
+        tool.sendall(b"GET /api/stream HTTP/1.0\r\n\r\n")
+        for sock in (own, tool):
+            sock.settimeout(5.0)
+            assert sock.recv(64).startswith(b"HTTP/1.0 200")
+            sock.close()
