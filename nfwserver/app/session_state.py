@@ -36,8 +36,9 @@ log = logging.getLogger(__name__)
 LOCK_WAIT_S = 2.0
 #: Bytes of the largest state file read (a saved state is about 200); a larger one is not the station's.
 MAX_STATE_BYTES = 16 * 1024
-#: Characters of the longest reason autotrack may be off for that is read back.
-MAX_REASON_CHARS = 300
+#: Characters of the longest reason autotrack may be off for that is read back as it is (the state file's own
+#: path is part of it after a restart); a longer one, or one with control characters, is cut and cleaned.
+MAX_REASON_CHARS = 1000
 
 
 @dataclass(frozen=True)
@@ -80,8 +81,10 @@ class StateFile:
                 raise ValueError("autotrack is not on/off with a reason")
             reason = auto[1]
             if isinstance(reason, str) and (len(reason) > MAX_REASON_CHARS or not reason.isprintable()):
-                raise ValueError(f"the reason autotrack is off is not one line of at most {MAX_REASON_CHARS} "
-                                 "printable characters")
+                log.warning("the reason autotrack was off in %s is not one line of at most %d printable "
+                            "characters: cut and cleaned", self.path, MAX_REASON_CHARS)
+                auto[1] = " ".join("".join(ch if ch.isprintable() else " " for ch in reason).split())[
+                    :MAX_REASON_CHARS]
             state = SessionState(*numbers, *auto)
         except FileNotFoundError:
             state = SessionState()
