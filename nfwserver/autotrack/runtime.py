@@ -77,6 +77,7 @@ class AutotrackRuntime:
         self._plan_retry: datetime | None = None  #: a failed plan is tried again from then on
         self._plan_fault: str | None = None
         self._selected: int | None = None  #: the satellite this runtime last selected (None after switching on)
+        self._switched_on = 0  #: times switched on: a selection begun before the last switch is not recorded
         self._select_retry: datetime | None = None
         self._select_fault: str | None = None
 
@@ -92,6 +93,7 @@ class AutotrackRuntime:
             self._off_reason = ""
             self._plan_due, self._selected = True, None
             self._plan_asks += 1
+            self._switched_on += 1
             self._plan_retry = self._select_retry = None
         if not was_on:
             log.info("autotrack on")
@@ -135,7 +137,7 @@ class AutotrackRuntime:
         self._plan_if_due(now)
         with self._lock:
             schedule, on, selected = self._schedule, self._on, self._selected
-            retry = self._select_retry
+            retry, switched_on = self._select_retry, self._switched_on
         if not on or schedule is None:
             return None
         row = schedule.current_or_next_row(now)
@@ -147,8 +149,8 @@ class AutotrackRuntime:
         wanted = schedule.pass_at(row)
         why = self._select(wanted.catalog_number)
         with self._lock:
-            if not self._on:  # switched off meanwhile: what was chosen since wins
-                return None
+            if not self._on or self._switched_on != switched_on:
+                return None  # switched off meanwhile (what was chosen since wins), or off and on: select afresh
             if why is None:
                 self._selected, self._select_retry = wanted.catalog_number, None
                 if self._select_fault is not None:

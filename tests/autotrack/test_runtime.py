@@ -57,11 +57,11 @@ class Station:
             self.clock.advance(step_s)
 
 
-
 def passes_of(schedule: Schedule | None) -> list[PlannedPass]:
     """Every candidate pass of ``schedule``, scheduled or not, in AOS order."""
     assert schedule is not None
     return [schedule.pass_at(row) for row in range(len(schedule))]
+
 
 def _catalog(path: Path = AMATEUR) -> Catalog:
     return Catalog(load_element_file(path).sets)
@@ -284,3 +284,28 @@ def test_an_empty_list_says_why_nothing_is_planned() -> None:
     assert status.next_pass is None and station.calls == []
     assert status.problems == ("no satellites to work: list them in [autotrack] satellites or [satellites] "
                                "favourites",)
+
+
+def test_a_sat_and_auto_on_during_autotrack_own_selection_are_followed_by_a_fresh_selection() -> None:
+    """Autotrack selects outside its lock (the station's choice lock is taken there).  A client's SAT= (switching
+    it off and selecting another satellite) and an AUTO ON, both arriving while that selection is under way,
+    left the runtime believing its satellite was selected: it did not select again until the schedule's
+    satellite changed, and the client's satellite stayed on with autotrack on."""
+    station = Station(_catalog())
+    runtime = station.runtime(on=True)
+    raced = []
+
+    def select(number: int) -> str | None:
+        why = station.select(number)
+        if not raced:  # other threads, between the selection and the runtime's record of it
+            raced.append(number)
+            runtime.switch_off("SAT=43017 from tcp 127.0.0.1:1 chose the satellite")
+            station.selected = 43017
+            runtime.switch_on()
+        return why
+
+    runtime._select = select
+    runtime.tick(START)
+    runtime.tick(START + timedelta(seconds=1))
+    assert len(station.calls) == 2 and station.selected == raced[0], station.calls
+
