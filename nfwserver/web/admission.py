@@ -160,6 +160,12 @@ class Admission:
             if slot is not None and slot.sock is sock:
                 del self._slots[id(sock)]
 
+    def holds(self, sock: socket.socket) -> bool:
+        """Whether ``sock``'s connection still has its slot (False once taken for another, or released)."""
+        with self._lock:
+            slot = self._slots.get(id(sock))
+            return slot is not None and slot.sock is sock
+
     def mark(self, sock: socket.socket, phase: Phase) -> None:
         """``sock``'s connection is now in ``phase``."""
         with self._lock:

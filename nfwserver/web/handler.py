@@ -237,13 +237,17 @@ class WebHandler(BaseHTTPRequestHandler):
             cursor, history = web.page_log()  # the frames are shared; the log lines are this page's own
             self.wfile.write(b"event: history\ndata: " + json.dumps(history, default=str).encode() + b"\n\n")
             seen, frame = web.hub.newest()
-            while not web.stopping:
+
+            def taken() -> bool:  # its slot was given to a newer connection (web/admission.py)
+                return not web.admission.holds(self.connection)
+
+            while not web.stopping and not taken():
                 if frame is not None:
                     self.wfile.write(b"event: state\ndata: " + cursor.attach(frame) + b"\n\n")
                 else:
                     self.wfile.write(b": keep-alive\n\n")
-                seen, frame = web.hub.wait_newer(seen, KEEPALIVE_S)
-            reason = "server stopping"
+                seen, frame = web.hub.wait_newer(seen, KEEPALIVE_S, taken)
+            reason = "server stopping" if web.stopping else "closed to make room for a newer connection"
         except TimeoutError:
             reason, dropped = f"stopped reading (nothing sent for {web.io_timeout_s:g} s)", True
         except (BrokenPipeError, ConnectionResetError, ConnectionAbortedError):

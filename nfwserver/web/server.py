@@ -49,7 +49,7 @@ from nfwserver.core.sample import TickSample
 from nfwserver.core.station_core import StationCore
 from nfwserver.listen_errors import bind_failure
 from nfwserver.ratelimited_log import RateLimitedLog
-from nfwserver.web.admission import OWN_RESERVE, Admission
+from nfwserver.web.admission import OWN_RESERVE, Admission, Phase
 from nfwserver.web.control import Control
 from nfwserver.web.handler import WebHandler
 from nfwserver.web.hub import FrameHub
@@ -308,6 +308,8 @@ class WebServer:
             gone = verdict.evicted
             with self._lock:
                 self.stats.evicted += 1
+            if gone.phase is Phase.STREAM:
+                self.hub.wake()  # its thread, waiting for a frame, sees at once that it was taken
             self._note_refusal(gone.host, f"web connection from {gone.host} closed ({gone.phase.value} for "
                                f"{time.monotonic() - gone.since:.1f} s) to make room for one from {host}",
                                "connection closed to make room for another (it had done least for longest)")
@@ -371,7 +373,7 @@ class WebServer:
                 self.stats.streams += 1
                 first, reason = self.stats.streams == 1, None
         if gone is not None:
-            self.hub.wake()  # its thread ends at its next write
+            self.hub.wake()  # its thread, waiting for a frame, sees at once that it was taken
             self._note_refusal(gone.host, f"web event stream for {gone.host} closed to make room for the station's "
                                "own page", "event stream closed to make room for the station's own page")
         if reason is None and first:
