@@ -17,6 +17,7 @@ from collections.abc import Callable
 from datetime import datetime
 
 from nfwserver.autotrack import AutotrackRuntime, AutotrackSettings, StationPlanner
+from nfwserver.autotrack.planner import list_warning
 from nfwserver.autotrack.runtime import NOT_SWITCHED_ON
 from nfwserver.autotrack.worker import AutotrackWorker
 from nfwserver.clock import Clock
@@ -28,6 +29,8 @@ from nfwserver.tracking.observer import Observer
 
 __all__ = ["StationAutotrack"]
 
+_KEPT = " (before the restart, kept in "  #: what a restart adds to the reason autotrack is off
+
 
 class StationAutotrack:
     """Autotrack on ``core``, with the ``[autotrack]`` settings of ``config()`` (the running configuration)."""
@@ -38,7 +41,8 @@ class StationAutotrack:
         self._settings = AutotrackSettings.of(config())
         self._sky = core.state.sky_generation
         planner = StationPlanner(lambda: core.state.catalog, self._sky_now, lambda: self._settings)
-        self.runtime = AutotrackRuntime(planner, core.select_scheduled)
+        self.runtime = AutotrackRuntime(planner, core.select_scheduled, list_warning=lambda: list_warning(
+            AutotrackSettings.of(config()).satellites, core.state.catalog))
         core.autotrack = self.runtime
         self.worker = AutotrackWorker(self.runtime, clock)
         self._unsubscribe: list[Callable[[], None]] = []
@@ -78,7 +82,8 @@ class StationAutotrack:
         sentence for the log."""
         enabled = self.config().autotrack.enabled
         if saved_on is not None and saved_enabled == enabled:
-            on, why = saved_on, f"{saved_off or NOT_SWITCHED_ON} (before the restart, kept in {where})"
+            said = (saved_off or NOT_SWITCHED_ON).split(_KEPT, 1)[0]  # said once, however many restarts since
+            on, why = saved_on, f"{said}{_KEPT}{where})"
             origin = f"as it was before the restart ({where})"
         else:
             on, why, origin = enabled, NOT_SWITCHED_ON, "from [autotrack] enabled"

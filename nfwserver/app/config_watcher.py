@@ -84,6 +84,7 @@ class ConfigWatcher(ServiceThread):
         self._requested = False
         self._request_lock = threading.Lock()  #: a request is never lost between reading and clearing the flag
         self._apply_lock = threading.Lock()  #: one reading and applying at a time (the thread, catch_up)
+        self._passed_over: Signature = None  #: the file's state catch_up last read and did not apply
 
     def request(self) -> None:
         """Read the file on the watcher's thread now, changed or not (any thread; only sets flags)."""
@@ -115,12 +116,13 @@ class ConfigWatcher(ServiceThread):
         """Apply the file now if it changed since it was last read and is whole and valid (any thread)."""
         from nfwserver.config.loader import ConfigError, has_settings, parse_config, read_config_text
 
-        if file_signature(self.path) == self._seen:
+        if file_signature(self.path) in (self._seen, self._passed_over):
             return
         with self._apply_lock:
             now = file_signature(self.path)
-            if now is None or now == self._seen:
+            if now is None or now in (self._seen, self._passed_over):
                 return
+            self._passed_over = now  # looked at once: not read again until it changes (posts are anyone's)
             try:
                 text = read_config_text(self.path)
                 if file_signature(self.path) != now or not has_settings(text):

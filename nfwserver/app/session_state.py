@@ -23,6 +23,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from nfwserver.config.files import read_regular_bytes
 from nfwserver.core.sample import TickSample
 from nfwserver.core.tick_worker import TickWorker
 from nfwserver.file_lock import locked
@@ -33,6 +34,11 @@ log = logging.getLogger(__name__)
 
 #: Longest wait for the state file's lock (real seconds); a longer hold is a failed save, tried again.
 LOCK_WAIT_S = 2.0
+#: Bytes of the largest state file read (a saved state is about 200); a larger one is not the station's.
+MAX_STATE_BYTES = 16 * 1024
+#: Characters of the longest reason autotrack may be off for that is read back as it is (the state file's own
+#: path is part of it after a restart); a longer one, or one with control characters, is cut and cleaned.
+MAX_REASON_CHARS = 1000
 
 
 @dataclass(frozen=True)
@@ -65,7 +71,7 @@ class StateFile:
 
     def load(self) -> SessionState:
         try:
-            doc = json.loads(self.path.read_text(encoding="utf-8"))
+            doc = json.loads(read_regular_bytes(self.path, MAX_STATE_BYTES).decode("utf-8"))  # never a FIFO's wait
             numbers = [doc.get("satellite"), doc.get("configured")]
             for number in numbers:
                 if number is not None and (isinstance(number, bool) or not isinstance(number, int)):
@@ -73,8 +79,17 @@ class StateFile:
             auto = [doc.get("autotrack"), doc.get("autotrack_off"), doc.get("autotrack_enabled")]
             if not all(v is None or isinstance(v, t) for v, t in zip(auto, (bool, str, bool), strict=True)):
                 raise ValueError("autotrack is not on/off with a reason")
+            reason = auto[1]
+            if isinstance(reason, str) and (len(reason) > MAX_REASON_CHARS or not reason.isprintable()):
+                log.warning("the reason autotrack was off in %s is not one line of at most %d printable "
+                            "characters: cut and cleaned", self.path, MAX_REASON_CHARS)
+                auto[1] = " ".join("".join(ch if ch.isprintable() else " " for ch in reason).split())[
+                    :MAX_REASON_CHARS]
             state = SessionState(*numbers, *auto)
         except FileNotFoundError:
+            state = SessionState()
+        except RecursionError:  # "[[[[..." deeper than the interpreter's stack
+            log.warning("ignoring the saved session state in %s: nested too deeply", self.path)
             state = SessionState()
         except (OSError, ValueError, AttributeError) as exc:
             log.warning("ignoring the saved session state in %s: %s", self.path, exc)

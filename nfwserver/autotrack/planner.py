@@ -53,6 +53,23 @@ class AutotrackSettings:
         return cls(config.autotrack_satellites(), config.autotrack.min_el_deg, config.autotrack.min_gap_s)
 
 
+#: Why a schedule is empty when the list is.
+NO_SATELLITES = "no satellites to work: list them in [autotrack] satellites or [satellites] favourites"
+
+
+def list_warning(values: Sequence[int | str], catalog: Catalog) -> str | None:
+    """What ``AUTO ON`` says about the list ``values`` (highest priority first) in ``catalog``: that autotrack
+    has nothing to work and why, or which listed names it leaves out (at most three named); None when it can
+    use every one."""
+    if not values:
+        return f"autotrack is on but has nothing to work: {NO_SATELLITES}"
+    sats, problems = resolve_satellites(values, catalog)
+    if not problems:
+        return None
+    said = "; ".join(problems[:3]) + (f"; and {len(problems) - 3} more" if len(problems) > 3 else "")
+    return f"autotrack is on; left out: {said}" if sats else f"autotrack is on but has nothing to work: {said}"
+
+
 def resolve_satellites(values: Sequence[int | str], catalog: Catalog) -> tuple[list[Satellite], list[str]]:
     """The satellites ``values`` name, in order and each once, as ``SAT=`` resolves them (a catalog number; a
     name matching one satellite only), and a sentence for each value that names none or several."""
@@ -84,7 +101,7 @@ def plan_schedule(catalog: Catalog, observer: Observer, horizon: HorizonTable | 
 
     sats, problems = resolve_satellites(settings.satellites, catalog)
     if not settings.satellites:
-        problems.append("no satellites to work: list them in [autotrack] satellites or [satellites] favourites")
+        problems.append(NO_SATELLITES)
     found = find_passes(sats, observer, start, end, horizon=horizon, ut1_utc=ut1_utc, workers=workers)
     problems += [f"{catalog.dde_names_of([n])[0]} has no usable position at the start (decayed, or elements far "
                  "outside their validity)" for n in found.skipped]

@@ -7,7 +7,9 @@ they overlap.  A pass with an unknown AOS (before the search reached) counts fro
 an unknown LOS to plus infinity.
 
 Scheduled passes never come closer than ``min_gap_s`` to each other, so in AOS order they are also in LOS
-order: the conflicts of a pass are one run of them, found by two bisections.
+order: the conflicts of a pass are one run of them, found by two bisections.  Passes kept from an earlier
+plan (begun before a re-plan) are the exception, as new elements may have moved them, so they are compared
+one by one (a few at most).
 """
 
 from __future__ import annotations
@@ -47,23 +49,31 @@ def decide(aos_s: np.ndarray, los_s: np.ndarray, priority: np.ndarray, min_gap_s
     scheduled = np.zeros(n, dtype=bool)
     blocker = np.full(n, NO_BLOCKER, dtype=np.int64)
     separation = np.full(n, np.nan)
-    starts: list[float] = []  # of the scheduled passes, ascending (so are their ends)
+    # The passes the rule scheduled, ascending (they are min_gap_s apart, so their ends are too); the fixed
+    # ones apart (an element update may have moved them closer, even one into another), looked at one by one.
+    starts: list[float] = []
     ends: list[float] = []
     which: list[int] = []
+    kept: list[int] = []
     fixed_list, start_list, end_list = fixed.tolist(), start.tolist(), end.tolist()
     for i in order.tolist():
         if fixed_list[i] == 0:
             continue
         a, b = start_list[i], end_list[i]
-        if fixed_list[i] != 1:
-            # conflicts: scheduled [c, d] with c - b < gap and a - d < gap
-            hi = bisect.bisect_left(starts, b + min_gap_s)
-            lo = bisect.bisect_right(ends, a - min_gap_s)
-            if lo < hi:
-                k = which[lo]
-                blocker[i] = k
-                separation[i] = max(start_list[k] - b, a - end_list[k])
-                continue
+        if fixed_list[i] == 1:
+            kept.append(i)
+            scheduled[i] = True
+            continue
+        # conflicts: scheduled [c, d] with c - b < gap and a - d < gap
+        hi = bisect.bisect_left(starts, b + min_gap_s)
+        lo = bisect.bisect_right(ends, a - min_gap_s)
+        conflicts = [which[lo]] if lo < hi else []
+        conflicts += [k for k in kept if start_list[k] - b < min_gap_s and a - end_list[k] < min_gap_s]
+        if conflicts:
+            k = min(conflicts, key=lambda c: (start_list[c], c))
+            blocker[i] = k
+            separation[i] = max(start_list[k] - b, a - end_list[k])
+            continue
         at = bisect.bisect_left(starts, a)
         starts.insert(at, a)
         ends.insert(at, b)

@@ -52,7 +52,6 @@ class AutotrackStatus:
     next_pass: PlannedPass | None  #: the scheduled pass in progress, else the next one; None: none planned
     fault: str | None  #: planning or selecting failing now (None when all is well)
     problems: tuple[str, ...]  #: listed satellites that the plan could not use, and why
-    planned_at: datetime | None  #: when the schedule shown was made (None: no plan yet)
 
     def next_pass_text(self) -> str:
         """``SO-50 04:09-04:23`` (UTC) of :attr:`next_pass`, or ``none``."""
@@ -64,8 +63,10 @@ class AutotrackRuntime:
     """See the module docstring.  Thread-safe: ticks on one thread, switching and status from others."""
 
     def __init__(self, planner: PlanProvider, select: Select, on: bool = False,
-                 off_reason: str = NOT_SWITCHED_ON) -> None:
+                 off_reason: str = NOT_SWITCHED_ON, list_warning: Callable[[], str | None] = lambda: None) -> None:
         self._planner, self._select = planner, select
+        #: what ``AUTO ON`` says about the list of satellites (nothing to work, names left out), or None
+        self.list_warning = list_warning
         self._lock = threading.Lock()
         self._on = on
         self._off_reason = off_reason
@@ -76,6 +77,7 @@ class AutotrackRuntime:
         self._plan_retry: datetime | None = None  #: a failed plan is tried again from then on
         self._plan_fault: str | None = None
         self._selected: int | None = None  #: the satellite this runtime last selected (None after switching on)
+        self._switched_on = 0  #: times switched on: a selection begun before the last switch is not recorded
         self._select_retry: datetime | None = None
         self._select_fault: str | None = None
 
@@ -91,6 +93,7 @@ class AutotrackRuntime:
             self._off_reason = ""
             self._plan_due, self._selected = True, None
             self._plan_asks += 1
+            self._switched_on += 1
             self._plan_retry = self._select_retry = None
         if not was_on:
             log.info("autotrack on")
@@ -125,7 +128,7 @@ class AutotrackRuntime:
             return AutotrackStatus(self._on, None if self._on else self._off_reason,
                                    schedule.current_or_next(now) if schedule is not None else None,
                                    self._plan_fault or self._select_fault,
-                                   schedule.problems if schedule is not None else (), self._planned_at)
+                                   schedule.problems if schedule is not None else ())
 
     # -- ticks (one thread) ----------------------------------------------------------------------------------
     def tick(self, now: datetime) -> int | None:
@@ -134,7 +137,7 @@ class AutotrackRuntime:
         self._plan_if_due(now)
         with self._lock:
             schedule, on, selected = self._schedule, self._on, self._selected
-            retry = self._select_retry
+            retry, switched_on = self._select_retry, self._switched_on
         if not on or schedule is None:
             return None
         row = schedule.current_or_next_row(now)
@@ -146,8 +149,8 @@ class AutotrackRuntime:
         wanted = schedule.pass_at(row)
         why = self._select(wanted.catalog_number)
         with self._lock:
-            if not self._on:  # switched off meanwhile: what was chosen since wins
-                return None
+            if not self._on or self._switched_on != switched_on:
+                return None  # switched off meanwhile (what was chosen since wins), or off and on: select afresh
             if why is None:
                 self._selected, self._select_retry = wanted.catalog_number, None
                 if self._select_fault is not None:

@@ -9,7 +9,7 @@ columns: times in seconds after :attr:`Schedule.start`, NaN when unknown; angles
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from datetime import datetime, timedelta
 from functools import cached_property
@@ -68,9 +68,6 @@ class Schedule:
 
     def __len__(self) -> int:
         return len(self.columns["tca_s"])
-
-    def __iter__(self) -> Iterator[PlannedPass]:
-        return (self.pass_at(i) for i in range(len(self)))
 
     def _time(self, seconds: float) -> datetime | None:
         return None if math.isnan(seconds) else self.start + timedelta(seconds=seconds)
@@ -132,5 +129,3 @@ class Schedule:
         row = self.current_or_next_row(when)
         return self.pass_at(row) if row is not None else None
 
-    def scheduled_passes(self) -> list[PlannedPass]:
-        return [self.pass_at(int(i)) for i in self.scheduled_rows()]

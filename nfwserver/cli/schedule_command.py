@@ -16,15 +16,13 @@ import sys
 from datetime import datetime, timedelta
 from typing import TYPE_CHECKING
 
-from nfwserver.cli.arguments import number_in, satellite_value, time_value
+from nfwserver.cli.arguments import number_in, satellite_value
 from nfwserver.cli.errors import CliError, say
-from nfwserver.cli.tracking_options import TrackingInputs, add_tracking_options
+from nfwserver.cli.tracking_options import TrackingInputs, add_tracking_options, add_window_options
 
 if TYPE_CHECKING:
     from nfwserver.autotrack.schedule import Schedule
     from nfwserver.cli.output_columns import Column
-
-TIME_HELP = "'now' (default), relative (+2h, -30m, +1d) or ISO-8601 (UTC when no zone is given)"
 
 
 def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -43,13 +41,7 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
                    help="a pass counts when its highest elevation reaches this (default: [autotrack] min_el_deg)")
     p.add_argument("--min-gap", type=number_in(0, 3600, unit="s"), default=None, metavar="SECONDS",
                    help="passes closer than this count as overlapping (default: [autotrack] min_gap_s)")
-    p.add_argument("--start", type=time_value, default="now", help=TIME_HELP)
-    p.add_argument("--hours", type=number_in(0, 744, low_open=True, unit="h"), default=24.0,
-                   help="length of the window from --start, hours (default 24)")
-    p.add_argument("--local", action="store_true",
-                   help="table times in this computer's zone, named in the header (default UTC; CSV and JSON "
-                   "always give UTC)")
-    p.add_argument("--wide", action="store_true", help="a table with every column, as CSV and JSON give")
+    add_window_options(p, "a table with every column, as CSV and JSON give")
     p.set_defaults(func=run_schedule)
 
 

@@ -29,7 +29,14 @@ from nfwserver.cli.pass_reports import (
     stale_days_of,
     wide_table_local_note,
 )
-from nfwserver.cli.tracking_options import TrackingInputs, add_tracking_options, format_time, load_tracking_inputs
+from nfwserver.cli.tracking_options import (
+    TIME_HELP,
+    TrackingInputs,
+    add_tracking_options,
+    add_window_options,
+    format_time,
+    load_tracking_inputs,
+)
 
 if TYPE_CHECKING:
     from nfwserver.tracking.catalog import Catalog, Satellite
@@ -39,7 +46,6 @@ if TYPE_CHECKING:
 
 EPHEMERIS_COLUMNS = ["time_utc", "azimuth_deg", "elevation_deg", "range_km", "range_rate_km_s", "above_horizon"]
 VISIBLE_COLUMNS = ["catalog_number", "name", "azimuth_deg", "elevation_deg", "range_km", "range_rate_km_s"]
-TIME_HELP = "'now' (default), relative (+2h, -30m, +90s, +1d) or ISO-8601 (UTC when no zone is given)"
 MAX_DURATION_S = 366 * 86400.0
 
 
@@ -75,15 +81,8 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     p.add_argument("--min-el", type=number_in(-90, 90, unit="deg"), default=0.0, metavar="DEG",
                    help="only passes whose highest elevation reaches this many degrees (default 0: every pass "
                    "over the horizon table; 10 is a common choice for passes worth working)")
-    p.add_argument("--start", type=time_value, default="now", help=TIME_HELP)
-    p.add_argument("--hours", type=number_in(0, 744, low_open=True, unit="h"), default=24.0,
-                   help="length of the window from --start, hours (default 24)")
-    p.add_argument("--local", action="store_true",
-                   help="table times in this computer's zone, named in the header (default UTC; CSV and JSON "
-                   "always give UTC)")
-    p.add_argument("--wide", action="store_true",
-                   help="a table with every column (catalog number, full name, ISO times with milliseconds, "
-                   "azimuths, duration in seconds, in_progress)")
+    add_window_options(p, "a table with every column (catalog number, full name, ISO times with milliseconds, "
+                       "azimuths, duration in seconds, in_progress)")
     p.add_argument("--workers", type=_workers_value, default="auto", metavar="N|auto",
                    help="worker processes for large catalogs (POSIX; the rows are the same whatever the number); "
                    "auto (the default): one per idle core for 1,000 satellites or more, else 1")

@@ -16,7 +16,7 @@ from functools import cached_property
 from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
-from nfwserver.cli.arguments import number_in, observer_value
+from nfwserver.cli.arguments import number_in, observer_value, time_value
 from nfwserver.cli.errors import CliError, load_config_or_fail, say
 
 if TYPE_CHECKING:  # imported when the options are resolved: `--help` and parsing stay light
@@ -163,6 +163,20 @@ def add_tracking_options(parser: argparse.ArgumentParser, output_format: bool = 
     if output_format:
         parser.add_argument("--format", choices=("table", "csv", "json"), default="table",
                             help="output format: an aligned table, CSV with a header row, or a JSON array of objects")
+
+
+TIME_HELP = "'now' (default), relative (+2h, -30m, +90s, +1d) or ISO-8601 (UTC when no zone is given)"
+
+
+def add_window_options(parser: argparse.ArgumentParser, wide_help: str) -> None:
+    """Add the pass tables' ``--start``, ``--hours`` (the window), ``--local`` and ``--wide`` (passes, schedule)."""
+    parser.add_argument("--start", type=time_value, default="now", help=TIME_HELP)
+    parser.add_argument("--hours", type=number_in(0, 744, low_open=True, unit="h"), default=24.0,
+                        help="length of the window from --start, hours (default 24)")
+    parser.add_argument("--local", action="store_true",
+                        help="table times in this computer's zone, named in the header (default UTC; CSV and JSON "
+                        "always give UTC)")
+    parser.add_argument("--wide", action="store_true", help=wide_help)
 
 
 def format_time(when: datetime) -> str:

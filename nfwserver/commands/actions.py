@@ -61,6 +61,9 @@ class AutotrackSwitch(Protocol):
 
     def switch_off(self, reason: str) -> bool: ...
 
+    def list_warning(self) -> str | None:
+        """What ``AUTO ON`` says about the list of satellites (nothing to work, names left out), or None."""
+
 
 class StationPort(Protocol):
     """What Nova's station commands need of the station core."""
@@ -180,7 +183,9 @@ def satellite(targets: Targets, value: object, source: str) -> Outcome:
 def autotrack(targets: Targets, value: object, source: str) -> Outcome:
     """AUTO ON/OFF: the station selects the satellite of its schedule by itself, or leaves the choice to people."""
     targets.station.set_autotrack(value is True, source)
-    return DONE
+    switch = targets.station.autotrack
+    warning = switch.list_warning() if value is True and switch is not None else None
+    return Outcome(warning=warning) if warning else DONE
 
 
 def doppler(targets: Targets, value: object, source: str) -> Outcome:

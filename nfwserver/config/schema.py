@@ -96,18 +96,24 @@ class TcpConfig:
 
     @staticmethod
     def peer_key(address: str) -> str:
-        """The peer's address as one key per host: IPv4-mapped IPv6 as IPv4, no zone, canonical form."""
-        try:
-            ip = ipaddress.ip_address(address.split("%", 1)[0])
-        except ValueError:
-            return address
-        if isinstance(ip, ipaddress.IPv6Address) and ip.ipv4_mapped is not None:
-            return str(ip.ipv4_mapped)
-        return str(ip)
+        """The peer's address as one key per host (:func:`plain_address`)."""
+        return plain_address(address)
 
     def allows(self, address: str) -> bool:
         """True when the peer ``address`` (an IP address string) lies in one of the ``allow`` networks."""
         return address_allowed(self.allow, address)
+
+
+def plain_address(address: str) -> str:
+    """``address`` (an IP address string) in canonical form, without an IPv6 zone, an IPv4-mapped IPv6 address
+    as IPv4: one key per host (text that is no address is returned as it is)."""
+    try:
+        ip = ipaddress.ip_address(address.split("%", 1)[0])
+    except ValueError:
+        return address
+    if isinstance(ip, ipaddress.IPv6Address) and ip.ipv4_mapped is not None:
+        return str(ip.ipv4_mapped)
+    return str(ip)
 
 
 def address_allowed(networks: tuple[str, ...], address: str) -> bool:

@@ -9,8 +9,8 @@ read-back.  No adapter keeps its own copy of the station, and none records a com
 Every command is run through its entry's check and action in the command table
 (:mod:`nfwserver.commands`) and recorded here as one event: Nova's ``TUNE ON|OFF`` (the DDE output),
 ``TRACK ON|OFF`` (autotracking), ``SAT=<catalog number>``, ``ANTAZ=<deg>``, ``ANTEL=<deg>`` and the radio's
-``DOPPLER ON|OFF`` on the station; ``FLIP``/``PARK`` on the rotor; the TCP session's and the console's own
-commands on the session or display the face passes.
+``DOPPLER ON|OFF`` and ``AUTO ON|OFF`` on the station; ``FLIP``/``PARK`` on the rotor; the TCP session's and
+the console's own commands on the session or display the face passes.
 ``TRACK ON`` is an OrbitDRV enable call: "ignored if the station or satellite parameters have not
 been set".  It is then acknowledged (a client without error handling must not die on it) but does
 nothing, and the reason is logged, recorded in the event stream and returned in

@@ -14,7 +14,9 @@ stream (``STREAM``).  Three caps, and what happens at each:
 - **in all** (``max_clients``): a new connection takes the place of the oldest connection still sending
   its request, of another address first; one from the station's own address may also take the place of
   another address's event stream.  The station's own event streams and connections being answered are
-  never taken, and another address never takes the station's own connections.
+  never taken, and another address never takes the station's own connections;
+- **event streams** (the server's ``max_streams``): a stream for the station's own address ends another
+  address's oldest stream (:meth:`Admission.make_room_for_stream`); others are refused.
 
 "The oldest still sending its request" is the connection that has done least for longest: a slowloris that
 trickles a byte every few seconds, a half request, or a browser's spare connection that sent nothing.  A
@@ -27,13 +29,14 @@ its slot is free before the new one is counted in.
 
 from __future__ import annotations
 
-import ipaddress
 import socket
 import threading
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass
 from enum import Enum
+
+from nfwserver.config.schema import plain_address
 
 __all__ = ["OWN_RESERVE", "Admission", "Phase", "Slot", "Verdict"]
 
@@ -65,17 +68,6 @@ class Verdict:
     slot: Slot | None
     reason: str | None = None
     evicted: Slot | None = None
-
-
-def plain_address(host: str) -> str:
-    """``host`` without an IPv6 zone, and an IPv4-mapped IPv6 address as IPv4."""
-    try:
-        ip = ipaddress.ip_address(host.split("%", 1)[0])
-    except ValueError:
-        return host
-    if isinstance(ip, ipaddress.IPv6Address) and ip.ipv4_mapped is not None:
-        return str(ip.ipv4_mapped)
-    return str(ip)
 
 
 def is_own(host: str, local: str) -> bool:
@@ -140,6 +132,18 @@ class Admission:
                 return victim
         return None
 
+    def make_room_for_stream(self, sock: socket.socket) -> Slot | None:
+        """The event streams' own cap is reached and ``sock`` asks for one: when it comes from the station's own
+        address, end another address's oldest event stream for it and return that slot; else None."""
+        with self._lock:
+            slot = self._slots.get(id(sock))
+            if slot is None or slot.sock is not sock or not slot.own:
+                return None
+            victim = _oldest(s for s in self._slots.values() if not s.own and s.phase is Phase.STREAM)
+            if victim is not None:
+                self._take(victim)
+            return victim
+
     def _take(self, victim: Slot) -> None:
         """Free ``victim``'s slot and end its connection (its own thread then finds it closed)."""
         del self._slots[id(victim.sock)]
@@ -155,6 +159,12 @@ class Admission:
             slot = self._slots.get(id(sock))
             if slot is not None and slot.sock is sock:
                 del self._slots[id(sock)]
+
+    def holds(self, sock: socket.socket) -> bool:
+        """Whether ``sock``'s connection still has its slot (False once taken for another, or released)."""
+        with self._lock:
+            slot = self._slots.get(id(sock))
+            return slot is not None and slot.sock is sock
 
     def mark(self, sock: socket.socket, phase: Phase) -> None:
         """``sock``'s connection is now in ``phase``."""

@@ -5,8 +5,8 @@ A control request is a JSON object ``{"command": "TRACK ON", "token": "..."}`` p
 station's stream) when ``[web] control`` is off or its token is weak (checked before the body is read),
 when the token is missing or wrong (:func:`~nfwserver.config.tokens.token_matches`, constant time), or
 when the line is not one of the commands the table lets the web face send (:attr:`Face.WEB`: ``TUNE``,
-``TRACK``, ``SAT``, ``ANTAZ``/``ANTEL``, ``DOPPLER``, ``FLIP``, ``PARK``).  The line is parsed by the command table
-(:func:`~nfwserver.commands.parsing.parse_request`, once, which also bounds its length) and run through
+``TRACK``, ``SAT``, ``ANTAZ``/``ANTEL``, ``DOPPLER``, ``AUTO``, ``FLIP``, ``PARK``).  The line is parsed by the
+command table (:func:`~nfwserver.commands.parsing.parse_request`, once, which also bounds its length) and run through
 the table's actions by :meth:`~nfwserver.core.station_core.StationCore.execute`, as every face's commands
 are, with the browser's address as the source; the reply is the station's answer (a rotor command acts on
 the station's rotor, or is refused without one).  The control switch and the token are read

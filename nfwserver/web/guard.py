@@ -11,6 +11,9 @@
   must be the station's own page (``http://`` or, behind a TLS proxy, ``https://`` with the request's
   Host).  A request that says nothing of the kind (``curl``, a script) is no browser's and may carry the
   token like any other.
+- **Event streams**: ``GET /api/stream`` holds a connection; one another site's page asks for (which it
+  cannot read, but may keep open) is refused (403) when the browser says so (``Sec-Fetch-Site``), so such
+  pages cannot take the station's own address's connections.
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ from typing import Protocol
 
 from nfwserver.config.schema import WebConfig
 
-__all__ = ["cross_site_reason", "host_name", "host_refusal"]
+__all__ = ["cross_site_reason", "foreign_site_reason", "host_name", "host_refusal"]
 
 _WILDCARDS = ("0.0.0.0", "::", "")
 _HOST_FORM = re.compile(r"(?:\[(?P<bracketed>[^\[\]]*)\]|(?P<name>[^:\[\]]*))(?::[0-9]{1,5})?")
@@ -71,6 +74,15 @@ def host_refusal(header: str | None, config: WebConfig, local_address: str) -> s
     return f"Host {name!r} is not a name of this station (add it to [web] hostnames)"
 
 
+def foreign_site_reason(headers: Headers) -> str | None:
+    """Why a request the browser says comes from another site's page (``Sec-Fetch-Site``) is refused, or None
+    (the station's own page, a typed address or bookmark, or no browser)."""
+    site = headers.get("Sec-Fetch-Site")
+    if site is not None and site.strip().lower() not in ("same-origin", "none"):
+        return f"a request from another site (Sec-Fetch-Site: {site.strip()[:40]})"
+    return None
+
+
 def cross_site_reason(headers: Headers, host: str) -> str | None:
     """Why a command request is refused as not coming from the station's own page, or None.
 
@@ -79,9 +91,9 @@ def cross_site_reason(headers: Headers, host: str) -> str | None:
     media_type = (headers.get("Content-Type") or "").split(";", 1)[0].strip().lower()
     if media_type != "application/json":
         return "commands are taken only as application/json"
-    site = headers.get("Sec-Fetch-Site")
-    if site is not None and site.strip().lower() not in ("same-origin", "none"):
-        return f"a request from another site (Sec-Fetch-Site: {site.strip()[:40]})"
+    why = foreign_site_reason(headers)
+    if why is not None:
+        return why
     own = tuple(f"{scheme}://{host.strip().lower()}" for scheme in ("http", "https"))  # https: behind a TLS proxy
     origin = headers.get("Origin")
     if origin is not None:

@@ -34,7 +34,7 @@ from typing import Any
 from nfwserver.release import package_version
 from nfwserver.web.admission import Phase
 from nfwserver.web.control import help_entries
-from nfwserver.web.guard import cross_site_reason, host_refusal
+from nfwserver.web.guard import cross_site_reason, foreign_site_reason, host_refusal
 from nfwserver.web.request_head import SECURITY_HEADERS, HeadReader, error_response, linger_close, read_head
 
 log = logging.getLogger(__name__)
@@ -222,7 +222,12 @@ class WebHandler(BaseHTTPRequestHandler):
 
     def _stream(self) -> None:
         web = self.web
-        refusal = web.stream_opened(self.peer)
+        foreign = foreign_site_reason(self.headers)
+        if foreign is not None:
+            web.request_refused(self.client_address[0], 403, foreign)
+            self._json(403, {"ok": False, "error": foreign})
+            return
+        refusal = web.stream_opened(self.peer, self.connection)
         if refusal is not None:
             self._json(503, {"ok": False, "error": refusal})
             return
@@ -233,13 +238,17 @@ class WebHandler(BaseHTTPRequestHandler):
             cursor, history = web.page_log()  # the frames are shared; the log lines are this page's own
             self.wfile.write(b"event: history\ndata: " + json.dumps(history, default=str).encode() + b"\n\n")
             seen, frame = web.hub.newest()
-            while not web.stopping:
+
+            def taken() -> bool:  # its slot was given to a newer connection (web/admission.py)
+                return not web.admission.holds(self.connection)
+
+            while not web.stopping and not taken():
                 if frame is not None:
                     self.wfile.write(b"event: state\ndata: " + cursor.attach(frame) + b"\n\n")
                 else:
                     self.wfile.write(b": keep-alive\n\n")
-                seen, frame = web.hub.wait_newer(seen, KEEPALIVE_S)
-            reason = "server stopping"
+                seen, frame = web.hub.wait_newer(seen, KEEPALIVE_S, taken)
+            reason = "server stopping" if web.stopping else "closed to make room for a newer connection"
         except TimeoutError:
             reason, dropped = f"stopped reading (nothing sent for {web.io_timeout_s:g} s)", True
         except (BrokenPipeError, ConnectionResetError, ConnectionAbortedError):

@@ -11,6 +11,7 @@ has not been sent to the frame it sends (:class:`~nfwserver.web.station_parts.Lo
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 
 
 class FrameHub:
@@ -38,14 +39,22 @@ class FrameHub:
         with self._cond:
             return self._seq, self._frame
 
-    def wait_newer(self, seen: int, timeout_s: float | None = None) -> tuple[int, bytes | None]:
-        """The newest frame once its number is above ``seen``; (seen, None) when closed or after
-        ``timeout_s`` real seconds (None: no limit)."""
+    def wait_newer(self, seen: int, timeout_s: float | None = None,
+                   ended: Callable[[], bool] | None = None) -> tuple[int, bytes | None]:
+        """The newest frame once its number is above ``seen``; (seen, None) when closed, after ``timeout_s``
+        real seconds (None: no limit), or when ``ended()`` is true (looked at on entry and at each
+        :meth:`wake`)."""
         with self._cond:
-            self._cond.wait_for(lambda: self._closed or self._seq > seen, timeout_s)
+            self._cond.wait_for(lambda: self._closed or self._seq > seen or (ended is not None and ended()),
+                                timeout_s)
             if self._closed or self._seq <= seen:
                 return seen, None
             return self._seq, self._frame
+
+    def wake(self) -> None:
+        """Make every waiting connection look at its ``ended`` condition again (a connection ended for another)."""
+        with self._cond:
+            self._cond.notify_all()
 
     def close(self) -> None:
         """Wake every waiting connection for good (server stopping)."""

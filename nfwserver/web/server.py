@@ -50,7 +50,7 @@ from nfwserver.core.station_core import StationCore
 from nfwserver.listen_errors import bind_failure
 from nfwserver.listen_socket import claim_port
 from nfwserver.ratelimited_log import RateLimitedLog
-from nfwserver.web.admission import OWN_RESERVE, Admission
+from nfwserver.web.admission import OWN_RESERVE, Admission, Phase
 from nfwserver.web.control import Control
 from nfwserver.web.handler import WebHandler
 from nfwserver.web.hub import FrameHub
@@ -313,6 +313,8 @@ class WebServer:
             gone = verdict.evicted
             with self._lock:
                 self.stats.evicted += 1
+            if gone.phase is Phase.STREAM:
+                self.hub.wake()  # its thread, waiting for a frame, sees at once that it was taken
             self._note_refusal(gone.host, f"web connection from {gone.host} closed ({gone.phase.value} for "
                                f"{time.monotonic() - gone.since:.1f} s) to make room for one from {host}",
                                "connection closed to make room for another (it had done least for longest)")
@@ -359,16 +361,26 @@ class WebServer:
         what = f"{type(exc).__name__}: {exc}" if exc is not None else "unknown error"
         self._refusals.log(logging.INFO, f"{host}:failed", "web connection from %s ended: %s", host, what[:200])
 
-    def stream_opened(self, peer: str) -> str | None:
-        """Count an event stream in; or why not (over :attr:`max_streams`)."""
+    def stream_opened(self, peer: str, sock: socket.socket | None = None) -> str | None:
+        """Count an event stream in (on ``sock``); or why not (over :attr:`max_streams`, unless it is the station's
+        own address's and another address's stream makes room for it)."""
         first = False
         with self._lock:
-            if self.stats.streams >= self.max_streams:
+            full = self.stats.streams >= self.max_streams
+        gone = self.admission.make_room_for_stream(sock) if full and sock is not None else None
+        with self._lock:
+            if gone is not None:
+                self.stats.evicted += 1
+            if self.stats.streams >= self.max_streams and gone is None:
                 self.stats.refused += 1
                 reason = f"already {self.max_streams} event streams (the web server's cap)"
             else:
                 self.stats.streams += 1
                 first, reason = self.stats.streams == 1, None
+        if gone is not None:
+            self.hub.wake()  # its thread, waiting for a frame, sees at once that it was taken
+            self._note_refusal(gone.host, f"web event stream for {gone.host} closed to make room for the station's "
+                               "own page", "event stream closed to make room for the station's own page")
         if reason is None and first:
             self._safe_frame()  # frames were not built while no page was connected: a fresh one now
         if reason is not None:

@@ -81,3 +81,13 @@ def test_the_rule_matches_a_brute_force_reading_of_its_words(raw, gap) -> None:
     assert list(zip(d.scheduled.tolist(), d.blocker.tolist())) == _plain_rule(passes, gap)
     chosen = [passes[i] for i in np.flatnonzero(d.scheduled)]
     assert all(max(q[0] - p[1], p[0] - q[1]) >= gap for p in chosen for q in chosen if p is not q)
+
+
+def test_a_pass_overlapping_a_kept_pass_is_left_out_even_when_kept_passes_overlap_each_other() -> None:
+    """Begun passes keep their decision on a re-plan; an element update can move one kept pass into another
+    ([0, 1000] holding [100, 200]).  The bisection over the scheduled passes' ends then missed [500, 600], which
+    overlaps the first: it was scheduled beside it."""
+    aos, los = np.array([0.0, 100.0, 500.0]), np.array([1000.0, 200.0, 600.0])
+    decisions = decide(aos, los, np.array([0, 1, 2]), 60.0, np.array([1, 1, -1]))
+    assert decisions.scheduled.tolist() == [True, True, False]
+    assert decisions.blocker[2] == 0 and decisions.separation_s[2] < 0  # overlaps the first

@@ -16,6 +16,7 @@ import pytest
 
 from nfwserver.autotrack import AutotrackRuntime, AutotrackSettings, StationPlanner, plan_schedule
 from nfwserver.autotrack import runtime as runtime_module
+from nfwserver.autotrack.schedule import PlannedPass, Schedule
 from nfwserver.cli import main
 from nfwserver.clock import VirtualClock
 from nfwserver.tracking.catalog import Catalog
@@ -54,6 +55,12 @@ class Station:
         while self.clock.now() < until:
             runtime.tick(self.clock.now())
             self.clock.advance(step_s)
+
+
+def passes_of(schedule: Schedule | None) -> list[PlannedPass]:
+    """Every candidate pass of ``schedule``, scheduled or not, in AOS order."""
+    assert schedule is not None
+    return [schedule.pass_at(row) for row in range(len(schedule))]
 
 
 def _catalog(path: Path = AMATEUR) -> Catalog:
@@ -134,7 +141,7 @@ def test_new_elements_are_planned_when_replan_is_asked(capsys, tmp_path) -> None
     runtime, unaware = station.runtime(), station.runtime(on=False)
     runtime.tick(START)
     unaware.tick(START)
-    old = [p.aos for p in runtime.schedule if p.catalog_number == 27607]
+    old = [p.aos for p in passes_of(runtime.schedule) if p.catalog_number == 27607]
     summary = station.catalog.update(load_element_file(newer).sets)
     assert summary.updated == [27607]
     runtime.replan()
@@ -142,10 +149,10 @@ def test_new_elements_are_planned_when_replan_is_asked(capsys, tmp_path) -> None
     station.clock.advance(3600.0)
     runtime.tick(later)
     unaware.tick(later)
-    assert [p.aos for p in unaware.schedule if p.catalog_number == 27607] == old  # not asked: the old plan
+    assert [p.aos for p in passes_of(unaware.schedule) if p.catalog_number == 27607] == old  # not asked: the old plan
     rows = _passes_csv(capsys, newer, later, 20)
     so50 = [r["aos_utc"] for r in rows if r["catalog_number"] == "27607" and _time(r["los_utc"]) > later]
-    got = [f"{p.aos:%Y-%m-%dT%H:%M:%S.%f}"[:23] + "Z" for p in runtime.schedule if p.catalog_number == 27607
+    got = [f"{p.aos:%Y-%m-%dT%H:%M:%S.%f}"[:23] + "Z" for p in passes_of(runtime.schedule) if p.catalog_number == 27607
            and p.aos is not None and later + timedelta(hours=20) > p.aos]
     assert got == so50 and got != [f"{a:%Y-%m-%dT%H:%M:%S.%f}"[:23] + "Z" for a in old if a > later][:len(got)]
     # and the selections follow the new passes
@@ -160,13 +167,13 @@ def test_a_begun_pass_keeps_its_decision_when_replanned() -> None:
     catalog = _catalog()
     settings = AutotrackSettings(tuple(SIX))
     first = plan_schedule(catalog, OBSERVER, None, 0.0, settings, START, START + timedelta(hours=24))
-    ao7 = next(p for p in first if p.catalog_number == 7530 and f"{p.aos:%H:%M}" == "06:02")
+    ao7 = next(p for p in passes_of(first) if p.catalog_number == 7530 and f"{p.aos:%H:%M}" == "06:02")
     assert ao7.reason == "overlaps SO-50 05:50-06:03"
     at = START + timedelta(hours=6, minutes=10)  # SO-50's pass is over, AO-7's under way
     fresh = plan_schedule(catalog, OBSERVER, None, 0.0, settings, at, at + timedelta(hours=24))
     again = plan_schedule(catalog, OBSERVER, None, 0.0, settings, at, at + timedelta(hours=24), previous=first)
     assert fresh.current_or_next(at).catalog_number == 7530  # alone, the rule would now take AO-7 mid-pass
-    kept = next(p for p in again if p.catalog_number == 7530 and p.in_progress(at))
+    kept = next(p for p in passes_of(again) if p.catalog_number == 7530 and p.in_progress(at))
     assert not kept.scheduled and kept.reason == "overlaps SO-50 05:50-06:03"
     assert again.current_or_next(at).catalog_number == 44909  # RS-44 07:05
 
@@ -261,7 +268,7 @@ def test_the_status_names_the_next_scheduled_pass() -> None:
     assert runtime.status(START).off_reason == runtime_module.NOT_SWITCHED_ON
     runtime.tick(START)
     status = runtime.status(START + timedelta(hours=2, minutes=20))  # after ISS's 02:03-02:14 pass
-    assert status.next_pass_text() == "SO-50 02:31-02:43" and status.planned_at == START
+    assert status.next_pass_text() == "SO-50 02:31-02:43"
     assert not status.on and status.fault is None and status.problems == ()
     settings = AutotrackSettings(("ISS", "NOSUCH", 25544))
     runtime = station.runtime(settings=settings)
@@ -277,3 +284,28 @@ def test_an_empty_list_says_why_nothing_is_planned() -> None:
     assert status.next_pass is None and station.calls == []
     assert status.problems == ("no satellites to work: list them in [autotrack] satellites or [satellites] "
                                "favourites",)
+
+
+def test_a_sat_and_auto_on_during_autotrack_own_selection_are_followed_by_a_fresh_selection() -> None:
+    """Autotrack selects outside its lock (the station's choice lock is taken there).  A client's SAT= (switching
+    it off and selecting another satellite) and an AUTO ON, both arriving while that selection is under way,
+    left the runtime believing its satellite was selected: it did not select again until the schedule's
+    satellite changed, and the client's satellite stayed on with autotrack on."""
+    station = Station(_catalog())
+    runtime = station.runtime(on=True)
+    raced = []
+
+    def select(number: int) -> str | None:
+        why = station.select(number)
+        if not raced:  # other threads, between the selection and the runtime's record of it
+            raced.append(number)
+            runtime.switch_off("SAT=43017 from tcp 127.0.0.1:1 chose the satellite")
+            station.selected = 43017
+            runtime.switch_on()
+        return why
+
+    runtime._select = select
+    runtime.tick(START)
+    runtime.tick(START + timedelta(seconds=1))
+    assert len(station.calls) == 2 and station.selected == raced[0], station.calls
+

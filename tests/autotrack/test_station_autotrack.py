@@ -226,3 +226,20 @@ def test_the_dashboard_gets_the_running_stations_schedule_and_its_auto_command()
         assert (status, body["ok"]) == (200, True) and not web.station.autotrack.runtime.on
     finally:
         web.station.stop()
+
+
+def test_the_reason_autotrack_is_off_does_not_grow_with_each_restart(tmp_path) -> None:
+    """Each restart appended "(before the restart, kept in FILE)" to the reason it read back and saved it again:
+    after a few restarts the reason outgrew what the state file takes back, and the saved state was lost."""
+    station = _station(tmp_path, True)
+    try:
+        assert _ask(station, "AUTO OFF") == "OK"
+    finally:
+        station.stop()
+    reasons = []
+    for _ in range(4):
+        again = _station(tmp_path, True)
+        again.stop()
+        reasons.append(json.loads((tmp_path / "state.json").read_text())["autotrack_off"])
+    assert reasons[0].startswith("AUTO OFF from tcp 127.0.0.1:") and reasons.count(reasons[0]) == 4, reasons
+    assert reasons[0].count("before the restart") <= 1

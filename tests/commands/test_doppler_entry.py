@@ -21,7 +21,7 @@ def test_every_face_switches_doppler_and_the_core_records_it() -> None:
     core = station.core
     conv = station.system.connect("NFW32", "NFW_DATA")
     tcp = NovaTcpProtocol(core)
-    web = Control(core, WebConfig(control=True, token=TOKEN), lambda address, line: True)
+    web = Control(core, WebConfig(control=True, token=TOKEN), lambda host, line: True)
     assert core.tracker.status_word() & StatusBit.TUNING_DISABLED
 
     conv.poke("NFW_SERVER", "DOPPLER ON")  # DDE: acknowledged (a refusal raises)

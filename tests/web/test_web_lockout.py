@@ -78,13 +78,65 @@ def test_the_operator_event_streams_are_never_evicted_for_other_addresses() -> N
 def test_other_addresses_cannot_take_the_reserve_of_the_station_own_address() -> None:
     """Event streams are not evicted for another address, so they are what a crowd would hold on to."""
     with running_web(max_clients=8, own_reserve=2, max_per_address=4, max_streams=64) as (_core, web):
-        held = [connect(web, source) for source in ("127.0.0.2", "127.0.0.3") for _ in range(4)]
-        for sock in held:
-            sock.sendall(b"GET /api/stream HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n")
-        wait_for(lambda: web.stats.accepted + web.stats.refused >= 8, what="the crowd's streams")
-        assert web.stats.streams == 6  # 8 - 2 reserved: two of them were refused
+        held, answers = [], []
+        for source in ("127.0.0.2", "127.0.0.3"):
+            for _ in range(4):  # one after the other: each streaming (or refused) before the next asks
+                sock = connect(web, source)
+                sock.sendall(b"GET /api/stream HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n")
+                sock.settimeout(5.0)
+                answers.append(sock.recv(12))
+                held.append(sock)
+        assert answers == [b"HTTP/1.0 200"] * 6 + [b"HTTP/1.0 503"] * 2  # 8 - 2 reserved: two were refused
+        assert web.stats.streams == 6
         third = exchange(web, GET_HELP, "127.0.0.4")
         assert status(third) == 503 and b"reserved" in third, third
         _answered_at_once(web)  # the reserve
         for sock in held:
+            sock.close()
+
+
+def test_other_addresses_event_streams_do_not_take_the_operator_page() -> None:
+    """Event streams have their own cap (``max_streams``): a crowd that holds all of them made the operator's
+    page answer 503 to its own event stream.  Now the station's own address takes the place of another
+    address's oldest stream."""
+    with running_web(max_streams=4) as (_core, web):
+        crowd = [connect(web, "127.0.0.2") for _ in range(4)]
+        for sock in crowd:
+            sock.sendall(b"GET /api/stream HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n")
+        for sock in crowd:  # each of them streaming
+            sock.settimeout(5.0)
+            assert sock.recv(12) == b"HTTP/1.0 200"
+        mine = connect(web, "127.0.0.1")
+        mine.sendall(b"GET /api/stream HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n")
+        mine.settimeout(5.0)
+        assert mine.recv(64).startswith(b"HTTP/1.0 200"), "the operator's event stream was refused"
+        assert not _still_open(crowd[0])  # the oldest of the crowd's streams was ended
+        wait_for(lambda: web.stats.streams == 4, what="the evicted stream counted out")
+        assert all(_still_open(sock) for sock in crowd[1:])
+        third = connect(web, "127.0.0.3")  # another address still meets the cap
+        third.sendall(b"GET /api/stream HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n")
+        assert status(read_all(third)) == 503
+        for sock in (*crowd, mine, third):
+            sock.close()
+
+
+def test_another_site_page_cannot_hold_the_operator_event_streams() -> None:
+    """A page of another site the operator visits may open the station's event stream (``fetch`` with
+    ``no-cors`` reads on for ever): its connections come from 127.0.0.1, the station's own address, whose
+    event streams are never taken, so a few such pages filled the 16 per address and locked the operator's
+    page out.  The browser says where the request comes from (``Sec-Fetch-Site``); another site's is refused
+    before it holds a stream."""
+    with running_web() as (_core, web):
+        for site in ("cross-site", "same-site"):
+            reply = exchange(web, b"GET /api/stream HTTP/1.1\r\nHost: 127.0.0.1\r\nSec-Fetch-Site: " +
+                             site.encode() + b"\r\nSec-Fetch-Mode: no-cors\r\n\r\n")
+            assert status(reply) == 403 and b"another site" in reply, reply[:300]
+        assert web.stats.streams == 0
+        own = connect(web)  # the station's own page (same-origin), and a tool that says nothing, still stream
+        own.sendall(b"GET /api/stream HTTP/1.1\r\nHost: 127.0.0.1\r\nSec-Fetch-Site: same-origin\r\n\r\n")
+        tool = connect(web)
+        tool.sendall(b"GET /api/stream HTTP/1.0\r\n\r\n")
+        for sock in (own, tool):
+            sock.settimeout(5.0)
+            assert sock.recv(64).startswith(b"HTTP/1.0 200")
             sock.close()

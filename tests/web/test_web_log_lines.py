@@ -11,6 +11,7 @@ import json
 import select
 import socket
 import threading
+from collections.abc import Callable
 
 from nfwserver.clock import VirtualClock
 from nfwserver.core.events import Direction
@@ -28,10 +29,11 @@ class _HeldReaderHub(FrameHub):
         self.gate = threading.Event()
         self.waiting = threading.Event()
 
-    def wait_newer(self, seen: int, timeout_s: float | None = None) -> tuple[int, bytes | None]:
+    def wait_newer(self, seen: int, timeout_s: float | None = None,
+                   ended: Callable[[], bool] | None = None) -> tuple[int, bytes | None]:
         self.waiting.set()
         self.gate.wait(30.0)
-        return super().wait_newer(seen, timeout_s)
+        return super().wait_newer(seen, timeout_s, ended)
 
 
 class _SseReader:
