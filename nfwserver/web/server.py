@@ -4,22 +4,19 @@ Threads and what they do:
 
 - the publisher thread only runs :meth:`WebServer.on_tick`: it keeps a reference to the newest sample
   and sets an event, at a cost that does not depend on the number of browsers;
-- ``nfw-web`` (the frame thread) wakes on that event and, while at least one page is connected (an
-  event stream is open), builds one frame (JSON) from the live state
-  (:mod:`~nfwserver.web.state_view`, :mod:`~nfwserver.web.station_parts`) at most
-  :data:`MAX_FRAME_HZ` times a second, and puts it in the :class:`~nfwserver.web.hub.FrameHub`; with no
-  page connected it builds none (``/api/state`` then builds its own).  A frame that fails to build is
-  logged once a minute and replaced in the hub by ``{"frame_error": ...}``, so no page shows itself live
-  on a frame that no longer changes;
+- ``nfw-web`` (the frame thread) wakes on that event and, while an event stream is open, builds one frame
+  (JSON) from the live state (:mod:`~nfwserver.web.state_view`, :mod:`~nfwserver.web.station_parts`) at most
+  :data:`MAX_FRAME_HZ` times a second into the :class:`~nfwserver.web.hub.FrameHub` (with no page, none:
+  ``/api/state`` builds its own).  A frame that fails to build is logged once a minute and replaced in the
+  hub by ``{"frame_error": ...}``, so no page shows itself live on a frame that no longer changes;
 - ``nfw-web-http`` accepts connections (Python's :class:`http.server.ThreadingHTTPServer`); each
-  connection has a thread of its own, at most ``max_clients`` at once (others are closed at once);
-  an event-stream connection sends the hub's newest frame whenever there is one (Server-Sent Events),
-  with the log lines that page has not been sent (:class:`~nfwserver.web.station_parts.LogCursor`);
+  connection has a thread of its own, at most ``max_clients`` at once; an event stream sends the hub's newest
+  frame whenever there is one (SSE), with the log lines that page lacks (:class:`~.station_parts.LogCursor`);
 - ``nfw-web-passes``: :class:`~nfwserver.web.pass_board.PassBoard`.
 
-Bounds: every socket has a timeout (``io_timeout_s``): a browser that stops reading blocks only its
-own thread, for at most that long, and is then dropped (``stats.dropped``); there is no queue, so it
-never costs memory beyond its socket buffer, and no tick ever waits for it.  A request head must arrive
+Bounds: every socket has a timeout (``io_timeout_s``): a browser that stops reading blocks only its own thread,
+that long at most, then is dropped (``stats.dropped``); no queue, so no memory beyond its socket buffer, and no
+tick ever waits for it.  A request head must arrive
 whole within ``head_deadline_s`` and :data:`~nfwserver.web.request_head.MAX_HEAD_BYTES`
 (:mod:`~nfwserver.web.request_head`).  Connections are held by :class:`~nfwserver.web.admission.Admission`:
 at a cap (``max_clients``, ``max_per_address``) the one that has done least for longest makes room, and
