@@ -115,6 +115,9 @@ class StationCore:
         self._choosing = threading.Lock()
         #: the rotor's command port for FLIP and PARK (set by the station; None: no rotor)
         self.rotor: RotorControl | None = None
+        #: run before each request is checked: the station applies a configuration file changed a moment ago
+        #: (``config set`` then a command: the command sees the change), see Station.catch_up_config
+        self.before_command: Callable[[], None] = lambda: None
         if satellite is not None:
             self.state.set_selected_by("config")
         if satellite is not None and not self.select_satellite(satellite, source="startup"):
@@ -269,6 +272,7 @@ class StationCore:
         start the count afresh).  Nova's station commands also set the status word's bad function/subfunction
         bits (cleared by the next accepted one).  Rotor commands act on :attr:`rotor` (refused without one),
         session commands on the sender's ``session``, display commands on the console's ``display``."""
+        self.before_command()
         targets = Targets(self, self.rotor, session, display)
         target = request.target
         reason = note = warning = None

@@ -243,3 +243,21 @@ def test_the_reason_autotrack_is_off_does_not_grow_with_each_restart(tmp_path) -
         reasons.append(json.loads((tmp_path / "state.json").read_text())["autotrack_off"])
     assert reasons[0].startswith("AUTO OFF from tcp 127.0.0.1:") and reasons.count(reasons[0]) == 4, reasons
     assert reasons[0].count("before the restart") <= 1
+
+
+def test_a_command_right_after_config_set_sees_the_change(tmp_path) -> None:
+    """``config set autotrack.satellites ...`` then ``poke "AUTO ON"`` (README's journey): the station's clock
+    stands still here, so its watcher never looks; the command itself must see the file as it is now."""
+    path = tmp_path / "station.toml"
+    path.write_text(CONFIG.replace(f"satellites = {LIST}\n", "").replace("enabled = true", "enabled = false")
+                    + f'[server]\nstate_file = "{tmp_path / "state.json"}"\n[tcp]\nenabled = true\nport = 0\n')
+    station = Station(load_config(str(path)), VirtualClock(START), transport=FakeDdeSystem().server_transport())
+    station.start()
+    try:
+        station.watch_config(str(path))
+        assert main(["config", "set", "autotrack.satellites", '["ISS", "AO-7"]', "--config", str(path)]) == 0
+        assert _ask(station, "AUTO ON") == "OK"  # not "OK warning: ... nothing to work"
+        assert main(["config", "set", "autotrack.satellites", '["NO-SUCH-SAT"]', "--config", str(path)]) == 0
+        assert "NO-SUCH-SAT is not in the catalog" in _ask(station, "AUTO ON")
+    finally:
+        station.stop()
