@@ -85,7 +85,7 @@ class Publisher(ServiceThread):
         cpu_s = max(0.0, time.process_time() - self._tick_cpu)
         stall = Stall(now, late, explain_stall(late, gc_s, generation, work_s, cpu_s))
         self.stats.stalls.append(stall)
-        self._stall_lines.log(logging.WARNING, "stall", "publish tick %.2f s late: %s", late, stall.cause)
+        self._stall_lines.log(logging.INFO, "stall", "publish tick %.2f s late: %s", late, stall.cause)
 
     def _run(self) -> None:
         self.gc_pauses.install()

@@ -55,7 +55,7 @@ def _core(clock: VirtualClock) -> StationCore:
 
 def _run_with(clock: VirtualClock, core: StationCore, caplog) -> Publisher:
     publisher = Publisher(core, clock)
-    with caplog.at_level(logging.WARNING, logger="nfwserver.core.publisher"):
+    with caplog.at_level(logging.INFO, logger="nfwserver.core.publisher"):
         publisher.start()
         try:
             assert advance_until(clock, lambda: publisher.stats.ticks >= 30, step_s=0.05, limit_s=30.0)
