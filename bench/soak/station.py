@@ -87,7 +87,10 @@ class Soak:
     def start(self, refresh_hours: float) -> None:
         self.rotctld.start()
         self.rigctld.start()
-        env = {**os.environ, "PYTHONPATH": str(ROOT)}
+        # A user directory of its own: the single-instance lock, the stored catalog and the state file of this
+        # station are not those of any other station of this user.
+        env = {**os.environ, "PYTHONPATH": str(ROOT), **{f"XDG_{kind}_HOME": str(self.work / kind.lower())
+                                                         for kind in ("STATE", "DATA", "CONFIG", "CACHE")}}
         config = self.config(refresh_hours)
         with open(self.work / "stderr.txt", "wb") as stderr:
             self.process = subprocess.Popen(
