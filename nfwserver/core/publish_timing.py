@@ -125,16 +125,22 @@ class Stall:
     cause: str
 
 
-def explain_stall(late_s: float, gc_s: float, generation: int, work_s: float, cpu_s: float) -> str:
+def explain_stall(late_s: float, gc_s: float, generation: int, work_s: float, cpu_s: float,
+                  work_cpu_s: float | None = None) -> str:
     """What held a tick ``late_s`` seconds: ``gc_s`` seconds of collection (oldest ``generation``), the
     previous tick's own ``work_s`` seconds (compute, locks, listeners; collections inside it not counted
-    twice), and the rest, waited for the thread to run, with ``cpu_s`` seconds of this process's CPU time
-    used in the window.  One line, the largest part first."""
+    twice; ``work_cpu_s`` of them on the processor, when measured: the rest of the tick was the thread waiting
+    for a lock, the interpreter or the processor), and the rest, waited for the thread to run, with ``cpu_s``
+    seconds of this process's CPU time used in the window.  One line, the largest part first."""
     parts: list[tuple[float, str]] = []
     if gc_s > 0:
         parts.append((gc_s, f"garbage collection {gc_s:.2f} s (generation {generation})"))
     if work_s > 0:
-        parts.append((work_s, f"the previous tick's own work {work_s:.2f} s (computing, locks, tick listeners)"))
+        inside = "computing, locks, tick listeners"
+        if work_cpu_s is not None:
+            inside = (f"{work_cpu_s:.2f} s of it on the processor, the rest waiting inside the tick for a lock, "
+                      "the interpreter or the processor")
+        parts.append((work_s, f"the previous tick's own work {work_s:.2f} s ({inside})"))
     rest = max(0.0, late_s - gc_s - work_s)
     if rest > 0:
         who = ("another thread of this process held the interpreter" if cpu_s >= 0.5 * rest

@@ -76,6 +76,7 @@ class Publisher(ServiceThread):
         self.gc_pauses = GcPauses(clock)
         self._tick_end = 0.0  # clock monotonic seconds the previous tick ended
         self._tick_cpu = 0.0  # this process's CPU seconds then
+        self._tick_thread_cpu = 0.0  # CPU seconds the publish thread itself spent in the previous tick
 
     def _stalled(self, late: float, due: float, now: float) -> None:
         """A tick ``late`` seconds late: record and log what held it (see :func:`explain_stall`)."""
@@ -83,7 +84,8 @@ class Publisher(ServiceThread):
         work_s = max(0.0, self._tick_end - due)
         work_s = max(0.0, work_s - self.gc_pauses.within(due, self._tick_end)[0])
         cpu_s = max(0.0, time.process_time() - self._tick_cpu)
-        stall = Stall(now, late, explain_stall(late, gc_s, generation, work_s, cpu_s))
+        stall = Stall(now, late, explain_stall(late, gc_s, generation, work_s, cpu_s,
+                                              work_cpu_s=min(work_s, self._tick_thread_cpu)))
         self.stats.stalls.append(stall)
         self._stall_lines.log(logging.INFO, "stall", "publish tick %.2f s late: %s", late, stall.cause)
 
@@ -111,12 +113,14 @@ class Publisher(ServiceThread):
             late = now - due
             if late >= STALL_S and k > 0:  # woke late (the first tick has no schedule to be late for)
                 self._stalled(late, due, now)
+            thread_cpu = time.thread_time()
             try:
                 self.core.tick()
             except Exception:
                 self.stats.failures += 1
                 self._failures.log(logging.ERROR, "tick", "publish tick failed", exc_info=True)
             self._tick_end, self._tick_cpu = self.clock.monotonic(), time.process_time()
+            self._tick_thread_cpu = time.thread_time() - thread_cpu
             self.stats.record(late)
             k += 1
             behind = self._tick_end - (t0 + k / rate)

@@ -109,4 +109,6 @@ def test_a_stall_in_a_slow_tick_listener_is_logged_as_the_tick_work(caplog) -> N
     (stall,) = publisher.stats.stalls
     assert stall.cause.startswith("the previous tick's own work 0.8")
     assert "garbage" not in stall.cause
+    # The listener slept on the clock, it did not compute: the tick's time is told apart from its CPU time.
+    assert "(0.00 s of it on the processor, the rest waiting inside the tick" in stall.cause
     assert any("publish tick 0.8" in r.getMessage() for r in caplog.records)
