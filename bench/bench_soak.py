@@ -15,6 +15,7 @@ plot, ``docs/soak-10hz.png`` or ``docs/soak-accelerated.png``.  Linux only.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 import tempfile
 import threading
@@ -29,12 +30,17 @@ SATELLITES = [25544, 14129, 27844, 43017]  # ISS, AO-10, CO-55 (no radio channel
 DOWN_S = 15.0  #: how long each killed daemon stays away (seconds)
 
 
+def _interrupted(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt
+
+
 def main(argv: list[str]) -> None:
     parser = argparse.ArgumentParser(prog="python -m bench soak")
     parser.add_argument("--minutes", type=float, default=30.0, help="how long to run (default 30)")
     parser.add_argument("--accelerated", action="store_true", help="50 Hz, events five times as often")
     parser.add_argument("--sample-s", type=float, default=5.0, help="seconds between samples of the process")
     args = parser.parse_args(argv)
+    signal.signal(signal.SIGTERM, _interrupted)  # a stopped soak still stops its station and daemons
     speed = 5.0 if args.accelerated else 1.0
     rate = 50.0 if args.accelerated else 10.0
     warmup_s = min(20.0, args.minutes / 2.0) * 60.0
