@@ -18,6 +18,7 @@ from nfwserver.app.station import Station
 from nfwserver.app.status_fields import device_status
 from nfwserver.clock import VirtualClock
 from nfwserver.config import parse_config
+from nfwserver.console.state_view import radio_line, rotor_line
 from nfwserver.fake_dde import FakeDdeSystem
 from nfwserver.rotor.kct_status import KctStatusBit
 from nfwserver.web.station_parts import radio_part, rotor_part
@@ -31,7 +32,7 @@ CO_55 = 27844  # no radio channel in the default channel table
 
 
 def _views(station: Station) -> dict[str, object]:
-    """What STATUS, the web page and OrbitDRV's status word say about the two links."""
+    """What STATUS, the web page, the console and OrbitDRV's status word say about the two links."""
     fields = device_status(station.rotor, station.radio, None)()
     faults = station.core.health.faults()
     rotor = rotor_part(station.rotor)
@@ -39,7 +40,9 @@ def _views(station: Station) -> dict[str, object]:
     assert rotor is not None and radio is not None and station.rotor is not None
     return {"rotor": fields["rotor"], "radio": fields["radio"], "rotctld_fault": "rotctld" in faults,
             "rigctld_fault": "rigctld" in faults, "web_rotor": rotor["state"], "web_radio": radio["state"],
-            "card_absent": bool(station.rotor.driver.status().bits & KctStatusBit.CARD_ABSENT)}
+            "card_absent": bool(station.rotor.driver.status().bits & KctStatusBit.CARD_ABSENT),
+            "console_radio_unreachable": "radio unreachable" in radio_line(station.radio, True).plain,
+            "console_kct_card_absent": "KCT 0x8" in rotor_line(station.rotor).plain}
 
 
 def test_a_daemon_leaving_and_returning_shows_within_seconds_whatever_is_selected(caplog) -> None:
@@ -69,6 +72,7 @@ def test_a_daemon_leaving_and_returning_shows_within_seconds_whatever_is_selecte
                     down = _views(station)
                     assert down["rigctld_fault"] and down["rotctld_fault"] and down["card_absent"]
                     assert down["web_radio"] == "unreachable" and down["web_rotor"] == "unreachable"
+                    assert down["console_radio_unreachable"] and down["console_kct_card_absent"]
                     assert advance_until(clock, lambda gone=gone: clock.monotonic() - gone >= 20.0, step_s=0.5)
                     rot.start()
                     rig.start()
@@ -77,6 +81,8 @@ def test_a_daemon_leaving_and_returning_shows_within_seconds_whatever_is_selecte
                                          and not v["rigctld_fault"] and not v["rotctld_fault"]
                                          and not v["card_absent"], step_s=0.1, limit_s=10.0)
                     assert clock.monotonic() - back <= 3.0  # the return seen within seconds, with no channel
+                    again = _views(station)
+                    assert not again["console_radio_unreachable"] and not again["console_kct_card_absent"]
                     # well for 10 s: the next outage is an episode of its own, not a flap
                     assert advance_until(clock, lambda back=back: clock.monotonic() - back >= 10.0, step_s=0.5)
             finally:
