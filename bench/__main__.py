@@ -5,7 +5,9 @@ prefix select a subset; the file is then updated only for those sections; ``-`` 
 names).  Each benchmark module is run as its own process (``python -m bench.bench_NAME``) and prints one
 Markdown section, starting with a ``## `` heading, on stdout; a benchmark that prints nothing leaves its section
 as it was.
-Benchmarks in ``OPT_IN`` run only when named: ``wine-dde`` needs a Wine prefix (tools/wine/setup).
+Benchmarks in ``OPT_IN`` run only when named: ``wine-dde`` needs a Wine prefix (tools/wine/setup); ``soak`` runs
+for as long as it is asked (``python -m bench soak --minutes N [--accelerated]``: options after the names go to
+every benchmark named).
 ``python -m bench reliability [OPTIONS]`` (``STANDALONE``) runs the hostile-input and fault campaign
 (bench/bench_reliability.py) with its output on the terminal and its options passed on; its figures go to
 docs/RELIABILITY.md by hand, not to docs/BENCHMARKS.md.
@@ -26,7 +28,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs" / "BENCHMARKS.md"
-OPT_IN = ("wine_dde",)  #: run only when named
+OPT_IN = ("wine_dde", "soak")  #: run only when named
 STANDALONE = ("reliability", "faults")  #: run alone, named first, with their own options; they write no section
 #: Opens the hand-written end of a section, which a new run of its benchmark keeps.
 KEPT = "<!-- written by hand: kept when the benchmark rewrites this section -->"
@@ -78,6 +80,8 @@ def main(argv: list[str]) -> int:
         return subprocess.run([sys.executable, "-m", f"bench.bench_{argv[0]}", *argv[1:]], cwd=ROOT).returncode
     names = sorted(p.stem[len("bench_") :] for p in (ROOT / "bench").glob("bench_*.py")
                    if p.stem[len("bench_") :] not in STANDALONE)
+    first_option = next((i for i, a in enumerate(argv) if a.startswith("-")), len(argv))
+    argv, options = argv[:first_option], argv[first_option:]
     chosen = [name.replace("-", "_") for name in argv] or [n for n in names if n not in OPT_IN]
     unknown = [n for n in chosen if n not in names]
     if unknown:
@@ -89,7 +93,7 @@ def main(argv: list[str]) -> int:
         print(f"running bench_{name} ...", file=sys.stderr)
         started = time.monotonic()
         proc = subprocess.run(  # its stderr (progress, failures) goes straight to ours
-            [sys.executable, "-m", f"bench.bench_{name}"], cwd=ROOT, stdout=subprocess.PIPE, text=True
+            [sys.executable, "-m", f"bench.bench_{name}", *options], cwd=ROOT, stdout=subprocess.PIPE, text=True
         )
         if proc.returncode != 0:
             print(f"bench_{name} failed (exit {proc.returncode})", file=sys.stderr)

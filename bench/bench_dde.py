@@ -8,8 +8,6 @@ import time
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
-import numpy as np
-
 from nfwserver.clock import SystemClock, VirtualClock
 from nfwserver.core.publisher import Publisher
 from nfwserver.core.station_core import StationCore
@@ -74,8 +72,8 @@ def loop_error_ms(rate: float, seconds: float) -> tuple[float, float, float, int
     publisher.start()
     time.sleep(seconds)
     publisher.stop()
-    late = np.array(publisher.stats.lateness_s) * 1e3
-    return float(np.percentile(late, 50)), float(np.percentile(late, 99)), float(late.max()), publisher.stats.ticks
+    late = publisher.stats.lateness
+    return late.quantile(0.5) * 1e3, late.quantile(0.99) * 1e3, late.max_s * 1e3, publisher.stats.ticks
 
 
 def main() -> None:

@@ -1,101 +1,97 @@
-"""Soak: a week of virtual time at 10 Hz with clients coming and going, satellite switches and hourly
-element refreshes, on the fake DDE transport.  Reports ticks, missed ticks, RSS and bounded queues.
+"""Soak: the real station (``nfwserver run --headless``) under a busy unattended load with real daemons killed.
 
-Run alone with ``python -m bench soak`` (about five minutes on this machine).
+``python -m bench soak [--minutes N] [--accelerated]`` (opt-in: it runs for as long as it is asked).  The load
+of issue #44: TUNE, TRACK and Doppler tuning on at 10 Hz; a real ``rotctld`` killed every 4 minutes and a real
+``rigctld`` every 6, each for 15 s; 3 Nova TCP ``WATCH`` clients; a TCP client switching ``SAT=`` every 20 s
+round the ISS, AO-10, CO-55 (no radio channel) and FOX-1B; 4 web event streams reconnecting every minute;
+``nfwserver watch`` beside it; the elements re-read every 3 minutes.  ``--accelerated``: 50 Hz, and the faults,
+switches, reconnections and re-reads five times as often.  Every 5 s the station's RSS, threads, descriptors,
+CPU and log size are read from ``/proc``; STATUS is read twice a second for the link states; every line and
+frame is timed at its client.  Writes one section (the RSS slope fitted after the warm-up, the peak, feed gaps
+per client, the stalls the station logged and explained, the link states against the injected outages) and a
+plot, ``docs/soak-10hz.png`` or ``docs/soak-accelerated.png``.  Linux only.
 """
 
 from __future__ import annotations
 
-import random
-import resource
+import argparse
+import signal
+import sys
+import tempfile
+import threading
 import time
-from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
-from nfwserver.clock import VirtualClock
-from nfwserver.core.station_core import StationCore
-from nfwserver.dde.nova_service import NovaDdeService
-from nfwserver.fake_dde import FakeDdeSystem
-from nfwserver.tracking.catalog import Catalog
-from nfwserver.tracking.elements import load_element_file
-from nfwserver.tracking.observer import Observer
+from bench.soak.load import Load
+from bench.soak.report import plot, section
+from bench.soak.station import ROOT, Soak
 
-ROOT = Path(__file__).resolve().parent.parent
-DAYS = 7
-RATE = 10.0
-CLIENTS = 20
+SATELLITES = [25544, 14129, 27844, 43017]  # ISS, AO-10, CO-55 (no radio channel), FOX-1B
+DOWN_S = 15.0  #: how long each killed daemon stays away (seconds)
 
 
-def rss_mib() -> float:
-    with open("/proc/self/status") as f:
-        for line in f:
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1]) / 1024.0
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+def _interrupted(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt
 
 
-def main() -> None:
-    rng = random.Random(8)
-    sets = load_element_file(ROOT / "tests" / "data" / "visual.txt").sets
-    catalog = Catalog(sets)
-    numbers = [s.catalog_number for s in catalog]
-    clock = VirtualClock(datetime(2026, 5, 8, tzinfo=timezone.utc))
-    server = StationCore(catalog, Observer(52.2, 0.12, 20.0), clock, satellite=25544, rate_hz=RATE)
-    system = FakeDdeSystem(received_capacity=64)
-    NovaDdeService(server).attach(system.server_transport())
-    clients = [system.connect("NFW32", "NFW_DATA") for _ in range(CLIENTS)]
-    for c in clients:
-        c.start_advise("NFW_SERVER")
-    clients[0].poke("NFW_SERVER", "TUNE ON")
-    ticks = int(DAYS * 86400 * RATE)
-    published = 0
-    samples = []
-
-    def count(sample) -> None:
-        nonlocal published
-        published += bool(sample.text)
-
-    server.subscribe(count)
-    rss_start = None
-    started = time.perf_counter()
-    step = timedelta(seconds=1.0 / RATE)
-    when = clock.now()
-    for k in range(ticks):
-        when += step
-        clock.set(when)
-        server.tick(when)
-        if k % 3000 == 0:  # every 5 minutes: a client leaves and a new one joins; switch satellite
-            victim = rng.randrange(CLIENTS)
-            clients[victim].disconnect()
-            clients[victim] = system.connect("NFW32", "NFW_DATA")
-            clients[victim].start_advise("NFW_SERVER")
-            clients[0].poke("NFW_SERVER", f"SAT={rng.choice(numbers)}")
-        if k % 36000 == 0:  # hourly element refresh
-            catalog.update(sets)
-        if k % 864000 == 0:
-            samples.append((k, rss_mib(), len(server.events), system.conversation_count()))
-            if rss_start is None and k > 0:
-                rss_start = samples[-1][1]
-    elapsed = time.perf_counter() - started
-    rss_end = rss_mib()
-    print("## Soak (a week of virtual time)\n")
-    print(f"{DAYS} days at {RATE:g} Hz = {ticks:,} ticks with {CLIENTS} hot-advise clients, one replaced and the "
-          "satellite switched every 5 minutes, elements refreshed hourly; fake DDE transport, virtual clock.\n")
-    print("| measurement | value |")
-    print("|---|---|")
-    print(f"| ticks run / strings published | {ticks:,} / {published:,} |")
-    print(f"| missed ticks | {ticks - published:,} |")
-    print(f"| wall time | {elapsed:.0f} s ({elapsed / ticks * 1e6:.1f} us per tick) |")
-    print(f"| RSS after day 1 / at the end | {rss_start:.1f} MiB / {rss_end:.1f} MiB |")
-    print(f"| event log length (bounded) | {len(server.events):,} (capacity 5,000) |")
-    print(f"| open conversations at the end | {system.conversation_count()} |")
-    print()
-    print("| tick | RSS MiB | event log | conversations |")
-    print("|---|---|---|---|")
-    for k, rss, events, convs in samples:
-        print(f"| {k:,} | {rss:.1f} | {events:,} | {convs} |")
-    print()
+def main(argv: list[str]) -> None:
+    parser = argparse.ArgumentParser(prog="python -m bench soak")
+    parser.add_argument("--minutes", type=float, default=30.0, help="how long to run (default 30)")
+    parser.add_argument("--accelerated", action="store_true", help="50 Hz, events five times as often")
+    parser.add_argument("--sample-s", type=float, default=5.0, help="seconds between samples of the process")
+    args = parser.parse_args(argv)
+    signal.signal(signal.SIGTERM, _interrupted)  # a stopped soak still stops its station and daemons
+    speed = 5.0 if args.accelerated else 1.0
+    rate = 50.0 if args.accelerated else 10.0
+    warmup_s = min(20.0, args.minutes / 2.0) * 60.0
+    with tempfile.TemporaryDirectory(prefix="nfw-soak-") as work:
+        soak = Soak(rate, Path(work))
+        soak.start(refresh_hours=0.05 / speed)
+        load = Load(soak.tcp_port, soak.web_port, SATELLITES, 20.0 / speed, 60.0 / speed)
+        load.start()
+        stop = threading.Event()
+        schedule = {"rotctld": 240.0 / speed, "rigctld": 360.0 / speed}
+        due = dict(schedule)
+        faults: list[threading.Thread] = []
+        ends = soak.started + args.minutes * 60.0
+        next_sample = soak.started
+        try:
+            while time.monotonic() < ends:
+                now = time.monotonic()
+                if now >= next_sample:
+                    sample = soak.sample()
+                    next_sample += args.sample_s
+                    if len(soak.samples) % 60 == 1:
+                        print(f"  {sample.at / 60.0:5.1f} min: RSS {sample.rss_mib:.1f} MiB, {sample.threads} threads, "
+                              f"{sample.fds} fds", file=sys.stderr)
+                for daemon, period in schedule.items():
+                    if now - soak.started >= due[daemon]:
+                        due[daemon] += period
+                        thread = threading.Thread(target=soak.kill, args=(daemon, DOWN_S, stop), daemon=True)
+                        thread.start()
+                        faults.append(thread)
+                time.sleep(0.2)
+        finally:
+            stop.set()
+            for thread in faults:
+                thread.join(30.0)
+            soak.sample()
+            load.join()
+            soak.stop()
+        if args.accelerated:
+            title = "Soak: the real process, accelerated (50 Hz, events five times as often)"
+            png = ROOT / "docs" / "soak-accelerated.png"
+        else:
+            title = "Soak: the real process at 10 Hz"
+            png = ROOT / "docs" / "soak-10hz.png"
+        what = (f"`python -m bench soak --minutes {args.minutes:g}{' --accelerated' if args.accelerated else ''}`: "
+                f"{rate:g} Hz, TUNE/TRACK/tuning on; rotctld killed every {schedule['rotctld']:g} s and rigctld "
+                f"every {schedule['rigctld']:g} s, each for {DOWN_S:g} s; 3 TCP WATCH clients; SAT= every "
+                f"{20.0 / speed:g} s round {', '.join(map(str, SATELLITES))}; 4 web streams reconnecting every "
+                f"{60.0 / speed:g} s; `nfwserver watch`; elements re-read every {180.0 / speed:g} s.")
+        drawn = plot(png, title, soak, load, warmup_s)
+        print(section(title, what, soak, load, args.minutes, warmup_s, drawn))
 
 
 if __name__ == "__main__":
-    main()
+    main(sys.argv[1:])

@@ -11,8 +11,6 @@ import time
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from nfwserver.clock import SystemClock
 from nfwserver.core.publisher import Publisher
 from nfwserver.core.station_core import StationCore
@@ -25,9 +23,8 @@ def run_publisher(core: StationCore, seconds: float) -> tuple[float, float, floa
     publisher.start()
     time.sleep(seconds)
     publisher.stop()
-    late = np.array(publisher.stats.lateness_s) * 1e3
-    return (float(np.percentile(late, 50)), float(np.percentile(late, 99)), float(late.max()),
-            publisher.stats.ticks)
+    late = publisher.stats.lateness  # quantiles: the upper edges of 19 %-wide bins
+    return late.quantile(0.5) * 1e3, late.quantile(0.99) * 1e3, late.max_s * 1e3, publisher.stats.ticks
 
 
 class ClientProcess:

@@ -178,4 +178,4 @@ def run_daemon_kills(tally: Tally, rig: StationRig, kills: int) -> None:
     stats = station.publisher.stats
     tally.extra.update({"outages seen by rotor and radio": seen_down,
                         "back after (max)": f"{max(delays):.2f} s" if delays else "-",
-                        "publish ticks late by more than 0.25 s": sum(1 for x in stats.lateness_s if x > 0.25)})
+                        "publish ticks late by more than 0.25 s": stats.lateness.over(0.25)})

@@ -79,15 +79,15 @@ def run_realtime(tally: Tally, seconds: float, workdir: Path, sample_every_s: fl
         rig.check(tally)
         samples.append((time.monotonic() - started, rss_mib()))
         stats = rig.station.publisher.stats
-        lateness = sorted(stats.lateness_s)
+        lateness = stats.lateness
         udp.close()
         tcp.close()
     first_minute = next((rss for t, rss in samples if t >= 60.0), samples[-1][1])
     tally.extra.update({
         "duration": f"{samples[-1][0]:.0f} s", "ticks": stats.ticks, "ticks skipped": stats.skipped,
         "tick failures": stats.failures,
-        "lateness p99 / max": f"{lateness[int(0.99 * (len(lateness) - 1))] * 1e3:.1f} / {lateness[-1] * 1e3:.1f} ms"
-        if lateness else "-",
+        "lateness p99 / max": f"{lateness.quantile(0.99) * 1e3:.1f} / {lateness.max_s * 1e3:.1f} ms"
+        if lateness.total else "-",
         "RSS at start / after 1 min / at end": f"{samples[0][1]:.1f} / {first_minute:.1f} / {samples[-1][1]:.1f} MiB",
         "RSS growth start->end / 1 min->end": f"{samples[-1][1] - samples[0][1]:+.1f} / "
                                                f"{samples[-1][1] - first_minute:+.1f} MiB",

@@ -9,9 +9,12 @@ gaps in a 10 Hz feed during a refresh; docs/RELIABILITY.md).
 :func:`building_long_lived` pauses collection while the block runs (the objects it makes have no
 cycles: they are freed by reference counting), then moves every object alive at that moment into the
 collector's permanent generation (``gc.freeze``), so later collections, on any thread, do not walk the
-catalog again.  Frozen objects are still freed by reference counting when released; only cyclic
-garbage that happened to be alive at the freeze is never collected, which costs little next to a
-catalog.  The collector is process-wide: nested and concurrent uses count, and the last one to leave
+catalog again.  Frozen objects are still freed by reference counting when released; cyclic garbage
+alive at a freeze would never be collected, so the first block to start collects first (cheap: what
+an earlier freeze moved out is not walked again).  Without that, every element refresh froze whatever
+cyclic garbage the station had made since the last one, for good (#44: a station re-reading its elements
+every 3 minutes grew by megabytes an hour).  Only the garbage made by other threads during the build
+itself can still be frozen.  The collector is process-wide: nested and concurrent uses count, and the last one to leave
 re-enables it (if it was enabled before the first).
 
 Freeing is the other pause: the last reference to a list of 100,000 sets, dropped at once, frees them all
@@ -37,6 +40,7 @@ def building_long_lived() -> Iterator[None]:
     with _lock:
         if _depth[0] == 0:
             _was_enabled[0] = gc.isenabled()
+            gc.collect()  # no cyclic garbage into the permanent generation (see the module docstring)
             gc.disable()
         _depth[0] += 1
     try:

@@ -8,6 +8,12 @@ slots it missed (counted in :attr:`PublishStats.skipped`) instead of bursting to
 tick computes for the wall-clock instant it runs at.  A tick that raises is logged and the loop
 goes on.
 
+Lateness is kept in constant memory (:class:`~nfwserver.core.publish_timing.LatenessHistogram`): a station
+running for weeks holds bin counts, not a sample per tick.  A tick later than :data:`STALL_S` is a *stall*:
+the publisher logs what held it (garbage collection timed through ``gc.callbacks``, the previous tick's own
+work, or the thread waiting to be scheduled; :func:`~nfwserver.core.publish_timing.explain_stall`) and keeps
+the last :data:`STALLS_KEPT` in :attr:`PublishStats.stalls`.
+
 Virtual time (:func:`run_virtual`): a :class:`~nfwserver.clock.VirtualClock` is stepped to each
 tick instant in turn, so a 45-minute session runs as fast as the computation allows.
 """
@@ -16,11 +22,14 @@ from __future__ import annotations
 
 import logging
 import math
+import time
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from datetime import timedelta
 
 from nfwserver.clock import Clock, VirtualClock
+from nfwserver.core.publish_timing import GcPauses, LatenessHistogram, Stall, explain_stall
 from nfwserver.core.service_thread import ServiceThread
 from nfwserver.core.station_core import StationCore
 from nfwserver.ratelimited_log import RateLimitedLog
@@ -28,21 +37,28 @@ from nfwserver.ratelimited_log import RateLimitedLog
 log = logging.getLogger(__name__)
 
 
+#: a tick starting this many seconds late is a stall, logged with what held it (clock seconds; #44's target:
+#: none above 0.5 s at 10 Hz)
+STALL_S = 0.5
+#: stalls remembered in :attr:`PublishStats.stalls`
+STALLS_KEPT = 32
+
+
 @dataclass
 class PublishStats:
-    """Timing of the real-time loop: how late each tick started (seconds), and slots skipped."""
+    """Timing of the real-time loop: how late ticks started (seconds, a histogram), slots skipped, and the
+    last stalls with their causes.  Constant size however long the loop runs."""
 
     ticks: int = 0
     skipped: int = 0
     failures: int = 0
-    lateness_s: list[float] = field(default_factory=list)
-    keep: int = 100_000  #: most recent lateness samples kept
+    lateness: LatenessHistogram = field(default_factory=LatenessHistogram)
+    stalls: deque[Stall] = field(default_factory=lambda: deque(maxlen=STALLS_KEPT))
 
     def record(self, late: float) -> None:
+        """Count one tick that started ``late`` seconds after it was due."""
         self.ticks += 1
-        self.lateness_s.append(late)
-        if len(self.lateness_s) > self.keep:
-            del self.lateness_s[: len(self.lateness_s) - self.keep]
+        self.lateness.add(late)
 
 
 class Publisher(ServiceThread):
@@ -56,8 +72,31 @@ class Publisher(ServiceThread):
         self.clock = clock
         self.stats = PublishStats()
         self._failures = RateLimitedLog(log, clock, 60.0)  #: a tick that raises: one line, then a count a minute
+        self._stall_lines = RateLimitedLog(log, clock, 10.0)  #: a stall: one line, then a count every 10 s
+        self.gc_pauses = GcPauses(clock)
+        self._tick_end = 0.0  # clock monotonic seconds the previous tick ended
+        self._tick_cpu = 0.0  # this process's CPU seconds then
+        self._tick_thread_cpu = 0.0  # CPU seconds the publish thread itself spent in the previous tick
+
+    def _stalled(self, late: float, due: float, now: float) -> None:
+        """A tick ``late`` seconds late: record and log what held it (see :func:`explain_stall`)."""
+        gc_s, generation = self.gc_pauses.within(due, now)
+        work_s = max(0.0, self._tick_end - due)
+        work_s = max(0.0, work_s - self.gc_pauses.within(due, self._tick_end)[0])
+        cpu_s = max(0.0, time.process_time() - self._tick_cpu)
+        stall = Stall(now, late, explain_stall(late, gc_s, generation, work_s, cpu_s,
+                                              work_cpu_s=min(work_s, self._tick_thread_cpu)))
+        self.stats.stalls.append(stall)
+        self._stall_lines.log(logging.INFO, "stall", "publish tick %.2f s late: %s", late, stall.cause)
 
     def _run(self) -> None:
+        self.gc_pauses.install()
+        try:
+            self._loop()
+        finally:
+            self.gc_pauses.remove()
+
+    def _loop(self) -> None:
         t0 = self.clock.monotonic()
         k = 0
         rate = self.core.state.rate_hz
@@ -72,14 +111,21 @@ class Publisher(ServiceThread):
                     break
                 now = self.clock.monotonic()
             late = now - due
+            if late >= STALL_S and k > 0:  # woke late (the first tick has no schedule to be late for)
+                self._stalled(late, due, now)
+            thread_cpu = time.thread_time()
             try:
                 self.core.tick()
             except Exception:
                 self.stats.failures += 1
                 self._failures.log(logging.ERROR, "tick", "publish tick failed", exc_info=True)
+            self._tick_end, self._tick_cpu = self.clock.monotonic(), time.process_time()
+            self._tick_thread_cpu = time.thread_time() - thread_cpu
             self.stats.record(late)
             k += 1
-            behind = self.clock.monotonic() - (t0 + k / rate)
+            behind = self._tick_end - (t0 + k / rate)
+            if behind >= STALL_S:  # the tick itself overran its slots by a stall's length
+                self._stalled(behind, t0 + k / rate, self._tick_end)
             if behind > 1.0 / rate:  # overran: skip the missed slots
                 missed = math.floor(behind * rate)
                 self.stats.skipped += missed

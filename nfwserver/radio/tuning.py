@@ -84,6 +84,24 @@ class DopplerTuner:
         log.info("operator retuned by %+.0f Hz; following from there", moved)
         return at_satellite
 
+    def probe(self) -> None:
+        """Read the receive frequency back, only to learn whether the radio can be reached while nothing is
+        tuned (no channel, tuning off, the satellite not computed): :attr:`available` stays true either way.
+        A radio found lost is prepared again (split, modes, frequencies) when tuning resumes."""
+        try:
+            self.backend.get_rx_frequency()
+        except RadioUnavailable as exc:
+            if self.available:
+                log.warning("radio unavailable: %s", exc)
+            self.available, self.last_error = False, str(exc)
+            self._prepared, self._last_rx, self._last_tx = False, None, None
+            return
+        except RadioError:
+            pass  # it answered: reachable, whatever it thinks of the question
+        if not self.available:
+            log.info("radio available again")
+            self.available, self.last_error = True, None
+
     def update(self, range_rate_km_s: float) -> TuneResult | None:
         """Tune for ``range_rate_km_s``; returns what happened, or None when the radio is unreachable."""
         try:

@@ -11,7 +11,9 @@ On every tick with ``TRACK ON``, :meth:`RotorCoupling.process`:
   when it moved by at least ``threshold_deg`` (relays wear out).  A target the rotor cannot reach is
   ignored by the driver, never clamped; the first one in a pass is reported as an event;
 - after LOS, parks (the driver's parking timer, or at once when the delay is 0) or pre-positions
-  to the next pass's AOS, as configured;
+  to the next pass's AOS, as configured; and the same at once when the selected satellite changes to one
+  below the horizon (or to none: park), whoever changed it (``SAT=``, autotrack, a restart): the step
+  reacts to the selection in the samples, so the rotor never stays pointing at the old satellite;
 - lets the driver run its clock duties and reads the rotor back, reporting the sky position the
   antennas point at through ``on_position`` (the server's ``report_antenna_position``).
 
@@ -95,6 +97,7 @@ class RotorCoupling(TickWorker):
         self._unreachable_reported = False
         self._catalog_number: int | None = None  # the satellite the plan belongs to
         self._seen_satellite = False
+        self._switched = False  # the selection changed: the rotor is placed for the new one at this tick
         # Guards flip_mode, flip_state, _replan and _retry_asked, which set_flip_mode writes from other
         # threads (TCP, console); never held across a call into the driver or the tracking engine.
         self._lock = threading.Lock()
@@ -217,8 +220,9 @@ class RotorCoupling(TickWorker):
         if sample.tracking and not self._track_on_seen:
             self.driver.retry_now()  # a new TRACK ON tries a stalled rotor again at once
         self._track_on_seen = sample.tracking
-        if sample.catalog_number != self._catalog_number:
+        if sample.catalog_number != self._catalog_number or not self._seen_satellite:
             self._satellite_changed(sample.catalog_number)
+        switched, self._switched = self._switched, False
         self._tracking = sample.tracking
         la = sample.look_angles
         if self._tracking and la is not None:
@@ -231,8 +235,10 @@ class RotorCoupling(TickWorker):
                 az, el = self._aim(sample.time, la.azimuth_deg, la.elevation_deg)
                 if self._sent is None or angular_distance(az, el, *self._sent) >= self.threshold_deg:
                     self._send(az, el)
-            elif self.plan is not None:
+            elif self.plan is not None or switched:  # a LOS, or a new satellite below the horizon
                 self._end_pass(sample.time)
+        elif self._tracking and switched and sample.catalog_number is None and self.after_los == "park":
+            self._end_pass(sample.time)  # no satellite any more: nothing to pre-position for
         elif not self._tracking:
             self.plan = None
         self.driver.service()
@@ -241,11 +247,13 @@ class RotorCoupling(TickWorker):
             self.on_position(*sky_from_rotor(*pos))
 
     def _satellite_changed(self, catalog_number: int | None) -> None:
-        """Another satellite: nothing planned for the old one survives (pass plan, flip decision, azimuth
-        branch, last target), and a stalled rotor is tried again at once for the new one."""
-        first = self._catalog_number is None and not self._seen_satellite
+        """Another satellite (or the first since the start): nothing planned for the old one survives (pass
+        plan, flip decision, azimuth branch, last target), a stalled rotor is tried again at once for the new
+        one, and this tick places the rotor for it (see :meth:`process`)."""
+        first = not self._seen_satellite
         self._catalog_number = catalog_number
         self._seen_satellite = True
+        self._switched = True
         if first:
             return
         self.plan = None

@@ -13,6 +13,9 @@ from nfwserver.clock import Clock
 from nfwserver.rotor.backend import RotorError, RotorUnavailable
 from nfwserver.rotor.geometry import RotorGeometry
 
+#: accepted targets the simulated rotor remembers (at least; trimmed to this when twice as many)
+COMMANDS_KEPT = 10_000
+
 
 class SimulatedRotor:
     def __init__(self, clock: Clock, geometry: RotorGeometry | None = None, az_speed_deg_s: float = 6.0,
@@ -26,7 +29,9 @@ class SimulatedRotor:
         self.card_absent = False
         self.az_stalled = False
         self.el_stalled = False
-        self.commands: list[tuple[float, float]] = []  #: every accepted set_position, in order
+        #: the accepted set_position calls, in order: the last :data:`COMMANDS_KEPT` to :data:`2 * COMMANDS_KEPT`
+        #: (a simulated station running for weeks keeps a bounded record)
+        self.commands: list[tuple[float, float]] = []
 
     def _advance(self) -> None:
         now = self.clock.monotonic()
@@ -50,6 +55,8 @@ class SimulatedRotor:
         self._advance()
         self._target = (azimuth_deg, elevation_deg)
         self.commands.append(self._target)
+        if len(self.commands) > 2 * COMMANDS_KEPT:
+            del self.commands[:-COMMANDS_KEPT]
 
     def get_position(self) -> tuple[float, float]:
         self._check()

@@ -385,7 +385,7 @@ class WebServer:
             self._note_refusal(host, f"web event stream for {host} refused: {reason}",
                                f"event stream refused: {reason}")
             return reason
-        log.info("web page %s connected", peer)
+        log.debug("web page %s connected", peer)  # a page reconnecting every minute: 1,440 lines a day at INFO
         return None
 
     def stream_closed(self, peer: str, reason: str, dropped: bool) -> None:
@@ -393,7 +393,7 @@ class WebServer:
             self.stats.streams -= 1
             if dropped:
                 self.stats.dropped += 1
-        (log.warning if dropped else log.info)("web page %s disconnected: %s", peer, reason)
+        (log.warning if dropped else log.debug)("web page %s disconnected: %s", peer, reason)
 
     @property
     def stopping(self) -> bool:
