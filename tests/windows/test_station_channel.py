@@ -1,0 +1,88 @@
+"""The station's channel on Windows (issues 42 and 45): a second ``run`` refused naming the running station,
+``status`` reaching it whatever its configuration file says, ``stop`` through the control file, the station
+verified by its start time (``GetProcessTimes``).
+
+Runs only on Windows or under Wine (``tools/wine/test``); on Linux tests/cli/test_station_channel*.py check
+the POSIX side (signals, ``/proc/locks``).  Each test gets a state folder of its own
+(``WIN_PD_OVERRIDE_LOCAL_APPDATA``, platformdirs' override of ``%LOCALAPPDATA%``), so the suite's own session
+station does not count as "a station already running".
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.waiting import wait_for
+from tests.windows.station_config import write_station_config
+
+pytestmark = pytest.mark.skipif(sys.platform != "win32", reason="the station's Windows channel")
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+
+
+@pytest.fixture
+def state_folder(tmp_path, monkeypatch) -> Path:
+    """``%LOCALAPPDATA%\\nfwserver`` of this test alone (the configuration file and the channel live there)."""
+    appdata = tmp_path / "appdata"
+    appdata.mkdir()
+    monkeypatch.setenv("WIN_PD_OVERRIDE_LOCAL_APPDATA", str(appdata))
+    return appdata / "nfwserver"
+
+
+def nfwserver(*args: str, timeout_s: float = 120.0) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "nfwserver", *args], cwd=ROOT, stdin=subprocess.DEVNULL,
+                          capture_output=True, text=True, timeout=timeout_s)
+
+
+def test_the_channel_names_the_running_station_and_stop_ends_it_cleanly(tmp_path, state_folder) -> None:
+    from nfwserver.cli.station_channel import StationChannel
+    from nfwserver.cli.station_process import process_start
+
+    config = write_station_config(tmp_path, extra="[tcp]\nenabled = true\nport = 0\n")
+    log = tmp_path / "station.log"
+    station = subprocess.Popen(
+        [sys.executable, "-m", "nfwserver", "run", "--headless", "--config", str(config), "--log-file", str(log),
+         "--duration", "300"], cwd=ROOT, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE, text=True)
+    try:
+        channel = StationChannel(state_folder)
+        info = wait_for(channel.serving, 60, "the station to describe itself as up in its own state folder")
+        assert info.pid == station.pid and info.tcp is not None
+        # The start time is the process's creation time (GetProcessTimes), not a value of the station's making.
+        assert info.start is not None and info.start == process_start(station.pid)
+
+        second = nfwserver("run", "--headless", "--config", str(config), "--duration", "5")
+        assert second.returncode == 1, second.stdout + second.stderr
+        assert second.stderr.strip() == (f"nfwserver: a station is already running for this user (process "
+                                         f"{station.pid}): `nfwserver stop` stops it")
+
+        (state_folder / "config.toml").write_text("[tcp\nport = 1\n", encoding="utf-8")  # a TOML syntax error
+        status = nfwserver("status")
+        assert status.returncode == 0, status.stderr
+        assert status.stdout.startswith("satellite=25544 name=ISS "), status.stdout
+        warnings = [line for line in status.stderr.splitlines() if "configuration refused" in line]
+        assert len(warnings) == 1 and "not valid TOML" in warnings[0], status.stderr
+        assert warnings[0].endswith("the running station runs on its last good configuration")
+
+        stop = nfwserver("stop", "--timeout", "60")
+        assert stop.returncode == 0, stop.stderr
+        assert stop.stdout.strip() == f"stopped the station (process {station.pid})"
+        assert station.poll() == 0  # ended (stop waits for the process itself), and cleanly: not killed
+        text = log.read_text(encoding="utf-8")
+        assert f"control file {state_folder / 'control'}: stopping" in text
+        assert text.rstrip().endswith("stopped")
+        assert not (state_folder / "station.json").exists()
+
+        again = nfwserver("stop")
+        assert again.returncode == 1 and again.stderr.strip().endswith(
+            "no station is running for this user: nothing to stop"), again.stderr
+    finally:
+        if station.poll() is None:
+            station.kill()
+        station.wait(30)
+        if station.stderr is not None:
+            station.stderr.close()
