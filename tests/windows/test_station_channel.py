@@ -1,6 +1,6 @@
 """The station's channel on Windows (issues 42 and 45): a second ``run`` refused naming the running station,
-``status`` reaching it whatever its configuration file says, ``stop`` through the control file, the station
-verified by its start time (``GetProcessTimes``).
+``status`` reaching it whatever its configuration file says, ``stop`` through the control file (and its request
+withdrawn when the station has not taken it in time), the station verified by its start time (``GetProcessTimes``).
 
 Runs only on Windows or under Wine (``tools/wine/test``); on Linux tests/cli/test_station_channel*.py check
 the POSIX side (signals, ``/proc/locks``).  Each test gets a state folder of its own
@@ -86,3 +86,39 @@ def test_the_channel_names_the_running_station_and_stop_ends_it_cleanly(tmp_path
         station.wait(30)
         if station.stderr is not None:
             station.stderr.close()
+
+
+#: A process that holds the channel as a station does (the lock, a description verified by its start time) but
+#: never looks at its control file: a station too busy to take a request in time.
+DEAF_STATION = """
+import os, sys, time
+from pathlib import Path
+from nfwserver.cli.station_channel import StationChannel, StationInfo
+from nfwserver.cli.station_process import process_start
+channel = StationChannel(Path(sys.argv[1]))
+assert channel.claim(retry_s=0)
+channel.describe(StationInfo(os.getpid(), process_start(os.getpid()), started=True))
+print("up", flush=True)
+sys.stdin.read()
+"""
+
+
+def test_stop_withdraws_its_request_when_the_station_has_not_taken_it_in_time(state_folder) -> None:
+    from nfwserver.cli.station_channel import StationChannel
+
+    deaf = subprocess.Popen([sys.executable, "-c", DEAF_STATION, str(state_folder)], cwd=ROOT, stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, text=True)
+    try:
+        assert deaf.stdout is not None and deaf.stdout.readline().strip() == "up"
+        assert StationChannel(state_folder).verified(StationChannel(state_folder).info())
+        stop = nfwserver("stop", "--timeout", "1")
+        assert stop.returncode == 3, stop.stdout + stop.stderr
+        assert stop.stderr.strip() == (
+            f"nfwserver: the station (process {deaf.pid}) was asked to stop but is still running after 1 s; the "
+            "request is withdrawn: it will go on running (its log says what it is waiting for)")
+        assert not (state_folder / "control").exists()  # a station looking later finds nothing to act on
+        assert deaf.poll() is None
+    finally:
+        if deaf.stdin is not None:
+            deaf.stdin.close()
+        deaf.wait(30)
