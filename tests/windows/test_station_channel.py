@@ -2,8 +2,8 @@
 ``status`` reaching it whatever its configuration file says, ``stop`` through the control file (and its request
 withdrawn when the station has not taken it in time), the station verified by its start time (``GetProcessTimes``).
 
-Runs only on Windows or under Wine (``tools/wine/test``); on Linux tests/cli/test_station_channel*.py check
-the POSIX side (signals, ``/proc/locks``).  Each test gets a state folder of its own
+Runs only on Windows or under Wine (``tools/wine/test``); on Linux tests/app/test_stop_command.py and
+test_stop_hostile.py check the POSIX side (signals, ``/proc/locks``).  Each test gets a state folder of its own
 (``WIN_PD_OVERRIDE_LOCAL_APPDATA``, platformdirs' override of ``%LOCALAPPDATA%``), so the suite's own session
 station does not count as "a station already running".
 """
