@@ -204,7 +204,10 @@ def test_a_signal_to_the_launcher_stops_the_windows_station_cleanly_within_5_s(t
         env={**os.environ, "NFW_WINE_TIMEOUT": "120"}, start_new_session=True)
     try:
         def clients_ready() -> bool:
-            assert client.poll() is None and station.poll() is None, (client.poll(), station.poll())
+            if client.poll() is not None:  # its own words (a traceback) say why, not just its exit status
+                raise AssertionError(f"the DDE client program exited {client.returncode} before it was ready: "
+                                     f"{client.communicate()[0][-3000:]}")
+            assert station.poll() is None, station.poll()
             return ready.exists()
 
         wait_for(clients_ready, 90.0, "the DDE clients to be connected", interval_s=0.1)
