@@ -106,3 +106,56 @@ def test_a_name_taken_before_the_station_creates_its_event_is_not_trusted() -> N
         assert StopEvent.create(os.getpid(), 515151, lambda _word, _origin: None) is None
     finally:
         ctypes.WinDLL("kernel32").CloseHandle(ctypes.c_void_p(handle))
+
+
+def _suspend(pid: int, resume: bool = False) -> None:
+    """Suspend (or resume) every thread of process ``pid`` (``NtSuspendProcess``, as a debugger does)."""
+    import ctypes
+
+    kernel32 = ctypes.WinDLL("kernel32", use_last_error=True)
+    kernel32.OpenProcess.restype = ctypes.c_void_p
+    handle = kernel32.OpenProcess(0x0800, False, pid)  # PROCESS_SUSPEND_RESUME
+    assert handle
+    try:
+        ntdll = ctypes.WinDLL("ntdll")
+        call = ntdll.NtResumeProcess if resume else ntdll.NtSuspendProcess
+        assert call(ctypes.c_void_p(handle)) == 0
+    finally:
+        kernel32.CloseHandle(ctypes.c_void_p(handle))
+
+
+def test_a_stop_that_gives_up_on_a_suspended_station_withdraws_its_request_and_the_station_goes_on(tmp_path) -> None:
+    from nfwserver.cli.station_channel import StationChannel
+
+    config = write_station_config(tmp_path / "cfg", extra="[tcp]\nenabled = false\n")
+    log = tmp_path / "station.log"
+    station = subprocess.Popen(
+        [sys.executable, "-m", "nfwserver", "run", "--headless", "--config", str(config), "--log-file", str(log),
+         "--duration", "300"], cwd=ROOT, env=_env(tmp_path), stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE)
+
+    def stop(timeout_s: float) -> subprocess.CompletedProcess[str]:
+        return subprocess.run([sys.executable, "-m", "nfwserver", "stop", "--timeout", f"{timeout_s:g}"], cwd=ROOT,
+                              env=_env(tmp_path), stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                              timeout=120)
+
+    try:
+        channel = StationChannel(tmp_path / "local" / "nfwserver")
+        wait_for(lambda: station.poll() is not None or channel.serving() is not None, 90, "the station to serve")
+        channel.default_control.mkdir()  # nothing can be written, as on a full disk
+        _suspend(station.pid)
+        try:
+            gave_up = stop(1.0)
+        finally:
+            _suspend(station.pid, resume=True)
+        assert gave_up.returncode == 3, gave_up.stdout + gave_up.stderr
+        assert "the request is withdrawn: it will go on running" in gave_up.stderr
+        assert station.poll() is None and "stopping" not in log.read_text(encoding="utf-8", errors="replace")
+        done = stop(60.0)  # the station was never asked: this stop is the one that ends it
+        assert done.returncode == 0, done.stdout + done.stderr
+        assert station.wait(30) == 0
+        assert log.read_text(encoding="utf-8", errors="replace").count("nfwserver stop (event") == 1
+    finally:
+        if station.poll() is None:
+            station.kill()
+            station.wait(10)
