@@ -3,7 +3,8 @@
 
 Real ``nfwserver run --headless`` processes, the real ``nfwserver stop`` program, real kernel events (Windows, or
 the Windows Python under Wine).  Each station gets a state folder of its own (platformdirs'
-``WIN_PD_OVERRIDE_LOCAL_APPDATA``), so it never meets the suite's other station.
+``WIN_PD_OVERRIDE_LOCAL_APPDATA``), and DDE service names of its own, so it never meets
+the suite's other station.
 """
 
 from __future__ import annotations
@@ -20,6 +21,8 @@ from tests.windows.station_config import write_station_config
 
 pytestmark = pytest.mark.skipif(sys.platform != "win32", reason="Windows kernel events (tools/wine/test)")
 ROOT = Path(__file__).resolve().parent.parent.parent
+#: ``[server]`` lines of these stations: DDE names and no TCP port of their own, beside the suite's station.
+OWN_NAMES = "services = ['NFW_STOP_TEST']\n[tcp]\nenabled = false\n"
 
 
 def _env(home: Path) -> dict[str, str]:
@@ -30,7 +33,7 @@ def _env(home: Path) -> dict[str, str]:
 def test_stop_stops_the_station_when_its_control_file_cannot_be_written(tmp_path) -> None:
     from nfwserver.cli.station_channel import StationChannel
 
-    config = write_station_config(tmp_path / "cfg", extra="[tcp]\nenabled = false\n")
+    config = write_station_config(tmp_path / "cfg", extra=OWN_NAMES)
     log = tmp_path / "station.log"
     station = subprocess.Popen(
         [sys.executable, "-m", "nfwserver", "run", "--headless", "--config", str(config), "--log-file", str(log),
@@ -127,7 +130,7 @@ def _suspend(pid: int, resume: bool = False) -> None:
 def test_a_stop_that_gives_up_on_a_suspended_station_withdraws_its_request_and_the_station_goes_on(tmp_path) -> None:
     from nfwserver.cli.station_channel import StationChannel
 
-    config = write_station_config(tmp_path / "cfg", extra="[tcp]\nenabled = false\n")
+    config = write_station_config(tmp_path / "cfg", extra=OWN_NAMES)
     log = tmp_path / "station.log"
     station = subprocess.Popen(
         [sys.executable, "-m", "nfwserver", "run", "--headless", "--config", str(config), "--log-file", str(log),
