@@ -5,12 +5,12 @@ saved, DDE clients never told), and Windows has no ``SIGHUP``.  So when the envi
 ``NFW_CONTROL_FILE`` names a file, ``nfwserver run`` looks for that file every
 :data:`POLL_S` seconds; when it appears, the station reads its first word, removes it and acts:
 ``stop`` stops the station as ``SIGTERM`` does, ``reload`` re-reads the configuration as ``SIGHUP`` does.
-Anything else gets one warning and is removed.  ``tools/wine/nfwserver`` sets the variable and writes
-``stop`` when it receives ``SIGTERM``, ``SIGINT`` or ``SIGHUP`` (``reload`` on ``SIGUSR1``); on Windows
-a service wrapper can do the same.  Besides that file, ``run`` always watches ``control`` in the user's
-state directory (:mod:`nfwserver.cli.station_channel`), which is how ``nfwserver stop`` reaches it on
-Windows.  Writers should write another name and rename it into place, so that the
-station never reads half a word (an empty file is left alone until it has a word).
+Anything else gets one warning and is removed. ``tools/wine/nfwserver`` sets the variable and writes ``stop``
+when it receives ``SIGTERM``, ``SIGINT`` or ``SIGHUP`` (``reload`` on ``SIGUSR1``); on Windows a service
+wrapper can do the same. Besides that file, ``run`` always watches ``control`` in the user's state directory
+(:mod:`nfwserver.cli.station_channel`), which is how ``nfwserver stop`` reaches it on Windows when it cannot
+open the station's stop event (:mod:`nfwserver.cli.stop_event`). Writers should write another name and rename
+it into place, so that the station never reads half a word (an empty file is left alone until it has a word).
 
 Owned by its own thread, ``nfw-control``; it waits on the injected clock.
 """

@@ -24,6 +24,7 @@ from nfwserver.cli.errors import CliError, load_config_or_fail, say
 from nfwserver.cli.signals import StationSignals, signal_actions
 from nfwserver.cli.station_channel import StationChannel, StationInfo
 from nfwserver.cli.station_runner import run_console, serve_headless, start_report
+from nfwserver.cli.stop_event import StopEvent
 from nfwserver.clock import Clock, SystemClock
 
 if TYPE_CHECKING:
@@ -216,6 +217,7 @@ class _OpenChannel:
     channel: StationChannel | None
     signals: StationSignals | None
     control: ControlFile | None
+    stop_event: StopEvent | None = None  #: Windows: ``nfwserver stop``'s event (cli/stop_event.py)
 
     def describe(self, station: Station | None = None) -> None:
         """Say who runs (and, with ``station``, that it is up and where it listens) in the channel."""
@@ -224,6 +226,8 @@ class _OpenChannel:
         if self.channel is None:
             return
         pid = os.getpid()
+        if sys.platform == "win32" and self.stop_event is None and self.signals is not None:  # before it is described
+            self.stop_event = StopEvent.create(pid, process_start(pid), self.signals.request)
         if station is None:
             self.channel.describe(StationInfo(pid, process_start(pid)))
         else:
@@ -235,8 +239,11 @@ class _OpenChannel:
         control, self.control = self.control, None
         signals, self.signals = self.signals, None
         channel, self.channel = self.channel, None
+        event, self.stop_event = self.stop_event, None
         if control is not None:
             control.stop()
+        if event is not None:
+            event.stop()
         if signals is not None:
             signals.close()
         if channel is not None:

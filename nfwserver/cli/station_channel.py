@@ -11,11 +11,11 @@ description, says whether one runs, and a description is believed only about a p
 always ``control`` in this same directory (:attr:`StationChannel.default_control`), whatever ``station.json``
 holds, so a forged description can make no command write elsewhere.
 
-``nfwserver stop`` signals the verified process (Linux) or writes ``stop`` to the control file (Windows) and
-waits until the lock is free; ``nfwserver dashboard``, ``status``, ``poke`` and ``watch`` find the station's
-addresses here, whatever state the configuration file is in.  A second ``nfwserver run`` of the same user
-while one runs is refused at once, naming the running one: two stations would offer the same DDE service
-names and ports.
+``nfwserver stop`` signals the verified process (Linux) or sets its named stop event (Windows,
+:mod:`nfwserver.cli.stop_event`; the control file only when that cannot be opened) and waits until the lock is
+free; ``nfwserver dashboard``, ``status``, ``poke`` and ``watch`` find the station's addresses here, whatever
+state the configuration file is in. A second ``nfwserver run`` of the same user while one runs is refused at
+once, naming the running one: two stations would offer the same DDE service names and ports.
 
 The lock is :mod:`nfwserver.file_lock`'s (``fcntl.flock`` on Linux, ``msvcrt.locking`` of one byte on
 Windows), held here for the whole run; the system releases it at process exit.

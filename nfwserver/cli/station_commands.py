@@ -11,11 +11,13 @@ thing ``run`` takes, and ``stop`` waits (up to ``--timeout``) for it to describe
   not matter.  A signal cannot be taken back: when the station has not stopped within ``--timeout`` the
   sentence says what will happen (a suspended station stops as soon as it is continued; a busy one when it
   has finished what it is doing).
-- Windows: ``stop`` is written to the station's control file (``control`` in the state directory, never a
-  path the description names), and the process waited for is the described one only when verified by its
-  start time (``GetProcessTimes``); otherwise the lock alone.  When the station has not stopped within
-  ``--timeout``, the request is withdrawn (the file removed) unless the station has already taken it, and the
-  sentence says which.
+- Windows: the verified station's named stop event is set (:mod:`nfwserver.cli.stop_event`; verified by its
+  start time, ``GetProcessTimes``): nothing is written, so a full disk does not matter.  Only when that event
+  cannot be opened (or the description is not verified) is ``stop`` written to the station's control file
+  (``control`` in the state directory, never a path the description names); the process waited for is the
+  described one only when verified, otherwise the lock alone.  When the station has not stopped within
+  ``--timeout``, the request is withdrawn (the event taken back by a zero-timeout wait, or the file removed)
+  unless the station has already taken it, and the sentence says which.
 
 Exit status: 0 once stopped; 1 with one sentence when none is running (or it cannot be asked, or its
 description names a process that is not the station); :data:`STILL_RUNNING` (3) with one sentence when it has
@@ -37,6 +39,7 @@ from nfwserver.cli.arguments import number_in
 from nfwserver.cli.errors import CliError, config_refused, say, say_last_good
 from nfwserver.cli.station_channel import StationChannel, StationInfo
 from nfwserver.cli.station_process import process_ended, process_start
+from nfwserver.cli.stop_event import SentRequest, ask_to_stop
 from nfwserver.storage import atomic_write_text
 
 #: Default seconds ``stop`` waits for the station to be gone.
@@ -88,22 +91,30 @@ def _not_the_station(channel: StationChannel, info: StationInfo) -> CliError:
                     "or with Ctrl+C")
 
 
-def _ask_to_stop(channel: StationChannel, info: StationInfo) -> None:
-    """Send the stop request to the verified station: a signal (POSIX), its own control file (Windows)."""
+def _ask_to_stop(channel: StationChannel, info: StationInfo, verified: bool) -> SentRequest | None:
+    """Send the stop request to the verified station: a signal (POSIX); on Windows its stop event
+    (:mod:`nfwserver.cli.stop_event`, the request returned), or its own control file when the event cannot be
+    opened (None returned)."""
     if sys.platform != "win32":
         import signal
 
         os.kill(info.pid, signal.SIGTERM)
-        return
+        return None
+    if verified and info.start is not None:
+        sent = ask_to_stop(info.pid, info.start)
+        if sent is not None:
+            return sent
     try:
         atomic_write_text(channel.default_control, "stop\n")
     except OSError as exc:
         raise CliError(f"cannot ask the station (process {info.pid}) to stop: {channel.default_control}: "
                        f"{exc.strerror or exc}") from None
+    return None
 
 
-def _gave_up(channel: StationChannel, info: StationInfo, timeout_s: float) -> str:
-    """What happens to the request of a ``stop`` that waited ``timeout_s`` in vain, in one sentence."""
+def _gave_up(channel: StationChannel, info: StationInfo, timeout_s: float, sent: SentRequest | None) -> str:
+    """What happens to the request of a ``stop`` that waited ``timeout_s`` in vain, in one sentence; the request
+    (the event's ``sent``, else the control file) is withdrawn unless the station has taken it."""
     from nfwserver.cli.station_process import suspended
 
     head = f"the station (process {info.pid}) was asked to stop but is still running after {timeout_s:g} s"
@@ -112,6 +123,10 @@ def _gave_up(channel: StationChannel, info: StationInfo, timeout_s: float) -> st
             return (f"{head}: it is suspended (SIGSTOP or Ctrl+Z) and has the stop signal, so it will stop "
                     f"cleanly as soon as it is continued (`kill -CONT {info.pid}`)")
         return f"{head}: it has the stop signal and will stop once it finishes what it is doing (its log says what)"
+    if sent is not None and not sent.withdraw():
+        return f"{head}: it has taken the request and is stopping (its log says what it is waiting for)"
+    if sent is not None:
+        return f"{head}; the request is withdrawn: it will go on running (its log says what it is waiting for)"
     try:
         channel.default_control.unlink()
     except FileNotFoundError:
@@ -136,12 +151,12 @@ def run_stop(args: argparse.Namespace) -> int:
     verified = channel.verified(info)
     if not verified and sys.platform != "win32":  # Windows writes only the station's own control file: no harm
         raise _not_the_station(channel, info)
-    _ask_to_stop(channel, info)
+    sent = _ask_to_stop(channel, info, verified)
     deadline = time.monotonic() + args.timeout
     # the lock is freed just before the process ends: wait for its end too (the same start time: not a new one)
     while channel.running() or (verified and process_start(info.pid) == info.start and not process_ended(info.pid)):
         if time.monotonic() >= deadline:
-            say(_gave_up(channel, info, args.timeout))
+            say(_gave_up(channel, info, args.timeout, sent))
             return STILL_RUNNING
         time.sleep(POLL_S)
     print(f"stopped the station (process {info.pid})" if verified else "stopped the station")
