@@ -34,7 +34,8 @@ def _elements(tmp_path, numbers: tuple[int, ...]):
 
 DRAWN_TRACK = """
 const xy = el => [Number(el.getAttribute('cx')), Number(el.getAttribute('cy'))];
-const poly = document.querySelector('#polar polyline.track').getAttribute('points').trim();
+const line = document.querySelector('#polar polyline.track');  // no points until the page has drawn a track
+const poly = ((line && line.getAttribute('points')) || '').trim();
 const points = poly ? poly.split(/\\s+/).map(p => p.split(',').map(Number)) : [];
 const mark = k => { const el = document.querySelector(`[data-testid="pass-${k}"]`); return el ? xy(el) : null; };
 const box = el => { const b = el.getBoundingClientRect(); return [b.left, b.top, b.right, b.bottom]; };
