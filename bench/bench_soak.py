@@ -9,7 +9,10 @@ switches, reconnections and re-reads five times as often.  Every 5 s the station
 CPU and log size are read from ``/proc``; STATUS is read twice a second for the link states; every line and
 frame is timed at its client.  Writes one section (the RSS slope fitted after the warm-up, the peak, feed gaps
 per client, the stalls the station logged and explained, the link states against the injected outages) and a
-plot, ``docs/soak-10hz.png`` or ``docs/soak-accelerated.png``.  Linux only.
+plot, ``docs/soak-10hz.png`` or ``docs/soak-accelerated.png``.  A STATUS sample that fails is said on stderr
+and counted, and the poller carries on; STATUS unanswered for more than :data:`SILENT_S` is said at once and
+makes the run exit 1 after its section is written; a daemon that does not start again is said and retried.
+Linux only.
 """
 
 from __future__ import annotations

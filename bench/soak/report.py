@@ -113,6 +113,8 @@ def section(title: str, what: str, soak: Soak, load: Load, minutes: float, warmu
              f"({load.status_failures}); {silence_s:.1f} s from {silence_at / 60.0:.1f} min |",
              f"| outages injected (rotctld / rigctld) | {sum(o.daemon == 'rotctld' for o in soak.outages)} / "
              f"{sum(o.daemon == 'rigctld' for o in soak.outages)} |",
+             f"| daemon restarts that failed and were retried | "
+             f"{sum(len(o.restart_errors) for o in soak.outages)} |",
              f"| outages STATUS showed late (> {TRUTH_S:g} s after the kill or the return) | {len(untrue)} |",
              f"| outages whose logged length is off by > {TRUTH_S:g} s (or not logged) | {len(wrong_length)} |",
              ""]
