@@ -9,7 +9,10 @@ switches, reconnections and re-reads five times as often.  Every 5 s the station
 CPU and log size are read from ``/proc``; STATUS is read twice a second for the link states; every line and
 frame is timed at its client.  Writes one section (the RSS slope fitted after the warm-up, the peak, feed gaps
 per client, the stalls the station logged and explained, the link states against the injected outages) and a
-plot, ``docs/soak-10hz.png`` or ``docs/soak-accelerated.png``.  Linux only.
+plot, ``docs/soak-10hz.png`` or ``docs/soak-accelerated.png``.  A STATUS sample that fails is said on stderr
+and counted, and the poller carries on; STATUS unanswered for more than :data:`SILENT_S` is said at once and
+makes the run exit 1 after its section is written; a daemon that does not start again is said and retried.
+Linux only.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ from bench.soak.station import ROOT, Soak
 
 SATELLITES = [25544, 14129, 27844, 43017]  # ISS, AO-10, CO-55 (no radio channel), FOX-1B
 DOWN_S = 15.0  #: how long each killed daemon stays away (seconds)
+SILENT_S = 10.0  #: STATUS answers missing this long (seconds) are said at once and fail the benchmark
 
 
 def _interrupted(signum: int, frame: object) -> None:
@@ -55,9 +59,22 @@ def main(argv: list[str]) -> None:
         faults: list[threading.Thread] = []
         ends = soak.started + args.minutes * 60.0
         next_sample = soak.started
+        silent_since: float | None = None  # when the current silence of STATUS answers was first said
+        silences: list[tuple[float, float]] = []  # (start, seconds) of each silence over SILENT_S, run seconds
         try:
             while time.monotonic() < ends:
                 now = time.monotonic()
+                silent_s = load.status_silence_s(now, soak.started)
+                if silent_s > SILENT_S and silent_since is None:
+                    silent_since = now - silent_s
+                    print(f"  {(now - soak.started) / 60.0:5.1f} min: NO STATUS ANSWER for {silent_s:.0f} s "
+                          f"(poller {'alive' if load.polling else 'DEAD'}, {load.status_failures} failed samples)",
+                          file=sys.stderr)
+                elif silent_s <= SILENT_S and silent_since is not None:
+                    silences.append((silent_since - soak.started, now - silent_since))
+                    print(f"  {(now - soak.started) / 60.0:5.1f} min: STATUS answers again after "
+                          f"{now - silent_since:.0f} s", file=sys.stderr)
+                    silent_since = None
                 if now >= next_sample:
                     sample = soak.sample()
                     next_sample += args.sample_s
@@ -76,6 +93,8 @@ def main(argv: list[str]) -> None:
             for thread in faults:
                 thread.join(30.0)
             soak.sample()
+            if silent_since is not None:
+                silences.append((silent_since - soak.started, time.monotonic() - silent_since))
             load.join()
             soak.stop()
         if args.accelerated:
@@ -91,6 +110,12 @@ def main(argv: list[str]) -> None:
                 f"{60.0 / speed:g} s; `nfwserver watch`; elements re-read every {180.0 / speed:g} s.")
         drawn = plot(png, title, soak, load, warmup_s)
         print(section(title, what, soak, load, args.minutes, warmup_s, drawn))
+        if silences:
+            print(f"FAILED: STATUS went unanswered for more than {SILENT_S:g} s "
+                  + ", ".join(f"from {at / 60.0:.1f} min for {length:.0f} s" for at, length in silences)
+                  + f" ({load.status_failures} failed samples); the link states of that time were not checked",
+                  file=sys.stderr)
+            sys.exit(1)
 
 
 if __name__ == "__main__":

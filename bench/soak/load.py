@@ -8,10 +8,13 @@ Every thread stops when :attr:`Load.stop` is set; times are ``time.monotonic()``
 from __future__ import annotations
 
 import socket
+import sys
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from nfwserver.tcp.greeting import GREETING
 from nfwserver.tcp.status_line import parse_status
 
 #: A feed gap longer than this (seconds) is counted as a stall as a client sees it.
@@ -63,19 +66,29 @@ class Load:
         self.feeds = [FeedTimes(f"tcp-{i + 1}") for i in range(watchers)]
         self.streams = [FeedTimes(f"web-{i + 1}") for i in range(streams)]
         self.links: list[LinkSample] = []
+        self.status_failures = 0  #: STATUS samples that failed (each followed by a reconnection)
+        self.status_failed: list[tuple[float, str]] = []  #: (when, why) of each failure (the first 1000)
+        self._status_ok = False
         self.switches = 0
         self.switch_failures = 0
         self.sleeper_late_s = 0.0  #: the 50 ms sleeper's worst oversleep (the machine's own stalls)
         self._threads: list[threading.Thread] = []
+        self._poller: threading.Thread | None = None
+
+    @property
+    def polling(self) -> bool:
+        """Whether the STATUS poller's thread is alive."""
+        return self._poller is not None and self._poller.is_alive()
 
     def start(self) -> None:
-        targets = [(self._watch, (f,)) for f in self.feeds] + [(self._stream, (s, i)) for i, s in
-                                                              enumerate(self.streams)]
+        targets: list[tuple[Callable[..., None], tuple[object, ...]]] = [(self._watch, (f,)) for f in self.feeds]
+        targets += [(self._stream, (s, i)) for i, s in enumerate(self.streams)]
         targets += [(self._switch, ()), (self._poll_status, ()), (self._sleep, ())]
         for target, args in targets:
-            thread = threading.Thread(target=target, args=args, daemon=True)
+            thread = threading.Thread(target=target, args=args, daemon=True, name=f"soak{target.__name__}")
             thread.start()
             self._threads.append(thread)
+        self._poller = self._threads[-2]
 
     def join(self) -> None:
         self.stop.set()
@@ -165,19 +178,49 @@ class Load:
 
     def _poll_status(self) -> None:
         """``STATUS`` twice a second on one connection (reopened when lost): the link states as the station says
-        them."""
+        them.  A sample that fails (no answer within the socket's timeout, the connection refused, evicted or
+        closed, an answer that is not a STATUS line, anything else raised) is recorded in
+        :attr:`status_failures`, said once per episode on stderr, and the poller reconnects and carries on."""
         while not self.stop.is_set():
             try:
-                with self._connect_tcp() as sock:
-                    reader = sock.makefile("rb")
-                    reader.readline()  # the greeting
+                with self._connect_tcp() as sock, sock.makefile("rb") as reader:
+                    greeting = reader.readline().decode("ascii", "replace").strip()
+                    if greeting != GREETING:  # an admission refusal (one ERROR line), or a close
+                        raise ConnectionError(f"greeted with {greeting[:120]!r}")
                     while not self.stop.wait(0.5):
                         sock.sendall(b"STATUS\r\n")
-                        fields = parse_status(reader.readline().decode("ascii", "replace"))
-                        self.links.append(LinkSample(time.monotonic(), fields.get("rotor", "-"),
-                                                     fields.get("radio", "-"), fields.get("faults", "-")))
-            except OSError:
+                        self._status_answer(reader.readline())
+            except Exception as exc:  # noqa: BLE001 -- any failure is recorded and the poller carries on
+                self._status_failed(exc)
                 self.stop.wait(1.0)
+
+    def _status_answer(self, raw: bytes) -> None:
+        """Record one answer to ``STATUS``; raise when it is none (the connection closed) or not a STATUS line
+        (an ``ERROR`` line, an answer out of step)."""
+        if not raw:
+            raise ConnectionError("closed by the station")
+        line = raw.decode("ascii", "replace").strip()
+        fields = parse_status(line)
+        if "rotor" not in fields or "radio" not in fields:
+            raise ValueError(f"not a STATUS line: {line[:120]!r}")
+        self.links.append(LinkSample(time.monotonic(), fields["rotor"], fields["radio"], fields.get("faults", "-")))
+        self._status_ok = True
+
+    def _status_failed(self, exc: BaseException) -> None:
+        """Count and keep a failed STATUS sample; the first of an episode (after an answer, or the first ever) is
+        said on stderr."""
+        now = time.monotonic()
+        self.status_failures += 1
+        reason = f"{type(exc).__name__}: {exc}"
+        if len(self.status_failed) < 1000:
+            self.status_failed.append((now, reason))
+        if self._status_ok or self.status_failures == 1:
+            self._status_ok = False
+            print(f"  STATUS sample failed ({reason}); reconnecting", file=sys.stderr)
+
+    def status_silence_s(self, now: float, since: float) -> float:
+        """Seconds up to ``now`` since the last STATUS answer (or since ``since``, the start, when none came)."""
+        return now - (self.links[-1].at if self.links else since)
 
     def _sleep(self) -> None:
         while not self.stop.is_set():

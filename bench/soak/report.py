@@ -36,6 +36,14 @@ def slope_mib_h(samples: list[Sample], after_s: float) -> float:
     return float(fit[0])
 
 
+def longest_silence(load: Load, started: float, ended: float) -> tuple[float, float]:
+    """The longest time (seconds) without a STATUS answer between ``started`` and ``ended`` (monotonic
+    seconds), the start and the end of the run included, and when it began (seconds into the run)."""
+    times = [started] + [s.at for s in load.links] + [ended]
+    length, at = max((b - a, a) for a, b in zip(times, times[1:]))
+    return length, at - started
+
+
 def _word(sample: LinkSample, daemon: str) -> str:
     return sample.rotor if daemon == "rotctld" else sample.radio
 
@@ -69,10 +77,12 @@ def section(title: str, what: str, soak: Soak, load: Load, minutes: float, warmu
     samples = soak.samples
     log_text = "".join(p.read_text("utf-8", "replace") for p in sorted(soak.work.glob("nfwserver.log*")))
     stalls = re.findall(r"publish tick ([\d.]+) s late: ([^\n]*)", log_text)
-    polled_until = max((s.at for s in load.links), default=0.0)
-    seen = [s for s in outages_seen(soak, load, log_text)  # those the run's end cut short are left out
-            if s.outage.up is not None and s.outage.up + TRUTH_S <= polled_until]
     duration_s = samples[-1].at if samples else 0.0
+    ended = soak.started + duration_s
+    # Those the run's end cut short are left out; those STATUS was not sampled for are kept and count as untrue.
+    seen = [s for s in outages_seen(soak, load, log_text)
+            if s.outage.up is not None and s.outage.up + TRUTH_S <= ended]
+    silence_s, silence_at = longest_silence(load, soak.started, ended)
     first, last = samples[0], samples[-1]
     cpu = (last.cpu_s - first.cpu_s) / max(1e-9, last.at - first.at) * 100.0
     log_rate = (last.log_bytes - first.log_bytes) / max(1e-9, last.at - first.at) * 3600.0 / 1024.0
@@ -99,8 +109,12 @@ def section(title: str, what: str, soak: Soak, load: Load, minutes: float, warmu
              f"| stalls the station logged (tick >= 0.5 s late) | {len(stalls)}"
              + (f", longest {max(float(s[0]) for s in stalls):.2f} s" if stalls else "") + " |",
              f"| SAT= switches (refused or failed) | {load.switches} ({load.switch_failures}) |",
+             f"| STATUS samples (failed); longest time without an answer | {len(load.links)} "
+             f"({load.status_failures}); {silence_s:.1f} s from {silence_at / 60.0:.1f} min |",
              f"| outages injected (rotctld / rigctld) | {sum(o.daemon == 'rotctld' for o in soak.outages)} / "
              f"{sum(o.daemon == 'rigctld' for o in soak.outages)} |",
+             f"| daemon restarts that failed and were retried | "
+             f"{sum(len(o.restart_errors) for o in soak.outages)} |",
              f"| outages STATUS showed late (> {TRUTH_S:g} s after the kill or the return) | {len(untrue)} |",
              f"| outages whose logged length is off by > {TRUTH_S:g} s (or not logged) | {len(wrong_length)} |",
              ""]
@@ -118,9 +132,9 @@ def section(title: str, what: str, soak: Soak, load: Load, minutes: float, warmu
         lines.append(f"| ... {len(seen) - 40} more | | | | |")
     lines += ["", "| minute | RSS MiB | threads | fds | CPU s | log KiB |", "|---|---|---|---|---|---|"]
     step = max(1, len(samples) // 12)
-    for s in samples[::step] + ([samples[-1]] if (len(samples) - 1) % step else []):
-        lines.append(f"| {s.at / 60.0:.1f} | {s.rss_mib:.1f} | {s.threads} | {s.fds} | {s.cpu_s:.0f} | "
-                     f"{s.log_bytes / 1024.0:.0f} |")
+    for row in samples[::step] + ([samples[-1]] if (len(samples) - 1) % step else []):
+        lines.append(f"| {row.at / 60.0:.1f} | {row.rss_mib:.1f} | {row.threads} | {row.fds} | {row.cpu_s:.0f} | "
+                     f"{row.log_bytes / 1024.0:.0f} |")
     if plot is not None:
         lines += ["", f"![{title}]({plot.name})"]
     return "\n".join(lines) + "\n"

@@ -37,11 +37,13 @@ class Sample:
 
 @dataclass
 class Outage:
-    """One daemon killed at ``down`` and started again at ``up`` (``time.monotonic()`` seconds)."""
+    """One daemon killed at ``down`` and started again at ``up`` (``time.monotonic()`` seconds; None: not yet, or
+    never when the run ended first)."""
 
     daemon: str
     down: float
     up: float | None = None
+    restart_errors: list[str] = field(default_factory=list)  #: why each failed attempt to start it again failed
 
 
 @dataclass
@@ -133,7 +135,15 @@ class Soak:
         self.outages.append(outage)
         target.kill()
         stop.wait(down_s)
-        target.start()
+        while True:  # a restart that fails (its port taken, too slow to listen on a busy machine) is said and retried
+            try:
+                target.start()
+                break
+            except Exception as exc:  # noqa: BLE001 -- kept in the outage and said; the daemon must come back
+                outage.restart_errors.append(f"{type(exc).__name__}: {exc}")
+                print(f"  {daemon} did not start again ({outage.restart_errors[-1]}); retrying", file=sys.stderr)
+                if stop.wait(2.0):
+                    return
         outage.up = time.monotonic()
 
     def stop(self) -> None:
