@@ -114,8 +114,8 @@ def test_the_control_file_asks_for_reload_and_stop_and_is_removed(tmp_path: Path
         path.write_text("RELOAD\n")
         assert wait_for(lambda: len(got) == 1) and not path.exists()
         path.write_text("halt now\n")
-        assert wait_for(lambda: not path.exists())
-        assert "'halt' is not a request" in caplog.text
+        assert wait_for(lambda: not path.exists())  # removed first, then said: wait for the line itself
+        assert wait_for(lambda: "'halt' is not a request" in caplog.text)
         path.write_text("stop")
         assert wait_for(lambda: len(got) == 2)
     finally:
