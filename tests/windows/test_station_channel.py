@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pytest
 
+from nfwserver.cli.stop_event import event_name
 from tests.waiting import wait_for
 from tests.windows.station_config import write_station_config
 
@@ -73,7 +74,9 @@ def test_the_channel_names_the_running_station_and_stop_ends_it_cleanly(tmp_path
         assert stop.stdout.strip() == f"stopped the station (process {station.pid})"
         assert station.poll() == 0  # ended (stop waits for the process itself), and cleanly: not killed
         text = log.read_text(encoding="utf-8")
-        assert f"control file {state_folder / 'control'}: stopping" in text
+        # the station's stop event (nfwserver/cli/stop_event.py): no file written (test_stop_event.py)
+        assert f"nfwserver stop (event {event_name(info.pid, info.start)}): stopping" in text, text[-2000:]
+        assert not (state_folder / "control").exists()
         assert text.rstrip().endswith("stopped")
         assert not (state_folder / "station.json").exists()
 
