@@ -33,6 +33,23 @@ from tests.waiting import wait_for  # noqa: E402
 SERVICES = ("NFW32", "NFW_SERVER")
 
 
+def _poke(client: DdemlClient, conv: int, text: str, tries: int = 3) -> None:
+    """Poke ``text``; a refusal is said on stderr and tried again after a second, ``tries`` times in all.
+
+    Under Wine, in the busy full suite, a ``SAT=`` poke right after the conversations came up was sometimes not
+    acknowledged although the ``TUNE ON`` pokes before it were (1 run in 3-5; the cause is not known yet): the
+    test this serves is about stopping the station, so it says so and tries again rather than failing there."""
+    for attempt in range(1, tries + 1):
+        try:
+            client.poke(conv, "NFW_SERVER", text)
+            return
+        except DdeRefused as exc:
+            print(f"dde_clients: poke {text!r} refused (try {attempt} of {tries}): {exc}", file=sys.stderr)
+            if attempt == tries:
+                raise
+            client.pump(1.0)
+
+
 def connect(client: DdemlClient, service: str, timeout_s: float) -> int:
     def connected() -> int | None:
         try:
@@ -73,7 +90,7 @@ def main(argv: list[str] | None = None) -> int:
         Path(args.out).write_text(json.dumps(records, indent=1))
         return 1
     if args.poke:
-        shared.poke(convs[0], "NFW_SERVER", args.poke)
+        _poke(shared, convs[0], args.poke)
     pump = clients[0].pump  # one thread: pumping dispatches every instance's messages
     late = time.time() > args.start_at if args.start_at else False
     if args.start_at and not late:
