@@ -240,7 +240,8 @@ def test_the_installed_program_serves_ddeml_clients_and_stops_on_request(install
         assert stop.stdout.strip() == f"stopped the station (process {pid})"
         assert station.wait(60) == 0  # a clean stop, not a kill
         log = (installed.user_files / "Logs" / "nfwserver.log").read_text(encoding="utf-8", errors="replace")
-        assert "control file" in log and log.rstrip().endswith("stopped")
+        # `stop` set the station's stop event (no file written: nfwserver/cli/stop_event.py)
+        assert f"nfwserver stop (event Local\\nfwserver-stop-{pid}-" in log and log.rstrip().endswith("stopped")
         assert log.count("compiled TLE reader is wrong here") == 1  # the first run's log says it, once
         again = installed.nfwserver("stop")
         assert again.returncode == 1 and again.stdout == ""
