@@ -1,6 +1,7 @@
 """The station's channel on Windows (issues 42 and 45): a second ``run`` refused naming the running station,
-``status`` reaching it whatever its configuration file says, ``stop`` through the station's stop event (and, through the control file, its request
-withdrawn when the station has not taken it in time), the station verified by its start time (``GetProcessTimes``).
+``status`` reaching it whatever its configuration file says, ``stop`` through the station's stop event (and,
+through the control file, its request withdrawn when the station has not taken it in time), the station verified by
+its start time (``GetProcessTimes``).
 
 Runs only on Windows or under Wine (``tools/wine/test``); on Linux tests/app/test_stop_command.py and
 test_stop_hostile.py check the POSIX side (signals, ``/proc/locks``).  Each test gets a state folder of its own
