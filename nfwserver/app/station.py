@@ -115,8 +115,6 @@ class Station:
         self.watcher: ConfigWatcher | None = None
         # a command (and the page's token) is checked against the file as it is now, whatever face it came from
         self.core.before_command = self.catch_up_config
-        if self.web is not None:
-            self.web.config_fresh = self.catch_up_config
         #: follows the stored catalog, which ``nfwserver elements update`` writes while the station runs
         self.store_watcher = StoreWatcher(self.store.path, clock, self.reload_store) if self.store else None
         self._watcher_lock = threading.Lock()

@@ -183,7 +183,9 @@ class WebHandler(BaseHTTPRequestHandler):
         if self.path.split("?", 1)[0] != "/api/command":
             self._json(404, {"ok": False, "error": "not found"})
             return
-        self.web.config_fresh()  # a token or control changed in the file a moment ago applies to this request
+        # a token or control changed in the file a moment ago applies to this request: the same catch-up every
+        # face's command gets (StationCore.before_command), here before the token is checked
+        self.web.core.before_command()
         control = self.web.control
         why = cross_site_reason(self.headers, self.headers.get("Host", ""))
         early = control.refuse(self.peer, 403, why) if why is not None else control.closed(self.peer)

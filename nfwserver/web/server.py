@@ -136,9 +136,6 @@ class WebServer:
         self._refusals = RateLimitedLog(log, core.clock, 60.0)
         self.control = Control(core, config, self.command_refused)
         self.admission = Admission(max_clients, max_per_address, own_reserve)
-        #: brings :attr:`config` up to the configuration file as it is now (the station's
-        #: :meth:`~nfwserver.app.station.Station.catch_up_config`): called before each command is checked
-        self.config_fresh: Callable[[], None] = lambda: None
         self.board = PassBoard(core.state, core.clock, self.parts.favourites, self.parts.rotor,
                                self.parts.autotrack_schedule)
         self.address: tuple[str, int] | None = None
