@@ -77,7 +77,7 @@ class Connection:
     def announce(self, events: EventLog, now: datetime) -> None:
         """Put its connect on record (log and event stream): done at its first line."""
         self.announced = True
-        log.info("TCP client %s connected", self.peer)
+        log.debug("TCP client %s connected", self.peer)  # a client reconnecting every minute: 1,440 lines a day
         events.add(now, Direction.IN, "connect", "TCP", client=self.peer, accepted=True)
 
 

@@ -31,6 +31,7 @@ so many clients cost no thread each.  The loop waits in ``select`` until the nex
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import logging
 import selectors
@@ -385,16 +386,15 @@ class NovaTcpServer(ServiceThread):
         self._clients.discard(client)
         self._watching.discard(client)
         if self._selector is not None:
-            try:
+            with contextlib.suppress(KeyError, ValueError):
                 self._selector.unregister(client.sock)
-            except (KeyError, ValueError):
-                pass
         client.sock.close()
         client.out.clear()
         client.inbox.clear()
         if not client.announced:  # it never sent a line: only the counters (and refusals) keep it
             log.debug("TCP client %s closed before its first line: %s", client.peer, reason)
             return
-        log.info("TCP client %s disconnected: %s", client.peer, reason)
+        ordinary = reason in ("QUIT", "closed by the client", "server stopping")  # the event stream keeps them
+        (log.debug if ordinary else log.info)("TCP client %s disconnected: %s", client.peer, reason)
         self.core.events.add(self.core.clock.now(), Direction.IN, "disconnect", reason, client=client.peer,
                              accepted=accepted)
