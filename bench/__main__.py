@@ -88,7 +88,12 @@ def main(argv: list[str]) -> int:
         print(f"unknown benchmark(s): {', '.join(unknown)}; have: {', '.join(names)} "
               f"(and, alone with its options: {', '.join(STANDALONE)})", file=sys.stderr)
         return 2
+    if "-h" in options or "--help" in options:  # each benchmark's own help; docs/BENCHMARKS.md untouched
+        for name in chosen:
+            subprocess.run([sys.executable, "-m", f"bench.bench_{name}", "--help"], cwd=ROOT, check=False)
+        return 0
     old = _sections(OUT.read_text()) if OUT.exists() else {}
+    written = 0
     for name in chosen:
         print(f"running bench_{name} ...", file=sys.stderr)
         started = time.monotonic()
@@ -101,12 +106,16 @@ def main(argv: list[str]) -> int:
         sections = _sections(proc.stdout)
         if not sections:
             print(f"  bench_{name} printed no section: its section is kept as it was", file=sys.stderr)
+        written += len(sections)
         for heading, section in sections.items():
             before = old.get(heading, "")
             if KEPT in before and KEPT not in section:
                 section = section.rstrip() + "\n\n" + before[before.index(KEPT):].rstrip() + "\n"
             old[heading] = section
         print(f"  done in {time.monotonic() - started:.1f} s", file=sys.stderr)
+    if not written:
+        print(f"no section: {OUT.relative_to(ROOT)} left as it was", file=sys.stderr)
+        return 0
     stamp = time.strftime("%Y-%m-%d", time.gmtime())
     ran = ", ".join(n.replace("_", "-") for n in chosen)
     text = HEADER + f"\nLast run {stamp}: {ran} (other sections are from earlier runs). {_machine()}\n\n" + \

@@ -5,7 +5,9 @@ of issue #44: TUNE, TRACK and Doppler tuning on at 10 Hz; a real ``rotctld`` kil
 ``rigctld`` every 6, each for 15 s; 3 Nova TCP ``WATCH`` clients; a TCP client switching ``SAT=`` every 20 s
 round the ISS, AO-10, CO-55 (no radio channel) and FOX-1B; 4 web event streams reconnecting every minute;
 ``nfwserver watch`` beside it; the elements re-read every 3 minutes.  ``--accelerated``: 50 Hz, and the faults,
-switches, reconnections and re-reads five times as often.  Every 5 s the station's RSS, threads, descriptors,
+switches, reconnections and re-reads five times as often (``--speed X``: X times as often; at 13, two hours
+hold 26 hours of the 10 Hz run's events; an outage lasts at most 30 % of its daemon's period, so that it is
+up most of the time).  Every 5 s the station's RSS, threads, descriptors,
 CPU and log size are read from ``/proc``; STATUS is read twice a second for the link states; every line and
 frame is timed at its client.  Writes one section (the RSS slope fitted after the warm-up, the peak, feed gaps
 per client, the stalls the station logged and explained, the link states against the injected outages) and a
@@ -30,7 +32,8 @@ from bench.soak.report import plot, section
 from bench.soak.station import ROOT, Soak
 
 SATELLITES = [25544, 14129, 27844, 43017]  # ISS, AO-10, CO-55 (no radio channel), FOX-1B
-DOWN_S = 15.0  #: how long each killed daemon stays away (seconds)
+DOWN_S = 15.0  #: how long each killed daemon stays away (seconds), at most :data:`DOWN_SHARE` of its period
+DOWN_SHARE = 0.3
 SILENT_S = 10.0  #: STATUS answers missing this long (seconds) are said at once and fail the benchmark
 
 
@@ -42,10 +45,12 @@ def main(argv: list[str]) -> None:
     parser = argparse.ArgumentParser(prog="python -m bench soak")
     parser.add_argument("--minutes", type=float, default=30.0, help="how long to run (default 30)")
     parser.add_argument("--accelerated", action="store_true", help="50 Hz, events five times as often")
+    parser.add_argument("--speed", type=float, default=None,
+                        help="events this many times as often as at 10 Hz (default 5 with --accelerated, else 1)")
     parser.add_argument("--sample-s", type=float, default=5.0, help="seconds between samples of the process")
     args = parser.parse_args(argv)
     signal.signal(signal.SIGTERM, _interrupted)  # a stopped soak still stops its station and daemons
-    speed = 5.0 if args.accelerated else 1.0
+    speed = args.speed or (5.0 if args.accelerated else 1.0)
     rate = 50.0 if args.accelerated else 10.0
     warmup_s = min(20.0, args.minutes / 2.0) * 60.0
     with tempfile.TemporaryDirectory(prefix="nfw-soak-") as work:
@@ -55,6 +60,7 @@ def main(argv: list[str]) -> None:
         load.start()
         stop = threading.Event()
         schedule = {"rotctld": 240.0 / speed, "rigctld": 360.0 / speed}
+        down = {daemon: min(DOWN_S, DOWN_SHARE * period) for daemon, period in schedule.items()}
         due = dict(schedule)
         faults: list[threading.Thread] = []
         ends = soak.started + args.minutes * 60.0
@@ -84,7 +90,7 @@ def main(argv: list[str]) -> None:
                 for daemon, period in schedule.items():
                     if now - soak.started >= due[daemon]:
                         due[daemon] += period
-                        thread = threading.Thread(target=soak.kill, args=(daemon, DOWN_S, stop), daemon=True)
+                        thread = threading.Thread(target=soak.kill, args=(daemon, down[daemon], stop), daemon=True)
                         thread.start()
                         faults.append(thread)
                 time.sleep(0.2)
@@ -98,16 +104,19 @@ def main(argv: list[str]) -> None:
             load.join()
             soak.stop()
         if args.accelerated:
-            title = "Soak: the real process, accelerated (50 Hz, events five times as often)"
+            title = f"Soak: the real process, accelerated (50 Hz, events {speed:g} times as often)"
             png = ROOT / "docs" / "soak-accelerated.png"
         else:
             title = "Soak: the real process at 10 Hz"
             png = ROOT / "docs" / "soak-10hz.png"
-        what = (f"`python -m bench soak --minutes {args.minutes:g}{' --accelerated' if args.accelerated else ''}`: "
-                f"{rate:g} Hz, TUNE/TRACK/tuning on; rotctld killed every {schedule['rotctld']:g} s and rigctld "
-                f"every {schedule['rigctld']:g} s, each for {DOWN_S:g} s; 3 TCP WATCH clients; SAT= every "
-                f"{20.0 / speed:g} s round {', '.join(map(str, SATELLITES))}; 4 web streams reconnecting every "
-                f"{60.0 / speed:g} s; `nfwserver watch`; elements re-read every {180.0 / speed:g} s.")
+        options = (" --accelerated" if args.accelerated else "") + (f" --speed {args.speed:g}" if args.speed else "")
+        what = (f"`python -m bench soak --minutes {args.minutes:g}{options}`: "
+                f"{rate:g} Hz, TUNE/TRACK/tuning on; rotctld killed every {schedule['rotctld']:.3g} s for "
+                f"{down['rotctld']:.3g} s and rigctld every {schedule['rigctld']:.3g} s for {down['rigctld']:.3g} s; "
+                f"3 TCP WATCH clients; SAT= every "
+                f"{20.0 / speed:.3g} s round {', '.join(map(str, SATELLITES))}; 4 web streams reconnecting every "
+                f"{60.0 / speed:.3g} s; `nfwserver watch`; elements re-read every {180.0 / speed:.3g} s; "
+                f"{args.minutes * speed / 60.0:.3g} hours of the 10 Hz run's events.")
         drawn = plot(png, title, soak, load, warmup_s)
         print(section(title, what, soak, load, args.minutes, warmup_s, drawn))
         if silences:
