@@ -20,10 +20,10 @@ pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="fork")
 PYTEST = os.getpid()  #: the process running the tests, which a slab must never kill
 
 
-@pytest.fixture(autouse=True)
-def _forking_allowed() -> None:
-    """These tests are about the forked path: with another thread running (pytest-timeout's thread method, a
-    test's leftover) this process would make every slab itself, and the killing slab would end pytest."""
+@pytest.fixture
+def forking() -> None:
+    """For the tests of the forked path: with another thread running (pytest-timeout's thread method, a test's
+    leftover) this process would make every slab itself, and the killing slab would end pytest."""
     if not can_fork():
         pytest.skip("another thread is running, so write_in_order does not fork")
 
@@ -38,6 +38,7 @@ def _written(count: int, make, processes: int) -> list[tuple[str, int]]:
     return out
 
 
+@pytest.mark.usefixtures("forking")
 @pytest.mark.parametrize("processes", [1, 2, 3, 9])
 def test_every_slab_once_in_order_each_made_by_its_process(processes: int) -> None:
     out = _written(7, _made_by, processes)
@@ -76,6 +77,7 @@ def _killed_in_a_forked_process(k: int) -> tuple[str, int]:
     return _made_by(k)
 
 
+@pytest.mark.usefixtures("forking")
 def test_a_killed_forked_process_is_an_error_not_missing_rows() -> None:
     with pytest.raises(OSError, match="a row-making process ended without its answer"):
         _written(4, _killed_in_a_forked_process, 2)
@@ -94,7 +96,6 @@ def test_a_failure_to_write_ends_the_forked_processes() -> None:
 _PENDING = """
 import sys
 from nfwserver.cli.forked_rows import write_in_order
-from nfwserver.forked_children import can_fork
 sys.stdout.write("header\\n")  # still in the buffer when the processes are forked
 write_in_order(4, lambda k: (f"slab {k}\\n", 1), lambda text, rows: sys.stdout.write(text), 2)
 """

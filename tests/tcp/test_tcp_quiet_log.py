@@ -17,6 +17,10 @@ def _tcp_lines(caplog) -> list[logging.LogRecord]:
     return [r for r in caplog.records if r.getMessage().startswith("TCP client ")]
 
 
+def _kinds(station) -> list[str]:
+    return [e.kind for e in station.core.events.since(0, 1000)[0] if e.kind in ("connect", "disconnect")]
+
+
 def test_a_client_connecting_and_leaving_writes_nothing_at_info(tcp_station, caplog) -> None:
     station, server = tcp_station
     with caplog.at_level(logging.DEBUG, logger="nfwserver.tcp"):
@@ -26,11 +30,11 @@ def test_a_client_connecting_and_leaving_writes_nothing_at_info(tcp_station, cap
             assert c.ask("STATUS").startswith("satellite=")  # its first line: now on record
             c.close()
         wait_for(lambda: len(_tcp_lines(caplog)) == 6, what="three connects and three disconnects")
+        wait_for(lambda: _kinds(station).count("disconnect") == 3, what="the third disconnect event")
     lines = _tcp_lines(caplog)
     assert [r.getMessage().split()[-1] for r in lines].count("connected") == 3
     assert all(r.levelno == logging.DEBUG for r in lines)  # for --verbose, not the station's log at INFO
-    kinds = [e.kind for e in station.core.events.since(0, 1000)[0] if e.kind in ("connect", "disconnect")]
-    assert kinds.count("connect") == 3 and kinds.count("disconnect") == 3
+    assert _kinds(station).count("connect") == 3  # the event stream keeps every one
 
 
 def test_a_close_the_server_decided_stays_at_info(caplog) -> None:
@@ -45,6 +49,8 @@ def test_a_close_the_server_decided_stays_at_info(caplog) -> None:
             station.run(31.0)  # no complete line for idle_timeout_s of the station's clock
             server.wake()
             assert c.read_line() == b""
+            # the socket is closed before the line is logged: wait for it while DEBUG is still captured
+            wait_for(lambda: any("disconnected" in r.getMessage() for r in _tcp_lines(caplog)), what="its log line")
     finally:
         c.close()
         server.stop()
