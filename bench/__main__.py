@@ -88,9 +88,12 @@ def main(argv: list[str]) -> int:
         print(f"unknown benchmark(s): {', '.join(unknown)}; have: {', '.join(names)} "
               f"(and, alone with its options: {', '.join(STANDALONE)})", file=sys.stderr)
         return 2
-    if "-h" in options or "--help" in options:  # each benchmark's own help; docs/BENCHMARKS.md untouched
+    if "-h" in options or "--help" in options:  # each benchmark's own help (none runs); docs/BENCHMARKS.md untouched
         for name in chosen:
-            subprocess.run([sys.executable, "-m", f"bench.bench_{name}", "--help"], cwd=ROOT, check=False)
+            if "argparse" in (ROOT / "bench" / f"bench_{name}.py").read_text():
+                subprocess.run([sys.executable, "-m", f"bench.bench_{name}", "--help"], cwd=ROOT, check=False)
+            else:
+                print(f"{name.replace('_', '-')}: {_summary(name)} (takes no options)")
         return 0
     old = _sections(OUT.read_text()) if OUT.exists() else {}
     written = 0

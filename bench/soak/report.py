@@ -72,8 +72,10 @@ def _fmt(value: float | None) -> str:
     return "-" if value is None else f"{value:.1f}"
 
 
-def section(title: str, what: str, soak: Soak, load: Load, minutes: float, warmup_s: float, plot: Path | None) -> str:
-    """The Markdown section of one run."""
+def section(title: str, what: str, soak: Soak, load: Load, minutes: float, warmup_s: float, plot: Path | None,
+            truth_s: float = TRUTH_S) -> str:
+    """The Markdown section of one run; an outage counts as shown late, or logged with a wrong length, beyond
+    ``truth_s`` seconds (less than :data:`TRUTH_S` when the outages are short)."""
     samples = soak.samples
     log_text = "".join(p.read_text("utf-8", "replace") for p in sorted(soak.work.glob("nfwserver.log*")))
     stalls = re.findall(r"publish tick ([\d.]+) s late: ([^\n]*)", log_text)
@@ -81,15 +83,15 @@ def section(title: str, what: str, soak: Soak, load: Load, minutes: float, warmu
     ended = soak.started + duration_s
     # Those the run's end cut short are left out; those STATUS was not sampled for are kept and count as untrue.
     seen = [s for s in outages_seen(soak, load, log_text)
-            if s.outage.up is not None and s.outage.up + TRUTH_S <= ended]
+            if s.outage.up is not None and s.outage.up + truth_s <= ended]
     silence_s, silence_at = longest_silence(load, soak.started, ended)
     first, last = samples[0], samples[-1]
     cpu = (last.cpu_s - first.cpu_s) / max(1e-9, last.at - first.at) * 100.0
     log_rate = (last.log_bytes - first.log_bytes) / max(1e-9, last.at - first.at) * 3600.0 / 1024.0
-    untrue = [s for s in seen if s.noticed_s is None or s.noticed_s > TRUTH_S or s.healed_s is None
-              or s.healed_s > TRUTH_S]
+    untrue = [s for s in seen if s.noticed_s is None or s.noticed_s > truth_s or s.healed_s is None
+              or s.healed_s > truth_s]
     wrong_length = [s for s in seen if s.logged_s is None or s.outage.up is None
-                    or abs(s.logged_s - (s.outage.up - s.outage.down)) > TRUTH_S]
+                    or abs(s.logged_s - (s.outage.up - s.outage.down)) > truth_s]
     lines = [f"## {title}", "", what, "",
              f"Ran {duration_s / 60.0:.1f} min (asked: {minutes:g} min); stopped by SIGTERM in "
              f"{_fmt(soak.stop_s)} s, exit code {soak.exit_code}.", "",
@@ -115,8 +117,8 @@ def section(title: str, what: str, soak: Soak, load: Load, minutes: float, warmu
              f"{sum(o.daemon == 'rigctld' for o in soak.outages)} |",
              f"| daemon restarts that failed and were retried | "
              f"{sum(len(o.restart_errors) for o in soak.outages)} |",
-             f"| outages STATUS showed late (> {TRUTH_S:g} s after the kill or the return) | {len(untrue)} |",
-             f"| outages whose logged length is off by > {TRUTH_S:g} s (or not logged) | {len(wrong_length)} |",
+             f"| outages STATUS showed late (> {truth_s:g} s after the kill or the return) | {len(untrue)} |",
+             f"| outages whose logged length is off by > {truth_s:g} s (or not logged) | {len(wrong_length)} |",
              ""]
     if stalls:
         lines += ["Stalls as the station explained them:", ""]
