@@ -30,15 +30,21 @@ def _env(home: Path) -> dict[str, str]:
             "WIN_PD_OVERRIDE_APPDATA": str(home / "roaming")}
 
 
-def test_stop_stops_the_station_when_its_control_file_cannot_be_written(tmp_path) -> None:
-    from nfwserver.cli.station_channel import StationChannel
-
+def _run_station(tmp_path: Path) -> tuple[subprocess.Popen[bytes], Path]:
+    """A headless station of this user (its own names, folders under ``tmp_path``) for 300 s, and its log."""
     config = write_station_config(tmp_path / "cfg", extra=OWN_NAMES)
     log = tmp_path / "station.log"
     station = subprocess.Popen(
         [sys.executable, "-m", "nfwserver", "run", "--headless", "--config", str(config), "--log-file", str(log),
          "--duration", "300"], cwd=ROOT, env=_env(tmp_path), stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE)
+    return station, log
+
+
+def test_stop_stops_the_station_when_its_control_file_cannot_be_written(tmp_path) -> None:
+    from nfwserver.cli.station_channel import StationChannel
+
+    station, log = _run_station(tmp_path)
     try:
         channel = StationChannel(tmp_path / "local" / "nfwserver")
         wait_for(lambda: station.poll() is not None or channel.serving() is not None, 90, "the station to serve")
@@ -130,12 +136,7 @@ def _suspend(pid: int, resume: bool = False) -> None:
 def test_a_stop_that_gives_up_on_a_suspended_station_withdraws_its_request_and_the_station_goes_on(tmp_path) -> None:
     from nfwserver.cli.station_channel import StationChannel
 
-    config = write_station_config(tmp_path / "cfg", extra=OWN_NAMES)
-    log = tmp_path / "station.log"
-    station = subprocess.Popen(
-        [sys.executable, "-m", "nfwserver", "run", "--headless", "--config", str(config), "--log-file", str(log),
-         "--duration", "300"], cwd=ROOT, env=_env(tmp_path), stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-        stderr=subprocess.PIPE)
+    station, log = _run_station(tmp_path)
 
     def stop(timeout_s: float) -> subprocess.CompletedProcess[str]:
         return subprocess.run([sys.executable, "-m", "nfwserver", "stop", "--timeout", f"{timeout_s:g}"], cwd=ROOT,
