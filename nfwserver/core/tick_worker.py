@@ -26,8 +26,9 @@ class TickWorker(ServiceThread):
     thread_name = "nfw-worker"
 
     def __init__(self, clock: Clock | None = None) -> None:
+        self.clock: Clock = clock if clock is not None else SystemClock()  #: the station's clock (the system's)
         #: A failure repeated every tick is logged (with its traceback) once, then counted.
-        self.warnings = RateLimitedLog(log, clock if clock is not None else SystemClock())
+        self.warnings = RateLimitedLog(log, self.clock)
         super().__init__()
         self._pending_lock = threading.Lock()  #: the hand-over of the newest sample between the two threads
         self._pending: TickSample | None = None

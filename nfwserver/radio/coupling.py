@@ -19,7 +19,7 @@ from __future__ import annotations
 import logging
 
 from nfwserver.channels.channel import Channel
-from nfwserver.clock import Clock, SystemClock
+from nfwserver.clock import Clock
 from nfwserver.core.sample import TickSample
 from nfwserver.core.state import StationState
 from nfwserver.core.tick_worker import TickWorker
@@ -41,7 +41,6 @@ class RadioCoupling(TickWorker):
         super().__init__(clock)
         self.tuner = tuner
         self.state = state
-        self.clock: Clock = clock if clock is not None else SystemClock()
         self._contact = -PROBE_S  # clock monotonic seconds the radio was last spoken to
         self.last_result: TuneResult | None = None
         self._catalog_number: int | None = None
